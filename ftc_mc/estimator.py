@@ -1,0 +1,191 @@
+"""Build the kernels' settings (namedtuples of arrays) from the plant and options.
+
+This is the bridge between the Python world (plant model, validated settings)
+and :mod:`ftc_mc.core`.  Paper values (section 5.1) are the defaults:
+``Q^x = 0.01^2 dt I_9``, ``Q^b = 0.001^2 dt I_5``, R from the sensor accuracies
+(``e^{-2}`` read as 1e-2 and ``e^{-6}`` as 1e-6, DESIGN.md section 4),
+thresholds ``t_q = t_nx = 25`` and the transition matrix ``T_M``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+
+from .core.settings import Belief, Detection, FilterModel
+from .model.faults import N_AUG, bias_matrix, fault_bounds
+from .model.linear import LinearPlant
+
+DEG = math.pi / 180.0
+_ANG = (0.05 * DEG) ** 2
+
+PAPER_R_DIAG = (1e-2, 1e-2, _ANG, 1e-2, 1e-2, _ANG, 1e-6, 1e-6, _ANG, _ANG, 1e-2, 1e-2)
+"""Measurement noise variances of the 12 outputs (paper section 5.1)."""
+
+PAPER_TM = (
+    (1 - 1e-7 - 2e-8, 1e-9, 1e-9, 1e-9),
+    (1e-7, 1 - 1e-9 - 2e-17, 1e-16, 1e-16),
+    (1e-8, 1e-17, 1 - 1e-9 - 1e-16 - 1e-17, 1e-17),
+    (1e-8, 1e-17, 1e-17, 1 - 1e-9 - 1e-16 - 1e-17),
+)
+"""Mode transition matrix T_M (paper section 5.1), column j = from mode j."""
+
+MODE_NAMES = ("nominal", "engine", "left_elevon", "right_elevon")
+
+
+@dataclasses.dataclass(frozen=True)
+class EstimatorSettings:
+    """Tunable settings of the estimation, detection and belief (section 3).
+
+    Parameters
+    ----------
+    sigma_qx : float
+        Process-noise density of the plant states: ``Q^x = sigma_qx^2 dt I``.
+    sigma_qb : float
+        Random-walk density of the fault parameters: ``Q^b = sigma_qb^2 dt I``.
+    r_diag : tuple of 12 float
+        Measurement noise variances (output units squared).
+    t_q, t_nx : float
+        Residual thresholds of Table 1 (dimensionless, > 0).
+    signature : str
+        ``"paper"`` (Table 1 as printed) or ``"swapped"``.
+    beta_engine, beta_elevon : float
+        Effectiveness loss above which an actuator counts as faulty in the mode
+        boxes (DESIGN.md section 4).
+    b0_nominal_engine, b0_nominal_elevon : float
+        Half-width of the nominal box of b0 (throttle [-], elevon sum [rad]).
+    tm : tuple
+        Mode transition matrix (column-stochastic).
+    """
+
+    sigma_qx: float = 0.01
+    sigma_qb: float = 0.001
+    r_diag: tuple = PAPER_R_DIAG
+    t_q: float = 25.0
+    t_nx: float = 25.0
+    signature: str = "paper"
+    beta_engine: float = 0.2
+    beta_elevon: float = 0.1
+    b0_nominal_engine: float = 0.05
+    b0_nominal_elevon: float = 0.05
+    tm: tuple = PAPER_TM
+
+    def __post_init__(self):
+        for name in ("sigma_qx", "sigma_qb", "t_q", "t_nx", "b0_nominal_engine",
+                     "b0_nominal_elevon"):
+            v = getattr(self, name)
+            if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
+                raise ValueError(f"estimator parameter {name!r} must be a finite "
+                                 f"number > 0, got {v!r}")
+        for name in ("beta_engine", "beta_elevon"):
+            v = getattr(self, name)
+            if not (isinstance(v, (int, float)) and 0 < v < 1):
+                raise ValueError(f"estimator parameter {name!r} must lie in (0, 1), "
+                                 f"got {v!r}")
+        r = np.asarray(self.r_diag, dtype=float)
+        if r.shape != (12,) or not np.all(np.isfinite(r)) or np.any(r <= 0):
+            raise ValueError("estimator parameter 'r_diag' must be 12 finite "
+                             f"variances > 0, got {self.r_diag!r}")
+        if self.signature not in ("paper", "swapped"):
+            raise ValueError("estimator parameter 'signature' must be 'paper' or "
+                             f"'swapped', got {self.signature!r}")
+        tm = np.asarray(self.tm, dtype=float)
+        if (tm.shape != (4, 4) or np.any(tm < 0)
+                or not np.allclose(tm.sum(axis=0), 1.0, atol=1e-12)):
+            raise ValueError("estimator parameter 'tm' must be a 4x4 "
+                             "column-stochastic matrix")
+
+
+def unit_rows(C: np.ndarray) -> np.ndarray:
+    """For each row of ``C``, the state index if it is a unit row, else -1."""
+    out = np.full(C.shape[0], -1, dtype=np.int64)
+    for r, row in enumerate(C):
+        nz = np.flatnonzero(row != 0.0)
+        if len(nz) == 1 and row[nz[0]] == 1.0:
+            out[r] = nz[0]
+    return out
+
+
+def filter_model(plant: LinearPlant, s: EstimatorSettings) -> FilterModel:
+    """Augmented filter model (eqs. 4-6) of a plant.
+
+    Parameters
+    ----------
+    plant : LinearPlant
+    s : EstimatorSettings
+
+    Returns
+    -------
+    FilterModel
+    """
+    C = plant.C
+    n = plant.A.shape[0]
+    q = np.empty(N_AUG)
+    q[:n] = s.sigma_qx ** 2 * plant.dt
+    q[n:] = s.sigma_qb ** 2 * plant.dt
+    lo, hi = fault_bounds(plant.u_lower, plant.u_upper)
+    return FilterModel(
+        A=np.ascontiguousarray(plant.A), B=np.ascontiguousarray(plant.B),
+        Bb0=np.ascontiguousarray(bias_matrix(plant.B)), C=np.ascontiguousarray(C),
+        c_ident=unit_rows(C), u0=plant.u0.copy(), q_diag=q,
+        r_diag=np.asarray(s.r_diag, dtype=float).copy(), lo=lo, hi=hi)
+
+
+def detection(plant: LinearPlant, s: EstimatorSettings) -> Detection:
+    """Table 1 settings and the reset variances of section 3.2.2.
+
+    Thrust block: ``((u_max - u_min)/t_nx)^2`` for b0, ``1/t_nx^2`` for b1;
+    elevon block: ``((u_max - u_min)/t_q)^2`` (one elevon's range) for the b0
+    sum, ``1/t_q^2`` for both b1.
+    """
+    rng = plant.u_upper - plant.u_lower
+    reset_var = np.array([(rng[0] / s.t_nx) ** 2, (rng[1] / s.t_q) ** 2,
+                          1.0 / s.t_nx ** 2, 1.0 / s.t_q ** 2, 1.0 / s.t_q ** 2])
+    return Detection(t_q=float(s.t_q), t_nx=float(s.t_nx),
+                     swapped=1 if s.signature == "swapped" else 0, reset_var=reset_var)
+
+
+def belief_settings(plant: LinearPlant, s: EstimatorSettings) -> Belief:
+    """Mode boxes of eq. (12) and ``T_M`` (DESIGN.md section 4).
+
+    Parameters are ``[b0_T, b0_e, b1_T, b1_L, b1_R]``.  Nominal: every ``b1`` in
+    ``[0, beta]`` and each ``b0`` within ``+-b0_nominal``.  Actuator ``i`` faulty:
+    its ``b1`` in ``[beta_i, 1]``, its ``b0`` free over its command range (a lock
+    has ``b1 = 1``, ``b0`` = the lock position), every other parameter nominal.
+    """
+    be, bt = s.beta_elevon, s.beta_engine
+    d_t, d_e = s.b0_nominal_engine, s.b0_nominal_elevon
+    nom_lo = np.array([-d_t, -d_e, 0.0, 0.0, 0.0])
+    nom_hi = np.array([d_t, d_e, bt, be, be])
+    lo = np.tile(nom_lo, (4, 1))
+    hi = np.tile(nom_hi, (4, 1))
+    lo[1, 0], hi[1, 0] = plant.u_lower[0], plant.u_upper[0]
+    lo[1, 2], hi[1, 2] = bt, 1.0
+    for m, j in ((2, 3), (3, 4)):
+        lo[m, 1], hi[m, 1] = plant.u_lower[1], plant.u_upper[1]
+        lo[m, j], hi[m, j] = be, 1.0
+    return Belief(TM=np.asarray(s.tm, dtype=float).copy(), lo=lo, hi=hi)
+
+
+def initial_covariance(fm: FilterModel, det: Detection) -> np.ndarray:
+    """Initial covariance: ``10 Q`` on the states, the reset variances on the faults.
+
+    The fault variances equal those of a reset of both blocks, i.e. the filter
+    starts as if every fault parameter had just been suspected.
+    """
+    P = np.diag(10.0 * fm.q_diag)
+    P[9:, 9:] = np.diag(det.reset_var)
+    return P
+
+
+@dataclasses.dataclass
+class Workspace:
+    """Work arrays of one trajectory's filter step."""
+
+    phi: np.ndarray = dataclasses.field(default_factory=lambda: np.zeros((9, 5)))
+    T: np.ndarray = dataclasses.field(default_factory=lambda: np.zeros((9, 14)))
+    h: np.ndarray = dataclasses.field(default_factory=lambda: np.zeros(14))
+    res: np.ndarray = dataclasses.field(default_factory=lambda: np.zeros(3))
+    belief: np.ndarray = dataclasses.field(default_factory=lambda: np.zeros(8))
