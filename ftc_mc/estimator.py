@@ -189,3 +189,5 @@ class Workspace:
     h: np.ndarray = dataclasses.field(default_factory=lambda: np.zeros(14))
     res: np.ndarray = dataclasses.field(default_factory=lambda: np.zeros(3))
     belief: np.ndarray = dataclasses.field(default_factory=lambda: np.zeros(8))
+    x_prev: np.ndarray = dataclasses.field(default_factory=lambda: np.zeros(14))
+    P_prev: np.ndarray = dataclasses.field(default_factory=lambda: np.zeros((14, 14)))

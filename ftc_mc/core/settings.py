@@ -36,3 +36,56 @@ Belief = namedtuple("Belief", [
     "hi",  # (4, 5) upper edge of each mode's box
 ])
 """Four-mode belief: nominal, engine, left elevon, right elevon (section 3.3)."""
+
+Controller = namedtuple("Controller", [
+    "K",       # (3, 9) state-feedback gain, u = -K x_hat (eqs. 17, 19)
+    "lo_dev",  # (3,) lower command limits as deviations from trim
+    "hi_dev",  # (3,) upper command limits as deviations from trim
+])
+"""Nominal controller c0 with its saturation (paper section 4.1, eqs. 15-19)."""
+
+Excitation = namedtuple("Excitation", [
+    "doublet_amp",      # amplitude of the engine doublet [throttle]
+    "doublet_half",     # steps of each half of the doublet
+    "s3211_amp",        # amplitude of the elevon 3211 [rad]
+    "s3211_unit",       # steps of one unit of the 3211
+    "resend_delay",     # steps after a thrust reset before the doublet re-check (3 s)
+    "resend_b1",        # re-send the doublet if b1_thrust estimate exceeds this (0.7)
+])
+"""Excitation on reset requests (paper sections 3.2.3 and 4.1.1)."""
+
+Timing = namedtuple("Timing", [
+    "n_steps",        # steps simulated
+    "k_fault",        # step at which the truth switches to the final mode
+    "reconf_every",   # steps between belief updates (reconfiguration period)
+    "detect_prob",    # belief of the final mode that counts as detected
+])
+"""Trial timing (DESIGN.md section 6)."""
+
+TrialInputs = namedtuple("TrialInputs", [
+    "b0_pre",     # (3, L) truth b0 per actuator before the switch (absolute lock position)
+    "b1_pre",     # (3, L) truth b1 per actuator before the switch
+    "b0_post",    # (3, L) truth b0 from the switch on
+    "b1_post",    # (3, L) truth b1 from the switch on
+    "mode_pre",   # (L,) int64 mode whose box holds the initial truth
+    "mode_post",  # (L,) int64 mode whose box holds the final truth
+    "xa0",        # (14, L) initial augmented estimate
+    "P0",         # (14, 14) initial covariance (shared)
+    "w",          # (n_steps, 9, L) process noise, already scaled
+    "v",          # (n_steps, 12, L) measurement noise, already scaled
+])
+"""Per-lane inputs of :func:`ftc_mc.core.trial.run_trials`."""
+
+TrialRecord = namedtuple("TrialRecord", [
+    "reset_k",      # (R, L) int64 step of each reset (time = k dt)
+    "reset_block",  # (R, L) int64 block of each reset (1 thrust, 2 elevons)
+    "reset_res",    # (R, 3, L) residuals r_q, r_nx, r_nz at each reset
+    "n_resets",     # (L,) int64 number of resets (may exceed R; extra not stored)
+    "belief",       # (n_periods, 4, L) belief after each reconfiguration period
+    "bhat",         # (n_periods, 5, L) fault-parameter estimate at each period
+    "detect_k",     # (L,) int64 first period end after the switch where the final
+                    #      mode is most probable with at least detect_prob, or -1
+    "status",       # (L,) int64 0 when the trial ran to its end
+    "xa_end",       # (14, L) final augmented estimate
+])
+"""Per-lane outputs of :func:`ftc_mc.core.trial.run_trials`."""

@@ -1,0 +1,65 @@
+"""Set up the project's virtual environment and run its main job or its tests.
+
+Only the Python standard library is used, so this works on a fresh machine with
+nothing but Python 3.11::
+
+    python3 dev.py run     # create .venv if needed, install, run the main job
+    python3 dev.py test    # create .venv if needed, install with test extras, run pytest
+
+Extra arguments after ``run`` go to ``ftc-mc``; after ``test`` to ``pytest``.
+The install is repeated only when ``pyproject.toml`` changes.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import subprocess
+import sys
+import venv
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent
+VENV = ROOT / ".venv"
+BIN = VENV / ("Scripts" if os.name == "nt" else "bin")
+PY = BIN / "python"
+
+MAIN_JOB = ["run", "configs/paper_tables.yaml"]
+
+
+def ensure_venv(extras: str) -> None:
+    """Create ``.venv`` and install the package (editable) with ``extras``."""
+    if sys.version_info < (3, 11):
+        sys.exit(f"dev.py: Python >= 3.11 is required, this is {sys.version.split()[0]}")
+    if not PY.exists():
+        print(f"dev.py: creating {VENV}", flush=True)
+        venv.EnvBuilder(with_pip=True).create(VENV)
+    digest = hashlib.sha256((ROOT / "pyproject.toml").read_bytes()).hexdigest()
+    stamp = VENV / f".installed-{extras or 'base'}"
+    if stamp.exists() and stamp.read_text() == digest:
+        return
+    print(f"dev.py: installing ftc-mc[{extras}] into {VENV}", flush=True)
+    target = f".[{extras}]" if extras else "."
+    subprocess.run([str(PY), "-m", "pip", "install", "--quiet", "--upgrade", "pip"],
+                   check=True, cwd=ROOT)
+    subprocess.run([str(PY), "-m", "pip", "install", "--quiet", "-e", target],
+                   check=True, cwd=ROOT)
+    stamp.write_text(digest)
+
+
+def main(argv: list[str]) -> int:
+    if not argv or argv[0] not in ("run", "test"):
+        print(__doc__)
+        return 2
+    cmd, rest = argv[0], argv[1:]
+    if cmd == "run":
+        ensure_venv("")
+        args = [str(BIN / "ftc-mc")] + (rest or MAIN_JOB)
+    else:
+        ensure_venv("test")
+        args = [str(PY), "-m", "pytest"] + (rest or ["-q"])
+    return subprocess.run(args, cwd=ROOT).returncode
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

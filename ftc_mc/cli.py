@@ -1,0 +1,115 @@
+"""The ``ftc-mc`` command line: parse, call, print.
+
+Every command turns a bad input into one line on stderr naming the problem and
+exit code 2, without a traceback and without writing anything.
+"""
+
+from __future__ import annotations
+
+import functools
+import json
+import sys
+
+import click
+
+from .errors import UserError
+
+
+def user_errors(func):
+    """Turn :class:`UserError` and ``ValueError`` into one line and exit code 2."""
+    @functools.wraps(func)
+    def wrapper(*args, **kwargs):
+        try:
+            return func(*args, **kwargs)
+        except (UserError, ValueError) as exc:
+            msg = str(exc).strip().splitlines()
+            click.echo(f"ftc-mc: error: {msg[0] if msg else type(exc).__name__}",
+                       err=True)
+            sys.exit(2)
+    return wrapper
+
+
+@click.group(context_settings={"help_option_names": ["-h", "--help"]})
+@click.version_option(package_name="ftc-mc")
+def cli():
+    """Monte Carlo fault injection for indirect active fault-tolerant control."""
+
+
+@cli.command()
+@click.option("--json", "as_json", is_flag=True, help="Print JSON instead of text.")
+@click.option("--save", type=click.Path(dir_okay=False, writable=True),
+              help="Write A, B, C, u0, limits and dt to this .npz file.")
+@click.option("--airspeed", default=20.0, show_default=True, type=float,
+              help="Trim airspeed [m/s].")
+@click.option("--gamma", "gamma_deg", default=-3.0, show_default=True, type=float,
+              help="Trim flight-path angle [deg].")
+@click.option("--dt", default=0.1, show_default=True, type=float,
+              help="Sampling period [s].")
+@user_errors
+def model(as_json, save, airspeed, gamma_deg, dt):
+    """Trim point, named eigenvalues and redundancy check of the linear model."""
+    from .io.atomic import atomic_path
+    from .model.linear import build_plant
+    from .model.summary import format_summary, model_summary, save_npz
+
+    if save is not None and not save.endswith(".npz"):
+        raise UserError(f"--save: file name must end in .npz, got {save!r}")
+    plant = build_plant(V0=airspeed, gamma0_deg=gamma_deg, dt=dt)
+    summary = model_summary(plant)
+    if save is not None:
+        with atomic_path(save) as tmp, open(tmp, "wb") as f:
+            save_npz(plant, f)
+    click.echo(json.dumps(summary, indent=2) if as_json else format_summary(summary))
+
+
+def _default_out(config_path: str):
+    """``results/<config stem>``, or the first ``-N`` suffix that holds no run."""
+    from pathlib import Path
+
+    from .io.results import RUN_FILES
+
+    base = Path("results") / Path(config_path).stem
+    cand, n = base, 1
+    while cand.exists() and any((cand / f).exists() for f in RUN_FILES):
+        n += 1
+        cand = base.with_name(f"{base.name}-{n}")
+    return cand
+
+
+@cli.command()
+@click.argument("config", type=click.Path(dir_okay=True))
+@click.option("--trials", type=int, help="Trials per transition (overrides the config).")
+@click.option("--seed", type=int, help="Root seed (overrides the config).")
+@click.option("--jobs", type=int, default=-1, show_default=True,
+              help="Worker processes; -1 uses every core. Results do not depend on it.")
+@click.option("--out", type=click.Path(file_okay=False),
+              help="Output directory [default: results/<config name>, never reused].")
+@click.option("--signature", type=click.Choice(["paper", "swapped", "both"]),
+              help="Table 1 variant(s) (overrides the config).")
+@click.option("--overwrite", is_flag=True, help="Replace results already in --out.")
+@click.option("--quiet", is_flag=True, help="No progress bar.")
+@user_errors
+def run(config, trials, seed, jobs, out, signature, overwrite, quiet):
+    """Run a Monte Carlo campaign (the paper's Tables 2-3) from CONFIG."""
+    from pathlib import Path
+
+    from .campaign.runner import resolve_config, run_campaign
+    from .io.results import prepare_output_dir, provenance, write_run
+
+    if jobs == 0 or jobs < -1:
+        raise UserError(f"--jobs: must be a positive count or -1, got {jobs}")
+    cfg = resolve_config(config, trials, seed, signature)
+    out_dir = Path(out) if out else _default_out(config)
+    prepare_output_dir(out_dir, overwrite)
+    result = run_campaign(cfg, jobs=jobs, progress=not quiet)
+    meta = provenance(cfg.model_dump(mode="json"), cfg.campaign.seed, "run")
+    md = "# ftc-mc run summary\n\n" + result.markdown() + "\n"
+    write_run(out_dir, result.trials, result.resets, result.summary, md, meta)
+    click.echo(result.markdown())
+    click.echo(f"\nwrote {out_dir}/: trials.parquet, resets.parquet, summary.parquet, "
+               "summary.md")
+
+
+def main():
+    """Console-script entry point."""
+    cli(prog_name="ftc-mc")

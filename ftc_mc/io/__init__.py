@@ -1,0 +1,1 @@
+"""Configuration, result files and reports (everything that touches the disk)."""

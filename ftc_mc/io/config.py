@@ -1,0 +1,347 @@
+"""Campaign configuration: pydantic models loaded from YAML.
+
+Every field has a documented default (the paper's value where it gives one);
+unknown keys, wrong types, NaN/inf and out-of-range numbers are refused with a
+message that names the field.  YAML is read with ``yaml.safe_load`` only, so no
+tag can construct a Python object.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+from typing import Annotated, Literal
+
+import yaml
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+
+from ..errors import UserError
+
+TRANSITIONS = ("elevon_lock", "elevon_unlock", "elevon_loss", "elevon_loss_recover",
+               "engine_lock", "engine_unlock", "engine_loss", "engine_loss_recover")
+"""The eight transitions of the paper's Tables 2-3 (DESIGN.md section 6)."""
+
+Pos = Annotated[float, Field(gt=0, allow_inf_nan=False)]
+NonNeg = Annotated[float, Field(ge=0, allow_inf_nan=False)]
+Fraction = Annotated[float, Field(gt=0, lt=1, allow_inf_nan=False)]
+Finite = Annotated[float, Field(allow_inf_nan=False)]
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True, use_attribute_docstrings=True)
+
+
+class ModelConfig(_Strict):
+    """Trim point and sampling (paper section 5.1)."""
+
+    airspeed_mps: Pos = 20.0
+    """Trim airspeed [m/s]."""
+    gamma_deg: Annotated[float, Field(gt=-30, lt=30, allow_inf_nan=False)] = -3.0
+    """Trim flight-path angle [deg]."""
+    dt_s: Annotated[float, Field(gt=0, le=1, allow_inf_nan=False)] = 0.1
+    """Control sampling period [s]."""
+
+
+class EstimatorConfig(_Strict):
+    """Filter noise, Table 1 thresholds and mode boxes (sections 3.2-3.3, 5.1)."""
+
+    sigma_qx: Pos = 0.01
+    """Process-noise density of the plant states: Q^x = sigma_qx^2 dt I."""
+    sigma_qb: Pos = 0.001
+    """Random-walk density of the fault parameters: Q^b = sigma_qb^2 dt I."""
+    t_q: Pos = 25.0
+    """Threshold on r_q (Table 1)."""
+    t_nx: Pos = 25.0
+    """Threshold on r_nx (Table 1)."""
+    beta_engine: Fraction = 0.2
+    """b1 of the engine above which the engine counts as faulty."""
+    beta_elevon: Fraction = 0.1
+    """b1 of an elevon above which it counts as faulty."""
+    b0_nominal_engine: Pos = 0.05
+    """Half-width of the nominal box of the thrust b0 [-]."""
+    b0_nominal_elevon: Pos = 0.05
+    """Half-width of the nominal box of the elevon-sum b0 [rad]."""
+
+
+class ControllerConfig(_Strict):
+    """Nominal discounted LQR (sections 4.1.2-4.1.3, 5.1)."""
+
+    kind: Literal["nominal"] = "nominal"
+    """Controller in the loop: ``nominal`` (c0 only)."""
+    discount: Annotated[float, Field(gt=0, le=1, allow_inf_nan=False)] = 0.999
+    """Discount factor alpha."""
+    r_lqr: Pos = 0.1
+    """R_lqr = r_lqr I_3."""
+
+
+class ExcitationConfig(_Strict):
+    """Excitation signals sent on covariance resets (sections 3.2.3, 4.1.1)."""
+
+    doublet_amplitude: Annotated[float, Field(gt=0, le=0.5, allow_inf_nan=False)] = 0.1
+    """Engine doublet amplitude [throttle fraction]."""
+    doublet_half_period_s: Pos = 1.0
+    """Duration of each half of the doublet [s] (engine time constant 0.3 s)."""
+    s3211_amplitude_rad: Annotated[float, Field(gt=0, le=0.3, allow_inf_nan=False)] = 0.05
+    """Elevon 3211 amplitude [rad], + on the left and - on the right elevon."""
+    s3211_unit_s: Pos = 0.2
+    """One unit of the 3211 [s] (the signal lasts 7 units)."""
+    resend_delay_s: NonNeg = 3.0
+    """Delay after a thrust reset before the doublet re-check [s]."""
+    resend_b1_threshold: Annotated[float, Field(ge=0, le=1, allow_inf_nan=False)] = 0.7
+    """Re-send the doublet if the estimated engine b1 exceeds this."""
+
+
+class NoiseConfig(_Strict):
+    """Truth noise as multiples of the filter's Q and R standard deviations."""
+
+    process_scale: NonNeg = 1.0
+    """Process-noise standard deviation / the filter's."""
+    measurement_scale: NonNeg = 1.0
+    """Measurement-noise standard deviation / the filter's."""
+
+
+class DrawsConfig(_Strict):
+    """Per-trial draws (DESIGN.md section 6)."""
+
+    engine_lock_range: tuple[Finite, Finite] | None = None
+    """Absolute throttle lock position range; null = the command range [0, 1]."""
+    elevon_lock_range_rad: tuple[Finite, Finite] | None = None
+    """Absolute left-elevon lock position range [rad]; null = the command range."""
+    loss_b1_range: tuple[Annotated[float, Field(ge=0, le=1)],
+                         Annotated[float, Field(ge=0, le=1)]] = (0.0, 1.0)
+    """Uniform range of the effectiveness loss b1."""
+
+    @model_validator(mode="after")
+    def _ordered(self):
+        for name in ("engine_lock_range", "elevon_lock_range_rad", "loss_b1_range"):
+            r = getattr(self, name)
+            if r is not None and not r[0] < r[1]:
+                raise ValueError(f"{name}: must be [low, high] with low < high, got {list(r)}")
+        return self
+
+
+class TimingConfig(_Strict):
+    """Trial timing: the switch at fault_time_s, judged over the window after it."""
+
+    fault_time_s: Pos = 20.0
+    """Time of the switch to the final mode [s]."""
+    window_s: Pos = 10.0
+    """Judging window after the switch for resets [s]."""
+    duration_s: Pos = 50.0
+    """Simulated time of a trial [s] (>= fault_time_s + window_s)."""
+    reconfiguration_period_s: Pos = 1.0
+    """Belief update period [s] (paper: 1 s)."""
+    detection_probability: Fraction = 0.5
+    """Belief of the final mode (also the most probable) that counts as detected."""
+
+    @model_validator(mode="after")
+    def _consistent(self):
+        if self.duration_s < self.fault_time_s + self.window_s:
+            raise ValueError("duration_s: must be at least fault_time_s + window_s "
+                             f"({self.fault_time_s + self.window_s:g}), got {self.duration_s:g}")
+        return self
+
+
+class ExplainConfig(_Strict):
+    """When a no-reset trial counts as explained (the paper's explanations)."""
+
+    engine_lock_near_trim: Pos = 0.05
+    """|lock - trim throttle| below which an engine lock is 'near trim' [-]."""
+    elevon_lock_near_trim_rad: Pos = 0.02
+    """|lock - trim elevon| below which an elevon lock is 'near trim' [rad]."""
+
+
+class CampaignConfig(_Strict):
+    """What to run."""
+
+    transitions: list[Literal[TRANSITIONS]] = Field(default_factory=lambda: ["elevon_lock"],
+                                                    min_length=1)
+    """Transitions to run (names of DESIGN.md section 6)."""
+    trials: Annotated[int, Field(gt=0, le=10_000_000)] = 1000
+    """Trials per transition."""
+    seed: Annotated[int, Field(ge=0, lt=2 ** 63)] = 2026
+    """Root seed: trial i draws from numpy.random.default_rng([i, seed])."""
+    signature: Literal["paper", "swapped", "both"] = "both"
+    """Table 1 variant(s) run on the same draws and noise."""
+    chunk_size: Annotated[int, Field(gt=0, le=4096)] = 128
+    """Trials per chunk (one kernel call, lanes); results do not depend on it."""
+    max_resets: Annotated[int, Field(gt=0, le=100_000)] = 64
+    """Resets stored per trial (more are counted, not stored)."""
+
+    @model_validator(mode="after")
+    def _unique(self):
+        if len(set(self.transitions)) != len(self.transitions):
+            raise ValueError("transitions: names must not repeat")
+        return self
+
+
+class Config(_Strict):
+    """A whole campaign configuration (one YAML file)."""
+
+    campaign: CampaignConfig = Field(default_factory=CampaignConfig)
+    model: ModelConfig = Field(default_factory=ModelConfig)
+    estimator: EstimatorConfig = Field(default_factory=EstimatorConfig)
+    controller: ControllerConfig = Field(default_factory=ControllerConfig)
+    excitation: ExcitationConfig = Field(default_factory=ExcitationConfig)
+    noise: NoiseConfig = Field(default_factory=NoiseConfig)
+    draws: DrawsConfig = Field(default_factory=DrawsConfig)
+    timing: TimingConfig = Field(default_factory=TimingConfig)
+    explain: ExplainConfig = Field(default_factory=ExplainConfig)
+
+    @model_validator(mode="after")
+    def _steps(self):
+        dt = self.model.dt_s
+        t = self.timing
+        e = self.excitation
+        for name, value in (("timing.fault_time_s", t.fault_time_s),
+                            ("timing.window_s", t.window_s),
+                            ("timing.duration_s", t.duration_s),
+                            ("timing.reconfiguration_period_s", t.reconfiguration_period_s),
+                            ("excitation.doublet_half_period_s", e.doublet_half_period_s),
+                            ("excitation.s3211_unit_s", e.s3211_unit_s),
+                            ("excitation.resend_delay_s", e.resend_delay_s)):
+            steps = value / dt
+            if abs(steps - round(steps)) > 1e-9 * max(1.0, steps) or (
+                    round(steps) < 1 and name != "excitation.resend_delay_s"):
+                raise ValueError(f"{name}: must be a positive multiple of model.dt_s "
+                                 f"({dt:g} s), got {value:g}")
+        n_steps = round(t.duration_s / dt)
+        if n_steps > 1_000_000:
+            raise ValueError(f"timing.duration_s: {n_steps} steps is more than 1e6")
+        return self
+
+    def steps(self, seconds: float) -> int:
+        """Number of sampling periods in ``seconds``."""
+        return int(round(seconds / self.model.dt_s))
+
+
+def _format_error(exc: ValidationError, source: str) -> str:
+    err = exc.errors()[0]
+    loc = ".".join(str(p) for p in err["loc"]) or "(top level)"
+    msg = err["msg"]
+    if msg.startswith("Value error, "):
+        msg = msg[len("Value error, "):]
+    prefix = re.match(r"^([A-Za-z_][\w.]*): (.*)$", msg)
+    if prefix and err["type"] == "value_error":
+        # a model validator names the field itself: "field: problem"
+        loc = prefix.group(1) if loc == "(top level)" else f"{loc}.{prefix.group(1)}"
+        return f"{source}: {loc}: {prefix.group(2)}"
+    got = err.get("input")
+    extra = ""
+    if err["type"] not in ("missing",) and not isinstance(got, (dict, list)):
+        extra = f" (got {got!r})"
+    more = len(exc.errors()) - 1
+    tail = f" [and {more} more problem{'s' if more > 1 else ''}]" if more else ""
+    return f"{source}: {loc}: {msg}{extra}{tail}"
+
+
+def parse_config(data, source: str = "config") -> Config:
+    """Validate a mapping as a :class:`Config`.
+
+    Parameters
+    ----------
+    data : dict
+        Parsed YAML.
+    source : str
+        Name used in error messages.
+
+    Raises
+    ------
+    UserError
+        Naming the field and the problem.
+    """
+    if data is None:
+        raise UserError(f"{source}: the file is empty; expected a mapping of sections")
+    if not isinstance(data, dict):
+        raise UserError(f"{source}: expected a mapping of sections at the top level, "
+                        f"got {type(data).__name__}")
+    try:
+        return Config.model_validate(data)
+    except ValidationError as exc:
+        raise UserError(_format_error(exc, source)) from None
+
+
+def load_config(path) -> Config:
+    """Read and validate a YAML configuration file.
+
+    Parameters
+    ----------
+    path : str or Path
+
+    Returns
+    -------
+    Config
+
+    Raises
+    ------
+    UserError
+        Missing or unreadable file, malformed YAML, or an invalid field.
+    """
+    path = Path(path)
+    if not path.exists():
+        raise UserError(f"{path}: no such file")
+    if not path.is_file():
+        raise UserError(f"{path}: not a regular file")
+    try:
+        text = path.read_bytes().decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise UserError(f"{path}: not UTF-8 text (byte {exc.start})") from None
+    except OSError as exc:
+        raise UserError(f"{path}: cannot read ({exc.strerror})") from None
+    try:
+        data = yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
+        problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
+        raise UserError(f"{path}: malformed YAML{where}: {problem}") from None
+    return parse_config(data, str(path))
+
+
+def with_overrides(cfg: Config, **sections) -> Config:
+    """Return ``cfg`` with fields replaced, re-validated.
+
+    Parameters
+    ----------
+    cfg : Config
+    **sections : dict
+        ``section={field: value}`` pairs, e.g. ``campaign={"trials": 10}``.
+    """
+    data = cfg.model_dump()
+    for section, fields in sections.items():
+        data[section].update({k: v for k, v in fields.items() if v is not None})
+    return parse_config(data, "options")
+
+
+
+def render_yaml(cfg: Config, title: str) -> str:
+    """A complete, commented YAML file for ``cfg``: every field with its doc.
+
+    Parameters
+    ----------
+    cfg : Config
+    title : str
+        First comment line.
+
+    Returns
+    -------
+    str
+        YAML that :func:`load_config` reads back to ``cfg``.
+    """
+    lines = [f"# {title}", "# Every field is listed with its default; delete a field to "
+             "use the default.", ""]
+    for section, field in Config.model_fields.items():
+        sub = getattr(cfg, section)
+        doc = (type(sub).__doc__ or "").strip().splitlines()[0]
+        lines.append(f"{section}:  # {doc}")
+        for name, info in type(sub).model_fields.items():
+            value = getattr(sub, name)
+            if isinstance(value, tuple):
+                value = list(value)
+            text = yaml.safe_dump(value, default_flow_style=True).strip()
+            if text.endswith("\n..."):
+                text = text[:-4].strip()
+            text = text.removesuffix("...").strip()
+            lines.append(f"  {name}: {text}  # {info.description or ''}".rstrip())
+        lines.append("")
+    return "\n".join(lines)

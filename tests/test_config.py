@@ -1,0 +1,89 @@
+"""Configuration: defaults, shipped files, and one-line errors for bad input."""
+
+import sys
+from pathlib import Path
+
+import pytest
+import yaml
+
+from ftc_mc.errors import UserError
+from ftc_mc.io.config import Config, load_config, parse_config
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "scripts"))
+from make_configs import campaign_configs  # noqa: E402
+
+
+def test_shipped_configs_are_current():
+    for fname, text in campaign_configs().items():
+        path = ROOT / "configs" / fname
+        assert path.read_text(encoding="utf-8") == text, (
+            f"configs/{fname} is stale: run python scripts/make_configs.py")
+        cfg = load_config(path)
+        assert cfg.campaign.trials == 1000
+
+
+def test_paper_tables_has_all_eight_rows():
+    cfg = load_config(ROOT / "configs" / "paper_tables.yaml")
+    assert len(cfg.campaign.transitions) == 8
+
+
+def test_paper_defaults():
+    cfg = Config()
+    assert cfg.estimator.t_q == cfg.estimator.t_nx == 25.0
+    assert cfg.controller.discount == 0.999
+    assert cfg.controller.r_lqr == 0.1
+    assert cfg.timing.reconfiguration_period_s == 1.0
+
+
+def test_scientific_notation_is_a_number(tmp_path):
+    # PyYAML reads 1e-3 as a string; validation must turn it into a float.
+    p = tmp_path / "c.yaml"
+    p.write_text("estimator:\n  sigma_qb: 1e-3\n")
+    assert load_config(p).estimator.sigma_qb == 1e-3
+
+
+@pytest.mark.parametrize("text,field", [
+    ("campaign:\n  trials: -5\n", "campaign.trials"),
+    ("campaign:\n  trials: many\n", "campaign.trials"),
+    ("campaign:\n  bogus: 1\n", "campaign.bogus"),
+    ("estimator:\n  t_q: .nan\n", "estimator.t_q"),
+    ("estimator:\n  t_nx: .inf\n", "estimator.t_nx"),
+    ("estimator:\n  t_q: 0\n", "estimator.t_q"),
+    ("campaign:\n  transitions: [elevon_flutter]\n", "campaign.transitions"),
+    ("campaign:\n  transitions: []\n", "campaign.transitions"),
+    ("timing:\n  fault_time_s: 20.05\n", "timing.fault_time_s"),
+    ("timing:\n  duration_s: 5\n", "timing.duration_s"),
+    ("campaign: 3\n", "campaign"),
+    ("- a\n- b\n", "mapping"),
+    ("", "empty"),
+    ("campaign: [\n", "malformed YAML"),
+    ("!!python/object/apply:os.system ['true']\n", "malformed YAML"),
+])
+def test_bad_config_names_the_field(tmp_path, text, field):
+    p = tmp_path / "c.yaml"
+    p.write_text(text)
+    with pytest.raises(UserError) as exc:
+        load_config(p)
+    msg = str(exc.value)
+    assert field in msg
+    assert "\n" not in msg
+
+
+def test_missing_file_and_directory(tmp_path):
+    with pytest.raises(UserError, match="no such file"):
+        load_config(tmp_path / "nope.yaml")
+    with pytest.raises(UserError, match="not a regular file"):
+        load_config(tmp_path)
+
+
+def test_non_utf8(tmp_path):
+    p = tmp_path / "c.yaml"
+    p.write_bytes(b"campaign:\n  seed: \xff\xfe\n")
+    with pytest.raises(UserError, match="UTF-8"):
+        load_config(p)
+
+
+def test_parse_roundtrip():
+    cfg = Config()
+    assert parse_config(yaml.safe_load(yaml.safe_dump(cfg.model_dump(mode="json")))) == cfg
