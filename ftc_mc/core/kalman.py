@@ -81,15 +81,21 @@ def predict(xa, P, u, fm, phi, T):
         T[i, 0] = acc
     for i in range(N_X):
         xa[i] = T[i, 0]
-    # T = [A Phi] P[:, :]  (rows 0..8 of A_aug times P)
+    # T = [A Phi] P[:, :]  (rows 0..8 of A_aug times P), a row at a time: each
+    # T[i, c] sums its terms from 0.0 in the same order as a dot product would
+    # (bit-identical), and the loop over c vectorises
     for i in range(N_X):
+        a = fm.A[i, 0]
         for c in range(N_AUG):
-            acc = 0.0
-            for j in range(N_X):
-                acc += fm.A[i, j] * P[j, c]
-            for j in range(N_F):
-                acc += phi[i, j] * P[N_X + j, c]
-            T[i, c] = acc
+            T[i, c] = 0.0 + a * P[0, c]
+        for j in range(1, N_X):
+            a = fm.A[i, j]
+            for c in range(N_AUG):
+                T[i, c] += a * P[j, c]
+        for j in range(N_F):
+            f = phi[i, j]
+            for c in range(N_AUG):
+                T[i, c] += f * P[N_X + j, c]
     # P_xx = T_x A^T + T_b Phi^T (upper triangle), P_xb = T_b
     for i in range(N_X):
         for k in range(i, N_X):
@@ -187,11 +193,15 @@ def update(xa, P, z, fm, h):
     h : ndarray, shape (14,)
         Work array.
     """
+    # only the upper triangle is updated (entry (a, b) read as P[min, max]);
+    # it is mirrored once at the end
     for r in range(N_Z):
         s_idx = fm.c_ident[r]
         if s_idx >= 0:
-            for a in range(N_AUG):
+            for a in range(s_idx):
                 h[a] = P[a, s_idx]
+            for a in range(s_idx, N_AUG):
+                h[a] = P[s_idx, a]
             pred = xa[s_idx]
         else:
             pred = 0.0
@@ -200,7 +210,10 @@ def update(xa, P, z, fm, h):
             for a in range(N_AUG):
                 acc = 0.0
                 for j in range(N_X):
-                    acc += P[a, j] * fm.C[r, j]
+                    if j < a:
+                        acc += P[j, a] * fm.C[r, j]
+                    else:
+                        acc += P[a, j] * fm.C[r, j]
                 h[a] = acc
         s = fm.r_diag[r]
         if s_idx >= 0:
@@ -216,9 +229,9 @@ def update(xa, P, z, fm, h):
             ha = h[a] * inv_s
             for b in range(a, N_AUG):
                 P[a, b] -= ha * h[b]
-        for a in range(N_AUG):
-            for b in range(a + 1, N_AUG):
-                P[b, a] = P[a, b]
+    for a in range(N_AUG):
+        for b in range(a + 1, N_AUG):
+            P[b, a] = P[a, b]
 
 
 @kernel

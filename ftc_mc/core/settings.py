@@ -63,10 +63,10 @@ Timing = namedtuple("Timing", [
 """Trial timing (DESIGN.md section 6)."""
 
 TrialInputs = namedtuple("TrialInputs", [
-    "b0_pre",     # (3, L) truth b0 per actuator before the switch (absolute lock position)
-    "b1_pre",     # (3, L) truth b1 per actuator before the switch
-    "b0_post",    # (3, L) truth b0 from the switch on
-    "b1_post",    # (3, L) truth b1 from the switch on
+    "k_switch",   # (E,) int64 steps at which the truth switches, k_switch[0] == 0
+    "b0",         # (E, 3, L) truth b0 per actuator from each switch on (absolute
+                  #           lock position when locked)
+    "b1",         # (E, 3, L) truth b1 per actuator from each switch on
     "mode_pre",   # (L,) int64 mode whose box holds the initial truth
     "mode_post",  # (L,) int64 mode whose box holds the final truth
     "xa0",        # (14, L) initial augmented estimate
@@ -74,7 +74,7 @@ TrialInputs = namedtuple("TrialInputs", [
     "w",          # (n_steps, 9, L) process noise, already scaled
     "v",          # (n_steps, 12, L) measurement noise, already scaled
 ])
-"""Per-lane inputs of :func:`ftc_mc.core.trial.run_trials`."""
+"""Per-lane inputs of :func:`ftc_mc.core.trial.run_trials` (a fault schedule)."""
 
 TrialRecord = namedtuple("TrialRecord", [
     "reset_k",      # (R, L) int64 step of each reset (time = k dt)
@@ -85,7 +85,39 @@ TrialRecord = namedtuple("TrialRecord", [
     "bhat",         # (n_periods, 5, L) fault-parameter estimate at each period
     "detect_k",     # (L,) int64 first period end after the switch where the final
                     #      mode is most probable with at least detect_prob, or -1
-    "status",       # (L,) int64 0 when the trial ran to its end
+    "status",       # (L,) int64 0 when the trial ran to its end, else a
+                    #      trial.STATUS_* reason
+    "stop_k",       # (L,) int64 step at which an invalid trial stopped, or -1
     "xa_end",       # (14, L) final augmented estimate
+    "controller",   # (n_periods, L) int64 controller in use after each period
+    "hist_x",       # (n_hist, 9, L) true state after each step (n_hist 0: none kept)
+    "hist_xa",      # (n_hist, 14, L) augmented estimate after each step
+    "hist_pdiag",   # (n_hist, 5, L) variances of the fault parameters
+    "hist_u",       # (n_hist, 3, L) commands applied during each step
+    "hist_res",     # (n_hist, 3, L) residuals r_q, r_nx, r_nz
+    "hist_exc",     # (n_hist, 2, L) doublet (engine) and 3211 (left elevon) values
+    "hist_block",   # (n_hist, L) int64 block reset at each step
 ])
 """Per-lane outputs of :func:`ftc_mc.core.trial.run_trials`."""
+
+Validity = namedtuple("Validity", [
+    "va_trim",     # trim airspeed [m/s]
+    "va_min",      # lowest airspeed the linear model is trusted at [m/s]
+    "va_max",      # highest [m/s]
+    "alpha_trim",  # trim angle of attack [rad]
+    "alpha_min",   # lowest angle of attack [rad]
+    "alpha_max",   # highest [rad]
+    "psd_every",   # steps between full positive-semi-definiteness checks of P
+])
+"""Where a trial stops as numerically or physically invalid (see core/trial.py)."""
+
+Reconfig = namedtuple("Reconfig", [
+    "kind",      # 0: nominal controller c0 only; 1: reconfiguring (eqs. 45-47)
+    "horizon",   # H, steps of the short-horizon prediction (eq. 45), >= 1
+    "alpha",     # discount factor (eqs. 18, 45)
+    "q_lqr",     # (9,) diagonal of Q_lqr (section 5.1)
+    "r_lqr",     # (3,) diagonal of R_lqr
+    "JN",        # (4, 3) terminal cost J^N(m, a) of mode m under controller a (eq. 46)
+    "penalty",   # (3, 3) switching penalty P(c, a) (eq. 46)
+])
+"""Controller selection settings (paper section 4.2)."""

@@ -64,14 +64,21 @@ class EstimatorConfig(_Strict):
 
 
 class ControllerConfig(_Strict):
-    """Nominal discounted LQR (sections 4.1.2-4.1.3, 5.1)."""
+    """Controllers and their selection (sections 4.1-4.2, 5.1)."""
 
-    kind: Literal["nominal"] = "nominal"
-    """Controller in the loop: ``nominal`` (c0 only)."""
-    discount: Annotated[float, Field(gt=0, le=1, allow_inf_nan=False)] = 0.999
-    """Discount factor alpha."""
+    kind: Literal["nominal", "reconfiguring"] = "reconfiguring"
+    """``nominal``: c0 only; ``reconfiguring``: c0/c1/c2 chosen by eqs. 45-47."""
+    discount: Annotated[float, Field(gt=0, lt=1, allow_inf_nan=False)] = 0.999
+    """Discount factor alpha (< 1: a locked engine needs it, section 4.1.2)."""
     r_lqr: Pos = 0.1
     """R_lqr = r_lqr I_3."""
+    horizon_s: Pos = 1.0
+    """Prediction horizon H of the selection (eq. 45) [s]."""
+    switch_penalty: NonNeg = 0.1
+    """Penalty P(c, a) of changing controller (eq. 46; paper 0.1)."""
+    terminal_horizon_s: Pos = 100.0
+    """Simulated rest of the mission for the terminal costs J^N (eq. 46) [s]
+    (100 s: the paper's mission, and about 1/(1 - alpha) steps)."""
 
 
 class ExcitationConfig(_Strict):
@@ -151,6 +158,27 @@ class ExplainConfig(_Strict):
     """|lock - trim elevon| below which an elevon lock is 'near trim' [rad]."""
 
 
+class ValidityConfig(_Strict):
+    """Envelope where a trial is trusted; a trial leaving it stops and is flagged."""
+
+    airspeed_min_mps: Pos = 12.0
+    """Lowest true airspeed [m/s] (about 1.2 times the X8's stall speed at this weight)."""
+    airspeed_max_mps: Pos = 30.0
+    """Highest true airspeed [m/s] (1.5 times trim: beyond it the linearisation is poor)."""
+    alpha_min_deg: Annotated[float, Field(ge=-45, le=0, allow_inf_nan=False)] = -8.0
+    """Lowest angle of attack [deg] (range of the aerodynamic fit)."""
+    alpha_max_deg: Annotated[float, Field(ge=0, le=45, allow_inf_nan=False)] = 12.0
+    """Highest angle of attack [deg] (below stall, range of the aerodynamic fit)."""
+    psd_check_period_s: Pos = 1.0
+    """Period of the full Cholesky check of the filter covariance [s]."""
+
+    @model_validator(mode="after")
+    def _ordered(self):
+        if not self.airspeed_min_mps < self.airspeed_max_mps:
+            raise ValueError("airspeed_max_mps: must exceed airspeed_min_mps")
+        return self
+
+
 class CampaignConfig(_Strict):
     """What to run."""
 
@@ -165,7 +193,7 @@ class CampaignConfig(_Strict):
     """Table 1 variant(s) run on the same draws and noise."""
     chunk_size: Annotated[int, Field(gt=0, le=4096)] = 128
     """Trials per chunk (one kernel call, lanes); results do not depend on it."""
-    max_resets: Annotated[int, Field(gt=0, le=100_000)] = 64
+    max_resets: Annotated[int, Field(gt=0, le=100_000)] = 256
     """Resets stored per trial (more are counted, not stored)."""
 
     @model_validator(mode="after")
@@ -187,6 +215,7 @@ class Config(_Strict):
     draws: DrawsConfig = Field(default_factory=DrawsConfig)
     timing: TimingConfig = Field(default_factory=TimingConfig)
     explain: ExplainConfig = Field(default_factory=ExplainConfig)
+    validity: ValidityConfig = Field(default_factory=ValidityConfig)
 
     @model_validator(mode="after")
     def _steps(self):
@@ -199,12 +228,20 @@ class Config(_Strict):
                             ("timing.reconfiguration_period_s", t.reconfiguration_period_s),
                             ("excitation.doublet_half_period_s", e.doublet_half_period_s),
                             ("excitation.s3211_unit_s", e.s3211_unit_s),
-                            ("excitation.resend_delay_s", e.resend_delay_s)):
+                            ("excitation.resend_delay_s", e.resend_delay_s),
+                            ("controller.horizon_s", self.controller.horizon_s),
+                            ("controller.terminal_horizon_s",
+                             self.controller.terminal_horizon_s),
+                            ("validity.psd_check_period_s",
+                             self.validity.psd_check_period_s)):
             steps = value / dt
             if abs(steps - round(steps)) > 1e-9 * max(1.0, steps) or (
                     round(steps) < 1 and name != "excitation.resend_delay_s"):
                 raise ValueError(f"{name}: must be a positive multiple of model.dt_s "
                                  f"({dt:g} s), got {value:g}")
+        if self.controller.horizon_s > t.duration_s:
+            raise ValueError("controller.horizon_s: must not exceed timing.duration_s "
+                             f"({t.duration_s:g} s), got {self.controller.horizon_s:g}")
         n_steps = round(t.duration_s / dt)
         if n_steps > 1_000_000:
             raise ValueError(f"timing.duration_s: {n_steps} steps is more than 1e6")
@@ -342,6 +379,7 @@ def render_yaml(cfg: Config, title: str) -> str:
             if text.endswith("\n..."):
                 text = text[:-4].strip()
             text = text.removesuffix("...").strip()
-            lines.append(f"  {name}: {text}  # {info.description or ''}".rstrip())
+            doc = " ".join((info.description or "").split())
+            lines.append(f"  {name}: {text}  # {doc}".rstrip())
         lines.append("")
     return "\n".join(lines)

@@ -1,0 +1,133 @@
+"""The Tables 2-3 summary: one row per transition and signature variant.
+
+Rates carry 95 % Wilson score intervals (:meth:`scipy.stats.binomtest`'s
+``proportion_ci(method="wilson")``).  The paper's own counts stand beside ours.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import scipy.stats
+
+from ..core.trial import STATUS_NAMES
+from .transitions import PAPER_TABLES, TRANSITION_TABLE
+
+
+def wilson(k: int, n: int, confidence: float = 0.95):
+    """Wilson score interval of a binomial proportion.
+
+    Parameters
+    ----------
+    k, n : int
+        Successes and trials (``n >= 1``).
+    confidence : float
+
+    Returns
+    -------
+    (float, float)
+    """
+    ci = scipy.stats.binomtest(int(k), int(n)).proportion_ci(confidence_level=confidence,
+                                                             method="wilson")
+    return float(ci.low), float(ci.high)
+
+
+def _rate(prefix: str, k: int, n: int) -> dict:
+    lo, hi = wilson(k, n) if n else (np.nan, np.nan)
+    return {prefix: int(k), f"{prefix}_rate": k / n if n else np.nan,
+            f"{prefix}_ci_low": lo, f"{prefix}_ci_high": hi}
+
+
+def _quantiles(prefix: str, values: np.ndarray) -> dict:
+    v = values[np.isfinite(values)]
+    if len(v) == 0:
+        return {f"{prefix}_median_s": np.nan, f"{prefix}_p95_s": np.nan}
+    return {f"{prefix}_median_s": float(np.median(v)),
+            f"{prefix}_p95_s": float(np.quantile(v, 0.95))}
+
+
+def summarize(trials: pd.DataFrame) -> pd.DataFrame:
+    """Summary table of a campaign.
+
+    Only judged trials (``judged`` column: no numerical failure, inside the
+    validity envelope through the judging window, all resets stored) enter the
+    rates; the others are counted in ``excluded``.  ``stopped_<reason>`` counts
+    every trial that stopped early, judged or not.
+
+    Parameters
+    ----------
+    trials : DataFrame
+        The ``trials.parquet`` table.
+
+    Returns
+    -------
+    DataFrame
+        One row per (transition, variant), in the paper's row order.
+    """
+    rows = []
+    order = {name: i for i, name in enumerate(TRANSITION_TABLE)}
+    for (name, variant), g in trials.groupby(["transition", "variant"], sort=False):
+        ok = g[g["judged"]]
+        n = len(ok)
+        no_reset = ok["no_reset"].to_numpy()
+        explained = no_reset & (ok["small_b1"].to_numpy() | ok["lock_near_trim"].to_numpy())
+        changed = ok["mode_changed"].to_numpy()
+        paper = PAPER_TABLES[name]
+        row = {"transition": name, "label": TRANSITION_TABLE[name].label,
+               "variant": variant, "trials": n, "excluded": len(g) - n}
+        for reason in STATUS_NAMES[1:]:
+            row[f"stopped_{reason}"] = int((g["status"] == reason).sum())
+        row["resets_truncated"] = int(g["resets_truncated"].sum())
+        row.update(_rate("inappropriate", int(ok["inappropriate"].sum()), n))
+        row.update(_rate("no_reset", int(no_reset.sum()), n))
+        row["no_reset_explained"] = int(explained.sum())
+        row["no_reset_explained_share"] = (explained.sum() / no_reset.sum()
+                                           if no_reset.sum() else np.nan)
+        row.update(_rate("correct", int(ok["correct"].sum()), n))
+        row.update(_quantiles("delay", ok["first_reset_s"].to_numpy()))
+        row["false_alarm_trials"] = int((ok["false_resets"] > 0).sum())
+        row["false_resets"] = int(ok["false_resets"].sum())
+        row["mode_changes"] = int(changed.sum())
+        row["detected"] = int(ok["detected"].sum())
+        row.update(_quantiles("detection", ok["detection_s"].to_numpy()))
+        row.update({"paper_trials": paper[0], "paper_inappropriate": paper[1],
+                    "paper_no_reset": paper[2]})
+        rows.append(row)
+    out = pd.DataFrame(rows)
+    if len(out):
+        out = out.sort_values(["transition", "variant"],
+                              key=lambda s: s.map(order) if s.name == "transition" else s,
+                              kind="stable").reset_index(drop=True)
+    return out
+
+
+def markdown_table(summary: pd.DataFrame) -> str:
+    """The summary as the paper's columns plus ours, in Markdown.
+
+    Columns: transition, variant, trials, inappropriate (rate, 95 % CI), no reset
+    (rate, CI, share explained), correct, median / p95 reset delay, false alarms,
+    detection median, and the paper's counts.
+    """
+    def pct(r, p):
+        return (f"{r[p]} ({100 * r[p + '_rate']:.1f} %, "
+                f"{100 * r[p + '_ci_low']:.1f}-{100 * r[p + '_ci_high']:.1f})")
+
+    def num(x, fmt="{:.1f}"):
+        return "-" if not np.isfinite(x) else fmt.format(x)
+
+    rows = []
+    for _, r in summary.iterrows():
+        rows.append({
+            "transition": r["label"], "signature": r["variant"], "judged": r["trials"],
+            "excluded": r["excluded"],
+            "inappropriate (%, 95% CI)": pct(r, "inappropriate"),
+            "no reset (%, 95% CI)": pct(r, "no_reset"),
+            "no reset explained": num(100 * r["no_reset_explained_share"], "{:.0f} %"),
+            "correct block": f"{100 * r['correct_rate']:.1f} %",
+            "delay median / p95 [s]": f"{num(r['delay_median_s'])} / {num(r['delay_p95_s'])}",
+            "false-alarm trials": r["false_alarm_trials"],
+            "detection median [s]": num(r["detection_median_s"]),
+            "paper: inappropriate / no reset": f"{r['paper_inappropriate']} / "
+                                               f"{r['paper_no_reset']} of {r['paper_trials']}",
+        })
+    return pd.DataFrame(rows).to_markdown(index=False)

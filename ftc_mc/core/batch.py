@@ -1,0 +1,613 @@
+"""Many independent augmented filters at once, lane-interleaved (paper eqs. 5-11).
+
+Each kernel here is the lane-wise twin of a single-trajectory kernel of
+:mod:`ftc_mc.core.kalman`, :mod:`ftc_mc.core.signature` and
+:mod:`ftc_mc.core.step`: lane ``l`` of every array is one trajectory, stored with
+the lane index *last* (``xa[14, L]``, ``P[14, 14, L]``, ``u[3, L]``, ``z[12, L]``)
+so that the innermost loops run over lanes and compile to 512-bit vector code
+(PERFORMANCE.md, lesson 2).  ``L`` is a run-time shape.
+
+Every lane is computed with the same floating-point operations, in the same
+order, as the single-trajectory kernel, so a lane agrees with
+:func:`ftc_mc.core.step.filter_step` bit for bit (fastmath stays off).  What
+differs is only the order in which *independent* results are produced:
+
+* lane-invariant coefficients (rows of ``A``, ``C``) are copied into tuples
+  before a lane loop, so the loop reads them from registers and the vectoriser
+  needs few run-time alias checks;
+* ``T = [A Phi] P`` is formed three rows at a time and ``P_xx`` three rows at
+  a time (entry ``(i, k)`` stored at ``[k, i]``, then mirrored), each loaded
+  ``P``/``T`` entry feeding three products.  Loops that store to several
+  entries of one array only vectorise when those entries differ in the *first*
+  index (LLVM rejects unknown distances along the others), hence the layouts;
+* the update keeps only the upper triangle of ``P`` while it works and mirrors
+  once at the end.  Consecutive unit rows of ``C`` (the first six outputs) are
+  taken as one group: their gains are formed lazily from the group's starting
+  ``P`` (``h_q = P_{q-1}[:, s_q]`` with the earlier rank-one terms subtracted
+  in the sequential order), then all the group's rank-one terms are applied in
+  one pass over the triangle.  The dense rows are processed one at a time as
+  in the single kernel;
+* a reset re-predicts from ``P_{k|k}``, which stays in ``P`` (the prediction
+  goes to a work array), only for the lanes that reset when they are few.
+
+Measured on the paper's problem, one core (``scripts/bench_core.py``): about
+1.6-1.7 M filter steps/s at 64-192 lanes, about 4x ``step.filter_step``.  The
+lane rows should start on 64-byte boundaries (``batch_workspace.lane_zeros``,
+``L`` a multiple of 8): NumPy's default placement cost 20 % here.  A cold
+compile of :func:`filter_step_lanes` takes about 30 s (then cached).
+
+Work arrays are passed in (:func:`ftc_mc.batch_workspace.new_lane_workspace`),
+so no kernel allocates.
+"""
+
+from __future__ import annotations
+
+from .jit import kernel
+
+N_X = 9
+N_F = 5
+N_AUG = 14
+N_Z = 12
+
+OUT_Q = 2
+OUT_NX = 6
+OUT_NZ = 7
+
+GROUP = 6
+"""Unit rows of ``C`` updated per pass (longer runs are split, shorter padded)."""
+
+UPDATE_ROWS = 2 * GROUP + 1
+"""First dimension of the update's work array ``h[UPDATE_ROWS, 14, L]``."""
+
+STEP_ROWS = N_AUG + UPDATE_ROWS + 1
+"""First dimension of the step's work array ``work[STEP_ROWS, 14, L]``."""
+
+SERIAL_REPREDICT = 8
+"""Up to this many reset lanes are re-predicted one run of lanes at a time;
+more re-predict every lane (identical results for the lanes without a reset)."""
+
+
+# ------------------------------------------------------------------ helpers
+@kernel
+def _row9(M, i):
+    """Row ``i`` of a ``(n, 9)`` matrix as a tuple (lane-invariant coefficients)."""
+    return (M[i, 0], M[i, 1], M[i, 2], M[i, 3], M[i, 4], M[i, 5], M[i, 6], M[i, 7],
+            M[i, 8])
+
+
+@kernel
+def _row2(M, i):
+    """Row ``i`` of a ``(n, 2)`` matrix as a tuple."""
+    return (M[i, 0], M[i, 1])
+
+
+@kernel
+def _neg_row3(M, i):
+    """Negated row ``i`` of a ``(n, 3)`` matrix as a tuple (``-B_i``, eq. 4)."""
+    return (-M[i, 0], -M[i, 1], -M[i, 2])
+
+
+@kernel
+def _mirror(P, l0, l1):
+    """Copy the upper triangle of ``P[:, :, l0:l1]`` onto the lower one."""
+    for i in range(N_AUG):
+        for k in range(i + 1, N_AUG):
+            for l in range(l0, l1):
+                P[k, i, l] = P[i, k, l]
+
+
+@kernel
+def _mirror_x(P, l0, l1):
+    """Copy the upper triangle of the plant-state block ``P[:9, :9]`` downwards."""
+    for i in range(N_X):
+        for k in range(i + 1, N_X):
+            for l in range(l0, l1):
+                P[k, i, l] = P[i, k, l]
+
+
+@kernel
+def _symmetric_copy(P, Pout, L):
+    """``Pout <- P`` from the upper triangle of ``P`` (both triangles written)."""
+    for i in range(N_AUG):
+        for k in range(i, N_AUG):
+            for l in range(L):
+                Pout[i, k, l] = P[i, k, l]
+        for k in range(i + 1, N_AUG):
+            for l in range(L):
+                Pout[k, i, l] = P[i, k, l]
+
+
+# ------------------------------------------------------------------ predict
+@kernel
+def _predict(xa, P, Pn, u, fm, phi, T, l0, l1):
+    """Eq. (5) on lanes ``l0:l1``: ``Pn <- A_aug P A_aug^T + Q`` (``Pn`` may be ``P``).
+
+    Reads the full symmetric ``P`` and writes the full symmetric ``Pn``; ``xa``
+    is advanced in place.  Operation order per lane as in
+    :func:`ftc_mc.core.kalman.predict`.
+    """
+    u00 = fm.u0[0]
+    u01 = fm.u0[1]
+    u02 = fm.u0[2]
+    # Phi(u) (eqs. 4-5), kept for the caller; the products below recompute it
+    for i in range(N_X):
+        bb = _row2(fm.Bb0, i)
+        nb = _neg_row3(fm.B, i)
+        for l in range(l0, l1):
+            phi[i, 0, l] = bb[0]
+            phi[i, 1, l] = bb[1]
+            phi[i, 2, l] = nb[0] * (u[0, l] + u00)
+            phi[i, 3, l] = nb[1] * (u[1, l] + u01)
+            phi[i, 4, l] = nb[2] * (u[2, l] + u02)
+    # state: x <- A x + B u + Phi b ; b unchanged (random walk, eq. 3)
+    for i in range(N_X):
+        a = _row9(fm.A, i)
+        b = (fm.B[i, 0], fm.B[i, 1], fm.B[i, 2])
+        for l in range(l0, l1):
+            acc = 0.0
+            for j in range(N_X):
+                acc += a[j] * xa[j, l]
+            for j in range(3):
+                acc += b[j] * u[j, l]
+            for j in range(N_F):
+                acc += phi[i, j, l] * xa[N_X + j, l]
+            T[i, 0, l] = acc
+    for i in range(N_X):
+        for l in range(l0, l1):
+            xa[i, l] = T[i, 0, l]
+    # T = [A Phi] P, three rows of A_aug at a time
+    for i in range(0, N_X, 3):
+        a0 = _row9(fm.A, i)
+        a1 = _row9(fm.A, i + 1)
+        a2 = _row9(fm.A, i + 2)
+        for c in range(N_AUG):
+            for l in range(l0, l1):
+                acc0 = 0.0
+                acc1 = 0.0
+                acc2 = 0.0
+                for j in range(N_X):
+                    p = P[j, c, l]
+                    acc0 += a0[j] * p
+                    acc1 += a1[j] * p
+                    acc2 += a2[j] * p
+                for j in range(N_F):
+                    p = P[N_X + j, c, l]
+                    acc0 += phi[i, j, l] * p
+                    acc1 += phi[i + 1, j, l] * p
+                    acc2 += phi[i + 2, j, l] * p
+                T[i, c, l] = acc0
+                T[i + 1, c, l] = acc1
+                T[i + 2, c, l] = acc2
+    # P_bb unchanged (copied when predicting out of place)
+    for i in range(N_X, N_AUG):
+        for k in range(i, N_AUG):
+            for l in range(l0, l1):
+                Pn[i, k, l] = P[i, k, l]
+    # P_xx = T_x A^T + T_b Phi^T, entry (i, k) stored at [k, i] for three k
+    # at a time (one T_i row load feeds three products); every block that
+    # reaches the lower triangle of column i is formed (its entries right of
+    # the diagonal are overwritten when the lower triangle is mirrored up)
+    for k in range(0, N_X, 3):
+        a0 = _row9(fm.A, k)
+        a1 = _row9(fm.A, k + 1)
+        a2 = _row9(fm.A, k + 2)
+        for i in range(k + 3):
+            for l in range(l0, l1):
+                acc0 = 0.0
+                acc1 = 0.0
+                acc2 = 0.0
+                for j in range(N_X):
+                    t = T[i, j, l]
+                    acc0 += t * a0[j]
+                    acc1 += t * a1[j]
+                    acc2 += t * a2[j]
+                for j in range(N_F):
+                    t = T[i, N_X + j, l]
+                    acc0 += t * phi[k, j, l]
+                    acc1 += t * phi[k + 1, j, l]
+                    acc2 += t * phi[k + 2, j, l]
+                Pn[k, i, l] = acc0
+                Pn[k + 1, i, l] = acc1
+                Pn[k + 2, i, l] = acc2
+    # P_xb = T_b
+    for i in range(N_X):
+        for j in range(N_F):
+            for l in range(l0, l1):
+                Pn[i, N_X + j, l] = T[i, N_X + j, l]
+    for i in range(N_AUG):
+        qi = fm.q_diag[i]
+        for l in range(l0, l1):
+            Pn[i, i, l] += qi
+    for i in range(N_X):
+        for k in range(i + 1, N_X):
+            for l in range(l0, l1):
+                Pn[i, k, l] = Pn[k, i, l]
+        for k in range(N_X, N_AUG):
+            for l in range(l0, l1):
+                Pn[k, i, l] = Pn[i, k, l]
+    for i in range(N_X, N_AUG):
+        for k in range(i + 1, N_AUG):
+            for l in range(l0, l1):
+                Pn[k, i, l] = Pn[i, k, l]
+
+
+@kernel
+def predict_lanes(xa, P, u, fm, phi, T):
+    """Time update of every lane (eq. 5), as :func:`ftc_mc.core.kalman.predict`.
+
+    ``X <- A_aug(u) X + B_aug u`` and ``P <- A_aug(u) P A_aug(u)^T + Q`` with
+    ``A_aug(u) = [[A, Phi(u)], [0, I]]``, ``Phi(u) = [B_b0, B diag(-u - u0)]``;
+    only ``P_xx`` and ``P_xb`` change besides the diagonal ``Q``.
+
+    Parameters
+    ----------
+    xa : ndarray, shape (14, L)
+        Augmented estimates, updated in place.
+    P : ndarray, shape (14, 14, L)
+        Covariances, symmetric, updated in place (stay exactly symmetric).
+    u : ndarray, shape (3, L)
+        Command deviations from trim applied during the step.
+    fm : FilterModel
+    phi : ndarray, shape (9, 5, L)
+        Work array; holds ``Phi(u)`` of each lane on return.
+    T : ndarray, shape (9, 14, L)
+        Work array.
+    """
+    _predict(xa, P, P, u, fm, phi, T, 0, xa.shape[1])
+
+
+# ------------------------------------------------------------------ residuals
+@kernel
+def residuals_lanes(xa, P, z, fm, res):
+    """Normalised residuals ``r_q, r_nx, r_nz`` of every lane (eqs. 9-11).
+
+    As :func:`ftc_mc.core.kalman.residuals`: ``r_i = mu_i^2 / (C_i P C_i^T + R_ii)``
+    on the prediction.
+
+    Parameters
+    ----------
+    xa : ndarray, shape (14, L)
+        Predicted augmented states ``X_{k+1|k}``.
+    P : ndarray, shape (14, 14, L)
+        Predicted covariances ``P_{k+1|k}`` (symmetric).
+    z : ndarray, shape (12, L)
+        Measurement deviations from the trim outputs.
+    fm : FilterModel
+    res : ndarray, shape (3, L)
+        Written with ``[r_q, r_nx, r_nz]`` of each lane.
+    """
+    L = xa.shape[1]
+    for o in range(3):
+        r = OUT_Q if o == 0 else (OUT_NX if o == 1 else OUT_NZ)
+        s_idx = fm.c_ident[r]
+        rr = fm.r_diag[r]
+        if s_idx >= 0:
+            for l in range(L):
+                mu = z[r, l] - xa[s_idx, l]
+                s = P[s_idx, s_idx, l] + rr
+                res[o, l] = mu * mu / s
+        else:
+            c = _row9(fm.C, r)
+            for l in range(L):
+                pred = 0.0
+                s = 0.0
+                for j in range(N_X):
+                    pred += c[j] * xa[j, l]
+                    acc = 0.0
+                    for k in range(N_X):
+                        acc += P[j, k, l] * c[k]
+                    s += c[j] * acc
+                mu = z[r, l] - pred
+                s = s + rr
+                res[o, l] = mu * mu / s
+
+
+# ------------------------------------------------------------------ signature
+@kernel
+def signature_lanes(res, det, block):
+    """Table 1 on every lane, as :func:`ftc_mc.core.signature.signature`.
+
+    Parameters
+    ----------
+    res : ndarray, shape (3, L)
+        ``[r_q, r_nx, r_nz]`` of each lane (eqs. 9-11).
+    det : Detection
+        Thresholds ``t_q``, ``t_nx`` and the variant (``swapped`` 0: Table 1 as
+        printed; 1: third clause's ``r_nz`` comparison swapped).
+    block : ndarray of int64, shape (L,)
+        Written with ``NO_RESET`` (0), ``RESET_THRUST`` (1) or
+        ``RESET_ELEVONS`` (2) per lane.
+    """
+    L = res.shape[1]
+    t_q = det.t_q
+    t_nx = det.t_nx
+    swapped = det.swapped != 0
+    for l in range(L):
+        r_nx = res[1, l]
+        nx_hit = r_nx >= t_nx
+        q_hit = res[0, l] >= t_q
+        nz_big = (res[2, l] >= r_nx) != swapped
+        b = 0
+        if nx_hit and q_hit:
+            b = 1 if nz_big else 2
+        elif nx_hit:
+            b = 1
+        elif q_hit:
+            b = 2
+        block[l] = b
+
+
+@kernel
+def reset_lanes(P, block, reset_var):
+    """Reset the suspected fault block of each lane (section 3.2.2).
+
+    As :func:`ftc_mc.core.signature.reset_covariance` per lane: the rows and
+    columns of the block's fault parameters are zeroed and their variances set
+    to ``reset_var``.
+
+    Parameters
+    ----------
+    P : ndarray, shape (14, 14, L)
+        Covariances, updated in place.
+    block : ndarray of int64, shape (L,)
+        Block per lane: 0 no reset, 1 thrust ``{b0_T, b1_T}``, 2 elevons
+        ``{b0_e, b1_L, b1_R}``.
+    reset_var : ndarray, shape (5,)
+        Variance of each fault parameter after its block is reset.
+    """
+    L = P.shape[2]
+    for l in range(L):
+        b = block[l]
+        if b == 1 or b == 2:
+            for j in range(N_F):
+                if b == 1:
+                    hit = j == 0 or j == 2
+                else:
+                    hit = j == 1 or j == 3 or j == 4
+                if hit:
+                    i = N_X + j
+                    for k in range(N_AUG):
+                        P[i, k, l] = 0.0
+                        P[k, i, l] = 0.0
+                    P[i, i, l] = reset_var[j]
+
+
+# ------------------------------------------------------------------ update
+@kernel
+def _unit_group(xa, P, z, fm, hk, vk, gs, r0, q_max):
+    """Sequential updates with the unit rows ``r0 .. r0+q-1`` of ``C`` (q <= GROUP).
+
+    The gains are formed lazily: ``h_q = P_{q-1}[:, s_q]`` where each entry of
+    ``P_{q-1}`` is the group's starting upper-triangle entry minus the earlier
+    rank-one terms ``(h_k[a] / s_k) h_k[b]`` (``a <= b``) in order, which are the
+    very operations the single kernel applies to ``P`` one row at a time; the
+    state is advanced the same way.  Then one pass over the upper triangle
+    subtracts all rank-one terms in order.  Returns ``q``.
+    """
+    L = xa.shape[1]
+    q = 0
+    while q < q_max and r0 + q < N_Z and fm.c_ident[r0 + q] >= 0:
+        r = r0 + q
+        s = fm.c_ident[r]
+        rr = fm.r_diag[r]
+        for a in range(N_AUG):
+            lo = min(a, s)
+            hi = max(a, s)
+            for l in range(L):
+                hk[q, a, l] = P[lo, hi, l]
+            for k in range(q):
+                for l in range(L):
+                    hk[q, a, l] -= vk[k, lo, l] * hk[k, hi, l]
+        # gs[q] = gain g_q = mu_q / s_q ; gs[GROUP + q] = 1 / s_q
+        for l in range(L):
+            gs[q, l] = xa[s, l]
+        for k in range(q):
+            for l in range(L):
+                gs[q, l] += hk[k, s, l] * gs[k, l]
+        for l in range(L):
+            sv = rr + hk[q, s, l]
+            gs[q, l] = (z[r, l] - gs[q, l]) / sv
+            gs[GROUP + q, l] = 1.0 / sv
+        for a in range(N_AUG):
+            for l in range(L):
+                vk[q, a, l] = hk[q, a, l] * gs[GROUP + q, l]
+        q += 1
+    for k in range(q, GROUP):
+        for a in range(N_AUG):
+            for l in range(L):
+                vk[k, a, l] = 0.0
+                hk[k, a, l] = 0.0
+    for k in range(q):
+        for a in range(N_AUG):
+            for l in range(L):
+                xa[a, l] += hk[k, a, l] * gs[k, l]
+    for a in range(N_AUG):
+        for b in range(a, N_AUG):
+            for l in range(L):
+                acc = P[a, b, l]
+                for k in range(GROUP):
+                    acc -= vk[k, a, l] * hk[k, b, l]
+                P[a, b, l] = acc
+    return q
+
+
+@kernel
+def _dense_row(xa, P, z, fm, h, v, gs, r):
+    """Scalar update with a dense row ``r`` of ``C`` (upper triangle of ``P`` kept)."""
+    L = xa.shape[1]
+    rr = fm.r_diag[r]
+    c = _row9(fm.C, r)
+    _mirror_x(P, 0, L)
+    for a in range(N_X):
+        for l in range(L):
+            acc = 0.0
+            for j in range(N_X):
+                acc += P[a, j, l] * c[j]
+            h[a, l] = acc
+    for a in range(N_X, N_AUG):
+        for l in range(L):
+            acc = 0.0
+            for j in range(N_X):
+                acc += P[j, a, l] * c[j]
+            h[a, l] = acc
+    for l in range(L):
+        pred = 0.0
+        for j in range(N_X):
+            pred += c[j] * xa[j, l]
+        sv = rr
+        for j in range(N_X):
+            sv += c[j] * h[j, l]
+        gs[0, l] = (z[r, l] - pred) / sv
+        gs[1, l] = 1.0 / sv
+    for a in range(N_AUG):
+        for l in range(L):
+            xa[a, l] += h[a, l] * gs[0, l]
+    for a in range(N_AUG):
+        for l in range(L):
+            v[a, l] = h[a, l] * gs[1, l]
+    for a in range(N_AUG):
+        for b in range(a, N_AUG):
+            for l in range(L):
+                P[a, b, l] -= v[a, l] * h[b, l]
+
+
+@kernel
+def _update(xa, P, z, fm, h):
+    """The 12 sequential scalar updates on the upper triangle of ``P`` (no mirror)."""
+    hk = h[0:GROUP]
+    vk = h[GROUP:2 * GROUP]
+    gs = h[2 * GROUP]
+    r = 0
+    while r < N_Z:
+        if fm.c_ident[r] >= 0:
+            r += _unit_group(xa, P, z, fm, hk, vk, gs, r, GROUP)
+        else:
+            _dense_row(xa, P, z, fm, hk[0], vk[0], gs, r)
+            r += 1
+
+
+@kernel
+def update_lanes(xa, P, z, fm, h):
+    """Measurement update of every lane with its 12 outputs (eq. 5, R diagonal).
+
+    As :func:`ftc_mc.core.kalman.update`: one scalar update per output,
+    ``h = P c^T``, ``s = c h + R_rr``, ``X += h (z_r - c X) / s``,
+    ``P -= (h / s) h^T``; a unit row of ``C`` (``fm.c_ident[r] >= 0``) reads a
+    column of ``P`` instead of multiplying.  ``P`` stays exactly symmetric.
+
+    Parameters
+    ----------
+    xa : ndarray, shape (14, L)
+        Updated in place.
+    P : ndarray, shape (14, 14, L)
+        Updated in place.
+    z : ndarray, shape (12, L)
+        Measurement deviations from the trim outputs.
+    fm : FilterModel
+    h : ndarray, shape (UPDATE_ROWS, 14, L)
+        Work array (``UPDATE_ROWS = 13``).
+    """
+    _update(xa, P, z, fm, h)
+    _mirror(P, 0, xa.shape[1])
+
+
+# ------------------------------------------------------------------ projection
+@kernel
+def project_lanes(xa, fm):
+    """Active-set projection of every lane's fault parameters (eqs. 6-8).
+
+    As :func:`ftc_mc.core.kalman.project`: each violated bound of
+    ``lo <= b <= hi`` becomes an equality, which sets that parameter to its
+    bound; ``P`` is not projected (semi-closed loop, Fig. 2).
+
+    Parameters
+    ----------
+    xa : ndarray, shape (14, L)
+        Updated in place.
+    fm : FilterModel
+    """
+    L = xa.shape[1]
+    for j in range(N_F):
+        lo = fm.lo[j]
+        hi = fm.hi[j]
+        for l in range(L):
+            v = xa[N_X + j, l]
+            xa[N_X + j, l] = lo if v < lo else (hi if v > hi else v)
+
+
+# ------------------------------------------------------------------ step
+@kernel
+def filter_step_lanes(xa, P, u, z, fm, det, phi, T, work, res, block):
+    """Advance every lane's filter by one sampling period, as
+    :func:`ftc_mc.core.step.filter_step`.
+
+    Per lane: predict (eq. 5); residuals (eqs. 9-11); Table 1 signature; on a
+    reset, reset the block of ``P_{k|k}`` (section 3.2.2) and predict again from
+    it; measurement update; projection of the fault parameters (eqs. 6-8).
+
+    ``P_{k|k}`` stays in ``P`` while the prediction goes to ``work[:14]``, so
+    the lanes that reset are re-predicted without a copy of ``P``: up to
+    ``SERIAL_REPREDICT`` of them run by run of adjacent lanes, more by
+    predicting every lane again (bit-identical for the others).
+
+    Parameters
+    ----------
+    xa : ndarray, shape (14, L)
+        Augmented estimates, updated in place.
+    P : ndarray, shape (14, 14, L)
+        Covariances, updated in place (exactly symmetric).
+    u : ndarray, shape (3, L)
+        Command deviations applied during the step.
+    z : ndarray, shape (12, L)
+        Measurement deviations from trim outputs at the end of the step.
+    fm : FilterModel
+    det : Detection
+    phi, T : ndarray
+        Work arrays of shapes (9, 5, L) and (9, 14, L).
+    work : ndarray, shape (STEP_ROWS, 14, L)
+        Work array (``STEP_ROWS = 28``).
+    res : ndarray, shape (3, L)
+        Written with ``[r_q, r_nx, r_nz]`` on the first prediction.
+    block : ndarray of int64, shape (L,)
+        Written with the block reset this step per lane (0 if none).
+    """
+    L = xa.shape[1]
+    Pn = work[0:N_AUG]
+    h = work[N_AUG:N_AUG + UPDATE_ROWS]
+    x_prev = work[N_AUG + UPDATE_ROWS]
+    for i in range(N_X):
+        for l in range(L):
+            x_prev[i, l] = xa[i, l]
+    _predict(xa, P, Pn, u, fm, phi, T, 0, L)
+    residuals_lanes(xa, Pn, z, fm, res)
+    signature_lanes(res, det, block)
+    n_reset = 0
+    for l in range(L):
+        if block[l] != 0:
+            n_reset += 1
+    if n_reset > 0:
+        reset_lanes(P, block, det.reset_var)
+        for l in range(L):
+            if block[l] != 0:
+                for i in range(N_X):
+                    xa[i, l] = x_prev[i, l]
+        if n_reset > SERIAL_REPREDICT:
+            for l in range(L):
+                if block[l] == 0:
+                    for i in range(N_X):
+                        xa[i, l] = x_prev[i, l]
+            _predict(xa, P, Pn, u, fm, phi, T, 0, L)
+        else:
+            l = 0
+            while l < L:
+                if block[l] != 0:
+                    l1 = l + 1
+                    while l1 < L and block[l1] != 0:
+                        l1 += 1
+                    _predict(xa, P, Pn, u, fm, phi, T, l, l1)
+                    l = l1
+                else:
+                    l += 1
+    _update(xa, Pn, z, fm, h)
+    _symmetric_copy(Pn, P, L)
+    project_lanes(xa, fm)

@@ -1,0 +1,332 @@
+"""Monte Carlo trials of the semi-closed estimation loop, many at once (lanes).
+
+One lane is one trial: the linear plant with the injected fault (eq. 4) and
+process/measurement noise, the nominal discounted-LQR controller with the
+saturation of eqs. (15-16), the doublet / 3211 excitation on reset requests and
+the re-sent doublet (section 4.1.1), the estimator (eqs. 5-11, Table 1), and the
+belief (eqs. 12-14) every reconfiguration period.
+
+Lane-last storage (``a[..., L]``) lets the inner loops vectorise across trials
+(PERFORMANCE.md lesson 2).  Random numbers come in from outside (``w``, ``v``) so
+each trial's stream depends only on its own seed.
+
+Timeline of step ``k -> k+1`` (time ``t = k dt``):
+
+1. controller ``U = -K x_hat_k``; commands ``u_k = f(U, s_k, A_k)`` (eq. 15);
+2. truth: fault parameters of the schedule's current entry; effect
+   ``e_k`` (eq. 2); ``x_{k+1} = A x_k + B e_k + w_k``; ``z_{k+1} = C x_{k+1} + v_k``;
+3. filter step with ``u_k`` and ``z_{k+1}`` (see :mod:`ftc_mc.core.step`);
+4. a reset of the thrust block starts the doublet on the engine (unless one is
+   running) and schedules a re-check ``resend_delay`` steps later, when the
+   doublet is sent again if ``b1_thrust`` is estimated above ``resend_b1``; a
+   reset of the elevon block starts the 3211 (+ on the left, - on the right
+   elevon) unless one is running;
+5. every ``reconf_every`` steps the belief is updated from the fault-parameter
+   estimate and its marginal variances.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .batch import STEP_ROWS, filter_step_lanes
+from .belief import belief_update
+from .control import C_ELEVON, controller_command, select_controller
+from .excitation import doublet, saturate, signal_3211
+from .jit import kernel
+
+STATUS_OK = 0
+STATUS_NONFINITE = 1      # estimate or covariance not finite
+STATUS_NOT_PSD = 2        # covariance lost positive semi-definiteness
+STATUS_AIRSPEED = 3       # true airspeed outside the validity bounds
+STATUS_ALPHA = 4          # true angle of attack outside the validity bounds
+STATUS_NAMES = ("ok", "nonfinite", "covariance_not_psd", "airspeed_out_of_bounds",
+                "alpha_out_of_bounds")
+NO_SIGNAL = -(1 << 40)
+OUT_ALPHA = 8
+OUT_VA = 11
+
+
+@kernel
+def is_psd(P, l, work):
+    """Cholesky test of ``P[:, :, l] + eps I`` (``eps = 1e-12 max diag``).
+
+    Parameters
+    ----------
+    P : ndarray, shape (n, n, L)
+    l : int
+        Lane.
+    work : ndarray, shape (n, n)
+
+    Returns
+    -------
+    bool
+        False if a pivot is not positive (or not finite).
+    """
+    n = P.shape[0]
+    dmax = 0.0
+    for i in range(n):
+        dmax = max(dmax, abs(P[i, i, l]))
+    eps = 1e-12 * dmax
+    for i in range(n):
+        for j in range(i + 1):
+            acc = P[i, j, l] + (eps if i == j else 0.0)
+            for m in range(j):
+                acc -= work[i, m] * work[j, m]
+            if i == j:
+                if not acc > 0.0:
+                    return False
+                work[i, i] = np.sqrt(acc)
+            else:
+                work[i, j] = acc / work[j, j]
+    return True
+
+
+@kernel
+def run_trials(fm, det, bs, ctl, exc, tim, val, rc, eng, inp, rec):
+    """Simulate ``L`` trials to the end, writing their records.
+
+    Parameters
+    ----------
+    fm : FilterModel
+    det : Detection
+    bs : Belief
+    ctl : Controller
+    exc : Excitation
+    tim : Timing
+    val : Validity
+        A lane stops being recorded (its ``status`` and ``stop_k`` are set, later
+        resets and detections are ignored) when its estimate or covariance is
+        not finite, its covariance fails the Cholesky test (every
+        ``psd_every`` steps), or the true airspeed or angle of attack (trim plus
+        the linear outputs) leaves the validity bounds.
+    rc : Reconfig
+        ``rc.kind == 0``: the nominal controller c0 throughout; ``1``: the
+        controller is re-selected every reconfiguration period (eqs. 45-47)
+        among c0, c1 and c2 (:mod:`ftc_mc.core.control`).
+    eng : EngineTables
+        Theorem 4.1 tables of c1.
+    inp : TrialInputs
+        Per-lane fault schedule, initial estimates and noise.
+    rec : TrialRecord
+        Preallocated outputs, overwritten.
+    """
+    n_steps = tim.n_steps
+    L = inp.w.shape[2]
+    nx = 9
+    n_res_max = rec.reset_k.shape[0]
+    x = np.zeros((nx, L))
+    xn = np.zeros((nx, L))
+    xa = inp.xa0.copy()
+    P = np.empty((14, 14, L))
+    for i in range(14):
+        for j in range(14):
+            for l in range(L):
+                P[i, j, l] = inp.P0[i, j]
+    u = np.zeros((3, L))
+    e = np.zeros((3, L))
+    z = np.zeros((12, L))
+    res = np.zeros((3, L))
+    block = np.zeros(L, dtype=np.int64)
+    phi = np.zeros((9, 5, L))
+    T = np.zeros((9, 14, L))
+    work = np.zeros((STEP_ROWS, 14, L))
+    d_start = np.full(L, NO_SIGNAL, dtype=np.int64)
+    s_start = np.full(L, NO_SIGNAL, dtype=np.int64)
+    recheck = np.full(L, -1, dtype=np.int64)
+    belief = np.zeros((4, L))
+    bl = np.zeros(4)
+    bh = np.zeros(5)
+    bv = np.zeros(5)
+    bwork = np.zeros(8)
+    chol = np.zeros((14, 14))
+    alive = np.ones(L, dtype=np.bool_)
+    cur = np.zeros(L, dtype=np.int64)
+    xl = np.zeros(14)
+    Ul = np.zeros(3)
+    Pl = np.zeros((14, 14))
+    xs = np.zeros(14)
+    Ps = np.zeros((14, 14))
+    sel_work = np.zeros((4, 14))
+    phi1 = np.zeros((9, 5))
+    T1 = np.zeros((9, 14))
+    bsel = np.zeros(4)
+    exc_now = np.zeros((2, L))
+    n_hist = rec.hist_x.shape[0]
+    for l in range(L):
+        rec.stop_k[l] = -1
+        belief[inp.mode_pre[l], l] = 1.0
+        rec.n_resets[l] = 0
+        rec.detect_k[l] = -1
+        rec.status[l] = STATUS_OK
+    d_len = 2 * exc.doublet_half
+    s_len = 7 * exc.s3211_unit
+    period = 0
+    ev = 0
+    n_ev = inp.k_switch.shape[0]
+    for k in range(n_steps):
+        # 1. controller and saturation with excitation headroom (eqs. 15-25, 44)
+        if rc.kind == 0:
+            for i in range(3):
+                for l in range(L):
+                    u[i, l] = 0.0
+                for j in range(nx):
+                    kij = ctl.K[i, j]
+                    for l in range(L):
+                        u[i, l] -= kij * xa[j, l]
+        else:
+            for l in range(L):
+                for i in range(14):
+                    xl[i] = xa[i, l]
+                controller_command(cur[l], xl, ctl.K, eng, fm.u0, Ul)
+                for i in range(3):
+                    u[i, l] = Ul[i]
+        for l in range(L):
+            kd = k - d_start[l]
+            if 0 <= kd < d_len:
+                sd = doublet(kd, exc.doublet_half, exc.doublet_amp)
+                u[0, l] = saturate(u[0, l], sd, exc.doublet_amp, ctl.lo_dev[0],
+                                   ctl.hi_dev[0])
+            else:
+                sd = 0.0
+                u[0, l] = saturate(u[0, l], 0.0, 0.0, ctl.lo_dev[0], ctl.hi_dev[0])
+            exc_now[0, l] = sd
+            ks = k - s_start[l]
+            if 0 <= ks < s_len:
+                s = signal_3211(ks, exc.s3211_unit, exc.s3211_amp)
+                if cur[l] == C_ELEVON:  # eq. 23: scaled by the left elevon's efficiency
+                    s *= 1.0 - xa[12, l]
+                a = exc.s3211_amp
+            else:
+                s = 0.0
+                a = 0.0
+            exc_now[1, l] = s
+            u[1, l] = saturate(u[1, l], s, a, ctl.lo_dev[1], ctl.hi_dev[1])
+            u[2, l] = saturate(u[2, l], -s, a, ctl.lo_dev[2], ctl.hi_dev[2])
+        # 2. truth: actuator effect (eq. 2) and plant (eq. 4)
+        while ev + 1 < n_ev and k >= inp.k_switch[ev + 1]:
+            ev += 1
+        for i in range(3):
+            u0 = fm.u0[i]
+            for l in range(L):
+                b1il = inp.b1[ev, i, l]
+                e[i, l] = inp.b0[ev, i, l] + (1.0 - b1il) * u[i, l] - b1il * u0
+        for i in range(nx):
+            for l in range(L):
+                xn[i, l] = inp.w[k, i, l]
+            for j in range(nx):
+                aij = fm.A[i, j]
+                for l in range(L):
+                    xn[i, l] += aij * x[j, l]
+            for j in range(3):
+                bij = fm.B[i, j]
+                for l in range(L):
+                    xn[i, l] += bij * e[j, l]
+        for i in range(nx):
+            for l in range(L):
+                x[i, l] = xn[i, l]
+        for r in range(12):
+            for l in range(L):
+                z[r, l] = inp.v[k, r, l]
+            for j in range(nx):
+                crj = fm.C[r, j]
+                if crj != 0.0:
+                    for l in range(L):
+                        z[r, l] += crj * x[j, l]
+        # 3. estimator
+        filter_step_lanes(xa, P, u, z, fm, det, phi, T, work, res, block)
+        kn = k + 1
+        # validity of the trial: numerics and the linear model's envelope
+        check_psd = kn % val.psd_every == 0
+        for l in range(L):
+            if not alive[l]:
+                continue
+            status = STATUS_OK
+            va = val.va_trim
+            al = val.alpha_trim
+            for j in range(nx):
+                va += fm.C[OUT_VA, j] * x[j, l]
+                al += fm.C[OUT_ALPHA, j] * x[j, l]
+            finite = np.isfinite(va) and np.isfinite(al)
+            for i in range(14):
+                if not (np.isfinite(xa[i, l]) and np.isfinite(P[i, i, l])):
+                    finite = False
+            if not finite:
+                status = STATUS_NONFINITE
+            elif check_psd and not is_psd(P, l, chol):
+                status = STATUS_NOT_PSD
+            elif not (val.va_min <= va <= val.va_max):
+                status = STATUS_AIRSPEED
+            elif not (val.alpha_min <= al <= val.alpha_max):
+                status = STATUS_ALPHA
+            if status != STATUS_OK:
+                alive[l] = False
+                rec.status[l] = status
+                rec.stop_k[l] = kn
+        # 4. resets, excitation requests, re-sent doublet
+        for l in range(L):
+            bk = block[l] if alive[l] else 0
+            if bk != 0:
+                n = rec.n_resets[l]
+                if n < n_res_max:
+                    rec.reset_k[n, l] = kn
+                    rec.reset_block[n, l] = bk
+                    for c in range(3):
+                        rec.reset_res[n, c, l] = res[c, l]
+                rec.n_resets[l] = n + 1
+                if bk == 1:
+                    if not (0 <= kn - d_start[l] < d_len):
+                        d_start[l] = kn
+                    recheck[l] = kn + exc.resend_delay
+                elif not (0 <= kn - s_start[l] < s_len):
+                    s_start[l] = kn
+            if recheck[l] == kn:
+                recheck[l] = -1
+                if xa[11, l] > exc.resend_b1 and not (0 <= kn - d_start[l] < d_len):
+                    d_start[l] = kn
+        if k < n_hist:
+            for l in range(L):
+                for i in range(nx):
+                    rec.hist_x[k, i, l] = x[i, l]
+                for i in range(14):
+                    rec.hist_xa[k, i, l] = xa[i, l]
+                for j in range(5):
+                    rec.hist_pdiag[k, j, l] = P[9 + j, 9 + j, l]
+                for i in range(3):
+                    rec.hist_u[k, i, l] = u[i, l]
+                    rec.hist_res[k, i, l] = res[i, l]
+                rec.hist_exc[k, 0, l] = exc_now[0, l]
+                rec.hist_exc[k, 1, l] = exc_now[1, l]
+                rec.hist_block[k, l] = block[l]
+        # 5. belief every reconfiguration period (eqs. 13-14) and controller
+        #    selection (eqs. 45-47)
+        if kn % tim.reconf_every == 0:
+            for l in range(L):
+                for m in range(4):
+                    bl[m] = belief[m, l]
+                for j in range(5):
+                    bh[j] = xa[9 + j, l]
+                    bv[j] = P[9 + j, 9 + j, l]
+                best = belief_update(bl, bs, bh, bv, bwork)
+                for m in range(4):
+                    belief[m, l] = bl[m]
+                    rec.belief[period, m, l] = bl[m]
+                for j in range(5):
+                    rec.bhat[period, j, l] = bh[j]
+                if rc.kind != 0:
+                    for i in range(14):
+                        xl[i] = xa[i, l]
+                        for j in range(14):
+                            Pl[i, j] = P[i, j, l]
+                    cur[l] = select_controller(cur[l], xl, Pl, bl, fm, bs, rc, eng, ctl.K,
+                                               ctl.lo_dev, ctl.hi_dev, xs, Ps, bsel, sel_work,
+                                               phi1, T1)
+                rec.controller[period, l] = cur[l]
+                mp = inp.mode_post[l]
+                if (alive[l] and kn > tim.k_fault and rec.detect_k[l] < 0 and best == mp
+                        and bl[mp] >= tim.detect_prob):
+                    rec.detect_k[l] = kn
+            period += 1
+    for i in range(14):
+        for l in range(L):
+            rec.xa_end[i, l] = xa[i, l]

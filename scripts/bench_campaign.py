@@ -1,0 +1,80 @@
+"""Benchmark of `ftc-mc run configs/paper_tables.yaml` (issue: campaign speed).
+
+Prints, for the full reproduction (1000 trials per transition, 8 transitions,
+both signature variants, 500 steps each):
+
+* cold compile: a fresh interpreter with an empty Numba cache compiling every
+  campaign kernel (``NUMBA_CACHE_DIR`` pointed at an empty folder);
+* cached start: ``ftc-mc run configs/elevon_lock.yaml`` end to end in a new
+  process with the cache warm;
+* wall time and trial steps per second with ``--jobs 1`` and ``--jobs 2``
+  (one trial step = plant, controller, filter and logic for one 0.1 s period).
+
+The last line is ``trial_steps_per_s=<x> wall_s=<y> compile_s=<z>`` for --jobs 2.
+Usage: ``python scripts/bench_campaign.py [--trials N]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+WARM = ("import numpy as np; from ftc_mc.io.config import load_config; "
+        "from ftc_mc.campaign.setup import build_setup; "
+        "from ftc_mc.campaign.runner import warm_up; "
+        "c = load_config('configs/paper_tables.yaml'); warm_up(build_setup(c), c)")
+
+
+def timed(cmd, env=None):
+    t = time.perf_counter()
+    subprocess.run(cmd, cwd=ROOT, env=env, check=True, stdout=subprocess.DEVNULL)
+    return time.perf_counter() - t
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--trials", type=int, default=1000)
+    args = ap.parse_args()
+    py = sys.executable
+    with tempfile.TemporaryDirectory() as cache:
+        env = dict(os.environ, NUMBA_CACHE_DIR=cache)
+        import_s = timed([py, "-c", "import ftc_mc.campaign.runner"], env)
+        cold_s = timed([py, "-c", WARM], env)
+    compile_s = cold_s - import_s
+    timed([py, "-c", WARM])  # make sure the normal cache is warm
+    with tempfile.TemporaryDirectory() as out:
+        cached_start_s = timed([py, "-m", "ftc_mc", "run", "configs/elevon_lock.yaml",
+                                "--out", str(Path(out) / "r"), "--quiet"])
+
+    import ftc_mc
+    from ftc_mc.io.config import load_config
+
+    cfg = load_config(ROOT / "configs" / "paper_tables.yaml")
+    n_steps = cfg.steps(cfg.timing.duration_s)
+    variants = 2 if cfg.campaign.signature == "both" else 1
+    steps = args.trials * len(cfg.campaign.transitions) * variants * n_steps
+    rows = {}
+    for jobs in (1, 2):
+        t = time.perf_counter()
+        ftc_mc.run_campaign(cfg, trials=args.trials, jobs=jobs, progress=False)
+        wall = time.perf_counter() - t
+        rows[jobs] = (wall, steps / wall)
+    print(f"paper_tables.yaml: {args.trials} trials x {len(cfg.campaign.transitions)} "
+          f"transitions x {variants} variants x {n_steps} steps = {steps:,} trial steps")
+    print(f"cold compile (empty cache, minus {import_s:.2f} s import): {compile_s:8.2f} s")
+    print(f"cached start, ftc-mc run configs/elevon_lock.yaml:   {cached_start_s:8.2f} s")
+    for jobs, (wall, rate) in rows.items():
+        print(f"--jobs {jobs}: wall {wall:7.2f} s   {rate / 1e6:6.3f} M trial steps/s")
+    print(f"jobs 2 / jobs 1 speed-up: {rows[1][0] / rows[2][0]:.2f}x")
+    wall, rate = rows[2]
+    print(f"trial_steps_per_s={rate:.4g} wall_s={wall:.3f} compile_s={compile_s:.2f}")
+
+
+if __name__ == "__main__":
+    main()
