@@ -110,6 +110,34 @@ def run(config, trials, seed, jobs, out, signature, overwrite, quiet):
                "summary.md")
 
 
+@cli.command()
+@click.argument("config", type=click.Path(dir_okay=True))
+@click.option("--out", type=click.Path(file_okay=False),
+              help="Output directory [default: results/<config name>, never reused].")
+@click.option("--seed", type=int, help="Noise seed (overrides the config).")
+@click.option("--overwrite", is_flag=True, help="Replace results already in --out.")
+@user_errors
+def scenario(config, out, seed, overwrite):
+    """Run the closed-loop scenario of CONFIG (the paper's Table 4 by default)."""
+    from pathlib import Path
+
+    from .io.config import load_scenario
+    from .io.results import prepare_output_dir, provenance
+    from .scenario import run_scenario, summary_markdown, write_scenario
+
+    sc = load_scenario(config)
+    if seed is not None and seed < 0:
+        raise UserError(f"--seed: must be >= 0, got {seed}")
+    out_dir = Path(out) if out else _default_out(config)
+    prepare_output_dir(out_dir, overwrite)
+    res = run_scenario(sc, seed=seed)
+    meta = provenance(res.config.model_dump(mode="json"), res.config.scenario.seed,
+                      "scenario")
+    files = write_scenario(res, out_dir, meta)
+    click.echo(summary_markdown(res))
+    click.echo(f"wrote {out_dir}/: " + ", ".join(p.name for p in files))
+
+
 def main():
     """Console-script entry point."""
     cli(prog_name="ftc-mc")

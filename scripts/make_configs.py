@@ -13,7 +13,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from ftc_mc.campaign.transitions import TRANSITION_TABLE  # noqa: E402
-from ftc_mc.io.config import Config, render_yaml  # noqa: E402
+from ftc_mc.io.config import Config, ScenarioConfig, render_yaml  # noqa: E402
 
 
 def campaign_configs() -> dict:
@@ -27,6 +27,9 @@ def campaign_configs() -> dict:
     cfg = Config.model_validate({"campaign": {"transitions": list(TRANSITION_TABLE)}})
     files["paper_tables.yaml"] = render_yaml(
         cfg, "ftc-mc run configs/paper_tables.yaml -- all eight rows of Tables 2-3")
+    files["paper_scenario.yaml"] = render_yaml(
+        ScenarioConfig(), "ftc-mc scenario configs/paper_scenario.yaml -- the paper's 100 s "
+                          "landing approach (Table 4) with the full reconfiguring loop")
     return files
 
 

@@ -298,8 +298,30 @@ def parse_config(data, source: str = "config") -> Config:
         raise UserError(_format_error(exc, source)) from None
 
 
+def _read_yaml(path):
+    """Parsed YAML of a file (safe loader), or :class:`UserError`."""
+    path = Path(path)
+    if not path.exists():
+        raise UserError(f"{path}: no such file")
+    if not path.is_file():
+        raise UserError(f"{path}: not a regular file")
+    try:
+        text = path.read_bytes().decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise UserError(f"{path}: not UTF-8 text (byte {exc.start})") from None
+    except OSError as exc:
+        raise UserError(f"{path}: cannot read ({exc.strerror})") from None
+    try:
+        return yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
+        problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
+        raise UserError(f"{path}: malformed YAML{where}: {problem}") from None
+
+
 def load_config(path) -> Config:
-    """Read and validate a YAML configuration file.
+    """Read and validate a YAML campaign configuration file.
 
     Parameters
     ----------
@@ -314,25 +336,7 @@ def load_config(path) -> Config:
     UserError
         Missing or unreadable file, malformed YAML, or an invalid field.
     """
-    path = Path(path)
-    if not path.exists():
-        raise UserError(f"{path}: no such file")
-    if not path.is_file():
-        raise UserError(f"{path}: not a regular file")
-    try:
-        text = path.read_bytes().decode("utf-8")
-    except UnicodeDecodeError as exc:
-        raise UserError(f"{path}: not UTF-8 text (byte {exc.start})") from None
-    except OSError as exc:
-        raise UserError(f"{path}: cannot read ({exc.strerror})") from None
-    try:
-        data = yaml.safe_load(text)
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
-        problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
-        raise UserError(f"{path}: malformed YAML{where}: {problem}") from None
-    return parse_config(data, str(path))
+    return parse_config(_read_yaml(path), str(path))
 
 
 def with_overrides(cfg: Config, **sections) -> Config:
@@ -351,12 +355,12 @@ def with_overrides(cfg: Config, **sections) -> Config:
 
 
 
-def render_yaml(cfg: Config, title: str) -> str:
+def render_yaml(cfg: BaseModel, title: str) -> str:
     """A complete, commented YAML file for ``cfg``: every field with its doc.
 
     Parameters
     ----------
-    cfg : Config
+    cfg : Config or ScenarioConfig
     title : str
         First comment line.
 
@@ -367,7 +371,7 @@ def render_yaml(cfg: Config, title: str) -> str:
     """
     lines = [f"# {title}", "# Every field is listed with its default; delete a field to "
              "use the default.", ""]
-    for section, field in Config.model_fields.items():
+    for section in type(cfg).model_fields:
         sub = getattr(cfg, section)
         doc = (type(sub).__doc__ or "").strip().splitlines()[0]
         lines.append(f"{section}:  # {doc}")
@@ -375,6 +379,13 @@ def render_yaml(cfg: Config, title: str) -> str:
             value = getattr(sub, name)
             if isinstance(value, tuple):
                 value = list(value)
+            if isinstance(value, list) and value and isinstance(value[0], BaseModel):
+                lines.append(f"  {name}:  # {' '.join((info.description or '').split())}")
+                for item in value:
+                    d = {k: v for k, v in item.model_dump().items() if v is not None}
+                    flow = yaml.safe_dump(d, default_flow_style=True, sort_keys=False).strip()
+                    lines.append(f"    - {flow}")
+                continue
             text = yaml.safe_dump(value, default_flow_style=True).strip()
             if text.endswith("\n..."):
                 text = text[:-4].strip()
@@ -383,3 +394,133 @@ def render_yaml(cfg: Config, title: str) -> str:
             lines.append(f"  {name}: {text}  # {doc}".rstrip())
         lines.append("")
     return "\n".join(lines)
+
+
+ACTUATOR_NAMES = ("engine", "left_elevon", "right_elevon")
+
+
+class FaultEvent(_Strict):
+    """One entry of a scenario's fault schedule."""
+
+    time_s: NonNeg
+    """Time from which this entry holds [s]."""
+    fault: Literal["nominal", "lock", "loss"]
+    """``nominal`` (every actuator healthy), ``lock`` or ``loss`` (of effectiveness)."""
+    actuator: Literal[ACTUATOR_NAMES] | None = None
+    """Faulty actuator (``engine``, ``left_elevon``, ``right_elevon``); not for nominal."""
+    position: Finite | Literal["trim"] | None = None
+    """Lock position (absolute command: throttle [-] or elevon [rad]) or ``trim``."""
+    b1: Annotated[float, Field(ge=0, le=1, allow_inf_nan=False)] | None = None
+    """Effectiveness loss of a ``loss`` fault (0 healthy, 1 no effect)."""
+
+    @model_validator(mode="after")
+    def _fields(self):
+        if self.fault == "nominal":
+            if self.actuator is not None or self.position is not None or self.b1 is not None:
+                raise ValueError("actuator: a nominal entry takes no actuator, position or b1")
+        elif self.actuator is None:
+            raise ValueError(f"actuator: a {self.fault} entry needs one of {list(ACTUATOR_NAMES)}")
+        elif self.fault == "lock" and (self.position is None or self.b1 is not None):
+            raise ValueError("position: a lock entry needs a position (number or 'trim') "
+                             "and no b1")
+        elif self.fault == "loss" and (self.b1 is None or self.position is not None):
+            raise ValueError("b1: a loss entry needs b1 in [0, 1] and no position")
+        return self
+
+
+class ScenarioSpec(_Strict):
+    """The closed-loop scenario: fault schedule, length, seed, signature."""
+
+    duration_s: Pos = 100.0
+    """Simulated time [s] (paper: 100 s)."""
+    seed: Annotated[int, Field(ge=0, lt=2 ** 63)] = 2026
+    """Seed of the process and measurement noise."""
+    signature: Literal["paper", "swapped"] = "swapped"
+    """Table 1 variant (swapped: fewer inappropriate resets in ftc-mc run, see docs)."""
+    reconfiguration_period_s: Pos = 1.0
+    """Belief update and controller selection period [s] (paper: 1 s)."""
+    detection_probability: Fraction = 0.5
+    """Belief of the true mode (also the most probable) that counts as detected."""
+    schedule: list[FaultEvent] = Field(default_factory=lambda: [
+        FaultEvent(time_s=0.0, fault="nominal"),
+        FaultEvent(time_s=10.0, fault="lock", actuator="engine", position=0.2),
+        FaultEvent(time_s=30.0, fault="nominal"),
+        FaultEvent(time_s=50.0, fault="loss", actuator="engine", b1=0.5),
+        FaultEvent(time_s=70.0, fault="nominal"),
+        FaultEvent(time_s=90.0, fault="lock", actuator="left_elevon", position="trim"),
+    ], min_length=1)
+    """Fault schedule, sorted by time, first entry at 0 s (default: paper Table 4)."""
+
+    @model_validator(mode="after")
+    def _sorted(self):
+        times = [e.time_s for e in self.schedule]
+        if times[0] != 0.0:
+            raise ValueError(f"schedule: the first entry must start at 0 s, got {times[0]:g}")
+        for a, b in zip(times, times[1:]):
+            if not b > a:
+                raise ValueError(f"schedule: times must be strictly increasing "
+                                 f"(overlapping or unsorted entries at {a:g} s and {b:g} s)")
+        if times[-1] >= self.duration_s:
+            raise ValueError(f"schedule: entry at {times[-1]:g} s is not before the end "
+                             f"of the run ({self.duration_s:g} s)")
+        return self
+
+
+class ScenarioConfig(_Strict):
+    """A scenario file: ``ftc-mc scenario CONFIG``."""
+
+    scenario: ScenarioSpec = Field(default_factory=ScenarioSpec)
+    model: ModelConfig = Field(default_factory=ModelConfig)
+    estimator: EstimatorConfig = Field(default_factory=EstimatorConfig)
+    controller: ControllerConfig = Field(default_factory=ControllerConfig)
+    excitation: ExcitationConfig = Field(default_factory=ExcitationConfig)
+    noise: NoiseConfig = Field(default_factory=NoiseConfig)
+    validity: ValidityConfig = Field(default_factory=ValidityConfig)
+
+    def campaign_config(self) -> Config:
+        """The equivalent campaign settings (one trial) for building the kernels."""
+        sc = self.scenario
+        dt = self.model.dt_s
+        last = sc.schedule[-1].time_s
+        try:
+            return Config.model_validate({
+                "campaign": {"signature": sc.signature, "trials": 1, "seed": sc.seed},
+                "model": self.model.model_dump(), "estimator": self.estimator.model_dump(),
+                "controller": self.controller.model_dump(),
+                "excitation": self.excitation.model_dump(),
+                "noise": self.noise.model_dump(), "validity": self.validity.model_dump(),
+                "timing": {"duration_s": sc.duration_s,
+                           "fault_time_s": last if last > 0 else dt,
+                           "window_s": max(sc.duration_s - last, dt) if last > 0 else dt,
+                           "reconfiguration_period_s": sc.reconfiguration_period_s,
+                           "detection_probability": sc.detection_probability}})
+        except ValidationError as exc:
+            err = exc.errors()[0]
+            loc = ".".join(str(p) for p in err["loc"])
+            loc = loc.replace("timing.", "scenario.")
+            raise ValueError(f"{loc}: {err['msg'].removeprefix('Value error, ')}") from None
+
+    @model_validator(mode="after")
+    def _steps(self):
+        dt = self.model.dt_s
+        for i, e in enumerate(self.scenario.schedule):
+            n = e.time_s / dt
+            if abs(n - round(n)) > 1e-9 * max(1.0, n):
+                raise ValueError(f"scenario.schedule.{i}.time_s: must be a multiple of "
+                                 f"model.dt_s ({dt:g} s), got {e.time_s:g}")
+        self.campaign_config()
+        return self
+
+
+def load_scenario(path) -> ScenarioConfig:
+    """Read and validate a scenario YAML file (see :func:`load_config`)."""
+    data = _read_yaml(path)
+    if data is None:
+        raise UserError(f"{path}: the file is empty; expected a mapping of sections")
+    if not isinstance(data, dict):
+        raise UserError(f"{path}: expected a mapping of sections at the top level, "
+                        f"got {type(data).__name__}")
+    try:
+        return ScenarioConfig.model_validate(data)
+    except ValidationError as exc:
+        raise UserError(_format_error(exc, str(path))) from None

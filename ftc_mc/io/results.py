@@ -20,7 +20,8 @@ from ..errors import UserError
 from .atomic import atomic_path, write_text
 
 META_KEY = b"ftc_mc"
-RUN_FILES = ("trials.parquet", "resets.parquet", "summary.parquet", "summary.md")
+RUN_FILES = ("trials.parquet", "resets.parquet", "summary.parquet", "summary.md",
+             "timeseries.parquet", "events.parquet")
 
 
 def package_version() -> str:
