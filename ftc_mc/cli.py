@@ -81,24 +81,30 @@ def _default_out(config_path: str):
 @click.option("--trials", type=int, help="Trials per transition (overrides the config).")
 @click.option("--seed", type=int, help="Root seed (overrides the config).")
 @click.option("--jobs", type=int, default=-1, show_default=True,
-              help="Worker processes; -1 uses every core. Results do not depend on it.")
+              help="Worker processes; -1: every core (one for a small run). Results do "
+              "not depend on it.")
 @click.option("--out", type=click.Path(file_okay=False),
               help="Output directory [default: results/<config name>, never reused].")
 @click.option("--signature", type=click.Choice(["paper", "swapped", "both"]),
               help="Table 1 variant(s) (overrides the config).")
+@click.option("--controller", type=click.Choice(["nominal", "reconfiguring"]),
+              help="Controller in the loop (overrides the config).")
 @click.option("--overwrite", is_flag=True, help="Replace results already in --out.")
 @click.option("--quiet", is_flag=True, help="No progress bar.")
 @user_errors
-def run(config, trials, seed, jobs, out, signature, overwrite, quiet):
+def run(config, trials, seed, jobs, out, signature, controller, overwrite, quiet):
     """Run a Monte Carlo campaign (the paper's Tables 2-3) from CONFIG."""
     from pathlib import Path
 
     from .campaign.runner import resolve_config, run_campaign
+    from .io.config import with_overrides
     from .io.results import prepare_output_dir, provenance, write_run
 
     if jobs == 0 or jobs < -1:
         raise UserError(f"--jobs: must be a positive count or -1, got {jobs}")
     cfg = resolve_config(config, trials, seed, signature)
+    if controller is not None:
+        cfg = with_overrides(cfg, controller={"kind": controller})
     out_dir = Path(out) if out else _default_out(config)
     prepare_output_dir(out_dir, overwrite)
     result = run_campaign(cfg, jobs=jobs, progress=not quiet)

@@ -181,6 +181,8 @@ def _timeseries(setup, sc, rec, k_sw, b0, b1) -> pd.DataFrame:
         cols[f"cmd_{nm}_dev"] = rec.hist_u[:, i, 0]
     cols["excitation_doublet"] = rec.hist_exc[:, 0, 0]
     cols["excitation_3211"] = rec.hist_exc[:, 1, 0]
+    cols["excitation_doublet_start"] = rec.hist_exc[:, 2, 0] != 0.0
+    cols["excitation_3211_start"] = rec.hist_exc[:, 3, 0] != 0.0
     cols["reset_block"] = rec.hist_block[:, 0]
     cols["schedule_entry"] = idx
     df = pd.DataFrame(cols)
@@ -191,7 +193,7 @@ def _timeseries(setup, sc, rec, k_sw, b0, b1) -> pd.DataFrame:
 
 def _events(ts: pd.DataFrame, sc: ScenarioConfig, rec, setup) -> pd.DataFrame:
     rows = []
-    dt = setup.plant.dt
+    dt = setup.plant.dt  # a signal applied during step k is logged at (k + 1) dt
     for e in sc.scenario.schedule:
         what = ("nominal" if e.fault == "nominal" else
                 f"{e.actuator} {e.fault} " + (f"at {e.position}" if e.fault == "lock"
@@ -202,10 +204,9 @@ def _events(ts: pd.DataFrame, sc: ScenarioConfig, rec, setup) -> pd.DataFrame:
         r = ts.iloc[k]
         rows.append((r.time_s, "reset", ("thrust" if blocks[k] == 1 else "elevons")
                      + f" (r_q={r.r_q:.3g}, r_nx={r.r_nx:.3g}, r_nz={r.r_nz:.3g})"))
-    for col, name in (("excitation_doublet", "doublet"), ("excitation_3211", "3211")):
-        on = ts[col].to_numpy() != 0.0
-        starts = np.flatnonzero(on & ~np.r_[False, on[:-1]])
-        for k in starts:
+    for col, name in (("excitation_doublet_start", "doublet"),
+                      ("excitation_3211_start", "3211")):
+        for k in np.flatnonzero(ts[col].to_numpy()):
             rows.append((ts.time_s.iloc[k] - dt, "excitation", name))
     ctrl = rec.controller[:, 0]
     every = setup.tim.reconf_every

@@ -83,7 +83,7 @@ def new_record(setup: CampaignSetup, L: int, max_resets: int, history: bool = Fa
         controller=np.zeros((n_per, L), dtype=np.int64),
         hist_x=np.zeros((n_hist, 9, L)), hist_xa=np.zeros((n_hist, 14, L)),
         hist_pdiag=np.zeros((n_hist, 5, L)), hist_u=np.zeros((n_hist, 3, L)),
-        hist_res=np.zeros((n_hist, 3, L)), hist_exc=np.zeros((n_hist, 2, L)),
+        hist_res=np.zeros((n_hist, 3, L)), hist_exc=np.zeros((n_hist, 4, L)),
         hist_block=np.zeros((n_hist, L), dtype=np.int64),
         xa_end=np.zeros((14, L)))
 

@@ -83,6 +83,26 @@ def warm_up(setup: CampaignSetup, cfg: Config) -> None:
               variants_of(cfg.campaign.signature)[:1], 4, 1)
 
 
+SMALL_RUN_STEPS = 3_000_000
+"""Below this many (controller-weighted) trial steps, ``jobs=-1`` runs in-process:
+starting worker processes (importing Numba and loading the cached kernels,
+about 3 s here) would cost more than it saves."""
+
+
+def auto_jobs(cfg: Config, n_variants: int) -> int:
+    """Worker count for ``jobs=-1``: every core, or 1 for a small run.
+
+    A trial step of the reconfiguring loop costs about six of the nominal one
+    (the controller selection predicts three controllers over the horizon).
+    """
+    c = cfg.campaign
+    weight = 6 if cfg.controller.kind == "reconfiguring" else 1
+    steps = c.trials * len(c.transitions) * n_variants * cfg.steps(cfg.timing.duration_s)
+    if steps * weight < SMALL_RUN_STEPS:
+        return 1
+    return max(1, min(os.cpu_count() or 1, len(plan_chunks(cfg))))
+
+
 def _frames(parts, key):
     cols = {}
     for part in parts:
@@ -111,8 +131,9 @@ def run_campaign(config, *, trials=None, seed=None, signature=None, jobs: int = 
     signature : {"paper", "swapped", "both"}, optional
         Override ``campaign.signature``.
     jobs : int
-        Worker processes (joblib/loky); 1 runs in this process; -1 all cores.
-        Results are identical for every value.
+        Worker processes (joblib/loky); 1 runs in this process; -1 every core,
+        or this process alone for a small run (:func:`auto_jobs`).  Results are
+        identical for every value.
     progress : bool
         Show a tqdm bar counting finished trials.
 
@@ -127,7 +148,7 @@ def run_campaign(config, *, trials=None, seed=None, signature=None, jobs: int = 
     variants = variants_of(c.signature)
     window = cfg.steps(cfg.timing.window_s)
     chunks = plan_chunks(cfg)
-    n_jobs = os.cpu_count() if jobs == -1 else max(1, int(jobs))
+    n_jobs = auto_jobs(cfg, len(variants)) if jobs == -1 else max(1, int(jobs))
     total = c.trials * len(c.transitions)
     parts = []
     with tqdm(total=total, unit="trial", disable=not progress, desc="trials",

@@ -95,7 +95,8 @@ TrialRecord = namedtuple("TrialRecord", [
     "hist_pdiag",   # (n_hist, 5, L) variances of the fault parameters
     "hist_u",       # (n_hist, 3, L) commands applied during each step
     "hist_res",     # (n_hist, 3, L) residuals r_q, r_nx, r_nz
-    "hist_exc",     # (n_hist, 2, L) doublet (engine) and 3211 (left elevon) values
+    "hist_exc",     # (n_hist, 4, L) doublet (engine) and 3211 (left elevon) values,
+                    #      then 1.0 where each signal started at that step
     "hist_block",   # (n_hist, L) int64 block reset at each step
 ])
 """Per-lane outputs of :func:`ftc_mc.core.trial.run_trials`."""

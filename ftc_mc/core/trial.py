@@ -151,7 +151,7 @@ def run_trials(fm, det, bs, ctl, exc, tim, val, rc, eng, inp, rec):
     phi1 = np.zeros((9, 5))
     T1 = np.zeros((9, 14))
     bsel = np.zeros(4)
-    exc_now = np.zeros((2, L))
+    exc_now = np.zeros((4, L))
     n_hist = rec.hist_x.shape[0]
     for l in range(L):
         rec.stop_k[l] = -1
@@ -191,6 +191,7 @@ def run_trials(fm, det, bs, ctl, exc, tim, val, rc, eng, inp, rec):
                 sd = 0.0
                 u[0, l] = saturate(u[0, l], 0.0, 0.0, ctl.lo_dev[0], ctl.hi_dev[0])
             exc_now[0, l] = sd
+            exc_now[2, l] = 1.0 if kd == 0 else 0.0
             ks = k - s_start[l]
             if 0 <= ks < s_len:
                 s = signal_3211(ks, exc.s3211_unit, exc.s3211_amp)
@@ -201,6 +202,7 @@ def run_trials(fm, det, bs, ctl, exc, tim, val, rc, eng, inp, rec):
                 s = 0.0
                 a = 0.0
             exc_now[1, l] = s
+            exc_now[3, l] = 1.0 if ks == 0 else 0.0
             u[1, l] = saturate(u[1, l], s, a, ctl.lo_dev[1], ctl.hi_dev[1])
             u[2, l] = saturate(u[2, l], -s, a, ctl.lo_dev[2], ctl.hi_dev[2])
         # 2. truth: actuator effect (eq. 2) and plant (eq. 4)
@@ -295,8 +297,8 @@ def run_trials(fm, det, bs, ctl, exc, tim, val, rc, eng, inp, rec):
                 for i in range(3):
                     rec.hist_u[k, i, l] = u[i, l]
                     rec.hist_res[k, i, l] = res[i, l]
-                rec.hist_exc[k, 0, l] = exc_now[0, l]
-                rec.hist_exc[k, 1, l] = exc_now[1, l]
+                for i in range(4):
+                    rec.hist_exc[k, i, l] = exc_now[i, l]
                 rec.hist_block[k, l] = block[l]
         # 5. belief every reconfiguration period (eqs. 13-14) and controller
         #    selection (eqs. 45-47)

@@ -13,6 +13,18 @@ fault parameters (:func:`ftc_mc.core.control.policy_cost`):
 * engine: locks at throttle 0, 0.2, ..., 1 and losses of 0.3, 0.6, 0.9;
 * left (right) elevon: locks at -0.4, -0.2, 0, 0.2, 0.4 rad and losses of 0.3,
   0.6, 0.9 of that elevon.
+
+The costs are returned as *regrets*: each mode's row has its smallest entry
+subtracted.  Eq. (47) weighs ``J^N(m, a)`` by the belief predicted *under each
+action*, ``b_{k+H}(m | a)``, which differs between actions only through the
+predicted covariance.  With raw costs, a mode whose cost is large for every
+controller (an engine lock far from trim costs about 6e6 over 100 s whatever the
+controller, since no controller can stop the drift) turns belief differences of
+1e-7 into cost differences above the 0.1 switching penalty, and the selection
+switched controller with no fault to justify it (measured: an engine locked at
+trim switched c0 -> c2 at 38 s).  Subtracting the part of ``J^N(m, .)`` that no
+choice of controller can avoid leaves the differences between controllers,
+which are what the selection is about.
 """
 
 from __future__ import annotations
@@ -42,7 +54,7 @@ def representative_faults():
 
 
 def terminal_costs(fm, K, eng, lo, hi, alpha, q_lqr, r_lqr, n_steps):
-    """``J^N`` as a (4, 3) array: modes (nominal, engine, left, right) x controllers.
+    """``J^N`` regrets as a (4, 3) array: modes (nominal, engine, left, right) x controllers.
 
     Parameters
     ----------
@@ -68,4 +80,4 @@ def terminal_costs(fm, K, eng, lo, hi, alpha, q_lqr, r_lqr, n_steps):
                 costs.append(policy_cost(a, fm, K, eng, lo, hi, b0, b1, best, alpha,
                                          q_lqr, r_lqr, n_steps))
             JN[m, a] = float(np.mean(costs))
-    return JN
+    return JN - JN.min(axis=1, keepdims=True)

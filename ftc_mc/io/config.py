@@ -16,6 +16,7 @@ import yaml
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
 from ..errors import UserError
+from ..model.airframe import X8
 
 TRANSITIONS = ("elevon_lock", "elevon_unlock", "elevon_loss", "elevon_loss_recover",
                "engine_lock", "engine_unlock", "engine_loss", "engine_loss_recover")
@@ -496,13 +497,38 @@ class ScenarioConfig(_Strict):
                            "detection_probability": sc.detection_probability}})
         except ValidationError as exc:
             err = exc.errors()[0]
+            msg = err["msg"].removeprefix("Value error, ")
             loc = ".".join(str(p) for p in err["loc"])
-            loc = loc.replace("timing.", "scenario.")
-            raise ValueError(f"{loc}: {err['msg'].removeprefix('Value error, ')}") from None
+            named = re.match(r"^([A-Za-z_][\w.]*): (.*)$", msg)
+            if named:  # a model validator named the field itself
+                loc = named.group(1) if not loc else f"{loc}.{named.group(1)}"
+                msg = named.group(2)
+            loc = loc.replace("timing.window_s", "scenario.schedule").replace(
+                "timing.fault_time_s", "scenario.schedule").replace("timing.", "scenario.")
+            msg = msg.replace("timing.", "scenario.")
+            raise ValueError(f"{loc}: {msg}") from None
 
     @model_validator(mode="after")
     def _steps(self):
         dt = self.model.dt_s
+        sc = self.scenario
+        for name, value in (("duration_s", sc.duration_s),
+                            ("reconfiguration_period_s", sc.reconfiguration_period_s)):
+            n = value / dt
+            if abs(n - round(n)) > 1e-9 * max(1.0, n) or round(n) < 1:
+                raise ValueError(f"scenario.{name}: must be a positive multiple of "
+                                 f"model.dt_s ({dt:g} s), got {value:g}")
+        if self.controller.horizon_s > sc.duration_s:
+            raise ValueError(f"controller.horizon_s: must not exceed scenario.duration_s "
+                             f"({sc.duration_s:g} s), got {self.controller.horizon_s:g}")
+        lower, upper = X8.command_lower, X8.command_upper
+        for i, e in enumerate(sc.schedule):
+            if e.fault == "lock" and e.position != "trim":
+                a = ACTUATOR_NAMES.index(e.actuator)
+                if not lower[a] <= e.position <= upper[a]:
+                    raise ValueError(f"scenario.schedule.{i}.position: {e.position:g} is "
+                                     f"outside the {e.actuator} command range "
+                                     f"[{lower[a]:g}, {upper[a]:g}]")
         for i, e in enumerate(self.scenario.schedule):
             n = e.time_s / dt
             if abs(n - round(n)) > 1e-9 * max(1.0, n):

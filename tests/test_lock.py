@@ -1,0 +1,315 @@
+"""Output-directory lock (ftc_mc.io.lock): one writer per folder, stale locks recovered."""
+
+import datetime as dt
+import json
+import os
+import socket
+import subprocess
+import sys
+import textwrap
+import time
+from pathlib import Path
+
+import pytest
+
+from ftc_mc.errors import UserError
+from ftc_mc.io import lock as lockmod
+from ftc_mc.io.lock import LOCK_NAME, acquire, holder
+
+ROOT = Path(__file__).resolve().parents[1]
+
+HOLDER_SNIPPET = textwrap.dedent("""
+    import sys, time
+    from ftc_mc.io.lock import acquire
+    with acquire(sys.argv[1], command="ftc-mc run child.yaml"):
+        print("locked", flush=True)
+        sys.stdin.read()          # hold until the test closes our stdin
+    print("released", flush=True)
+""")
+
+
+def _spawn_holder(directory):
+    """A second process that takes the lock on ``directory`` and waits."""
+    env = dict(os.environ, PYTHONPATH=str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", ""))
+    child = subprocess.Popen([sys.executable, "-c", HOLDER_SNIPPET, str(directory)],
+                             stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                             stderr=subprocess.PIPE, text=True, env=env)
+    line = child.stdout.readline()
+    if line.strip() != "locked":
+        child.kill()
+        _, err = child.communicate(timeout=10)
+        pytest.fail(f"holder process did not take the lock: {line!r} {err}")
+    return child
+
+
+def _stop(child, kill=False):
+    if child.poll() is None:
+        if kill:
+            child.kill()
+        else:
+            child.stdin.close()
+    try:
+        child.wait(timeout=20)
+    finally:
+        if child.poll() is None:
+            child.kill()
+            child.wait()
+
+
+def _dead_pid():
+    """The pid of a process that has exited (and been reaped)."""
+    p = subprocess.Popen([sys.executable, "-c", "pass"])
+    p.wait()
+    try:
+        os.kill(p.pid, 0)
+    except ProcessLookupError:
+        return p.pid
+    pytest.skip("pid of the exited process was reused immediately")
+
+
+def _write_lock(directory, **fields):
+    info = {"pid": os.getpid(), "hostname": socket.gethostname(),
+            "started": dt.datetime.now(dt.timezone.utc).isoformat(),
+            "command": "ftc-mc run other.yaml"}
+    info.update(fields)
+    (Path(directory) / LOCK_NAME).write_text(json.dumps(info))
+    return info
+
+
+def _lock_info(directory):
+    return json.loads((Path(directory) / LOCK_NAME).read_text())
+
+
+def test_second_process_is_refused_with_a_clear_message(tmp_path):
+    out = tmp_path / "out"
+    child = _spawn_holder(out)
+    try:
+        with pytest.raises(UserError) as err:
+            with acquire(out):
+                pytest.fail("took a lock held by a live process")
+        msg = str(err.value)
+        assert len(msg.splitlines()) == 1
+        assert str(out) in msg
+        assert f"pid {child.pid}" in msg
+        assert "ftc-mc run child.yaml" in msg
+        # the refused attempt left the owner's lock untouched
+        assert _lock_info(out)["pid"] == child.pid
+        assert holder(out)["pid"] == child.pid
+    finally:
+        _stop(child)
+    assert child.stdout.read().strip() == "released"
+    assert not (out / LOCK_NAME).exists()
+    with acquire(out):  # free again after the owner released it
+        assert _lock_info(out)["pid"] == os.getpid()
+
+
+def test_lock_of_a_killed_process_is_taken_over(tmp_path):
+    out = tmp_path / "out"
+    child = _spawn_holder(out)
+    _stop(child, kill=True)  # SIGKILL: no cleanup, the lock file stays behind
+    assert _lock_info(out)["pid"] == child.pid
+    assert holder(out) is None
+    with acquire(out, command="me") as lk:
+        info = _lock_info(out)
+        assert info["pid"] == os.getpid() and info["command"] == "me"
+        assert lk.held
+    assert not (out / LOCK_NAME).exists()
+
+
+def test_stale_lock_is_taken_over(tmp_path):
+    pid = _dead_pid()
+    _write_lock(tmp_path, pid=pid)
+    with acquire(tmp_path):
+        info = _lock_info(tmp_path)
+        assert info["pid"] == os.getpid()
+        assert info["hostname"] == socket.gethostname()
+        dt.datetime.fromisoformat(info["started"])
+        assert isinstance(info["command"], str)
+    assert not (tmp_path / LOCK_NAME).exists()
+
+
+@pytest.mark.parametrize("content", [
+    b"", b"\n", b"not json", b"\xff\xfe\x00garbage", b"[1, 2]", b"{}", b"null",
+    b'{"pid": "123", "hostname": "h", "started": "2026-01-01T00:00:00"}',
+    b'{"pid": -5, "hostname": "h", "started": "2026-01-01T00:00:00"}',
+    b'{"pid": true, "hostname": "h", "started": "2026-01-01T00:00:00"}',
+    b'{"pid": 1, "hostname": 3, "started": "2026-01-01T00:00:00"}',
+    b'{"pid": 1, "hostname": "h", "started": "yesterday"}',
+    b'{"pid": 1, "hostname": "h"}',
+    b'{"pid": 1, "hostname": "h", "started": "2026-01-01T00:00:00"',  # truncated
+    b"[" * 100_000,
+], ids=lambda c: repr(c[:20]))
+def test_corrupt_lock_is_taken_over(tmp_path, content):
+    (tmp_path / LOCK_NAME).write_bytes(content)
+    t0 = time.monotonic()
+    with acquire(tmp_path):
+        assert _lock_info(tmp_path)["pid"] == os.getpid()
+    assert time.monotonic() - t0 < 5
+    assert not (tmp_path / LOCK_NAME).exists()
+
+
+def test_lock_is_released_on_exception(tmp_path):
+    with pytest.raises(RuntimeError, match="boom"):
+        with acquire(tmp_path):
+            assert (tmp_path / LOCK_NAME).exists()
+            raise RuntimeError("boom")
+    assert not (tmp_path / LOCK_NAME).exists()
+    with pytest.raises(KeyboardInterrupt):
+        with acquire(tmp_path):
+            raise KeyboardInterrupt
+    assert not (tmp_path / LOCK_NAME).exists()
+    with acquire(tmp_path):  # and can be taken again
+        pass
+
+
+def test_lock_file_contents(tmp_path):
+    before = dt.datetime.now(dt.timezone.utc)
+    with acquire(tmp_path, command="ftc-mc scenario configs/paper_scenario.yaml"):
+        info = _lock_info(tmp_path)
+    assert info["pid"] == os.getpid()
+    assert info["hostname"] == socket.gethostname()
+    started = dt.datetime.fromisoformat(info["started"])
+    assert started.tzinfo is not None
+    assert before <= started <= dt.datetime.now(dt.timezone.utc)
+    assert info["command"] == "ftc-mc scenario configs/paper_scenario.yaml"
+
+
+def test_default_command_is_argv(tmp_path):
+    with acquire(tmp_path):
+        cmd = _lock_info(tmp_path)["command"]
+    assert isinstance(cmd, str) and cmd
+
+
+def test_nested_acquire_in_one_process_is_refused(tmp_path):
+    with acquire(tmp_path):
+        with pytest.raises(UserError, match=f"pid {os.getpid()}"):
+            with acquire(tmp_path):
+                pass
+        assert _lock_info(tmp_path)["pid"] == os.getpid()  # outer lock intact
+    assert not (tmp_path / LOCK_NAME).exists()
+
+
+def test_permission_error_means_alive(tmp_path, monkeypatch):
+    def kill(pid, sig):
+        raise PermissionError(1, "Operation not permitted")
+
+    monkeypatch.setattr(lockmod.os, "kill", kill)
+    monkeypatch.setattr(lockmod, "_process_start", lambda pid: None)
+    _write_lock(tmp_path, pid=424242)
+    with pytest.raises(UserError, match="pid 424242"):
+        with acquire(tmp_path):
+            pass
+    assert _lock_info(tmp_path)["pid"] == 424242
+
+
+def test_live_pid_of_another_user_style_process_is_respected(tmp_path):
+    # pid 1 always exists; its start time predates the lock, so the lock is live
+    _write_lock(tmp_path, pid=1)
+    with pytest.raises(UserError, match=r"pid 1\b"):
+        with acquire(tmp_path):
+            pass
+
+
+@pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="needs Linux /proc")
+def test_reused_pid_is_stale(tmp_path):
+    # a lock "taken" by our own pid a day before this process started: pid reuse
+    old = dt.datetime.now(dt.timezone.utc) - dt.timedelta(days=1)
+    _write_lock(tmp_path, pid=os.getpid(), started=old.isoformat())
+    with acquire(tmp_path):
+        assert dt.datetime.fromisoformat(_lock_info(tmp_path)["started"]) > old
+
+
+def test_foreign_host_lock(tmp_path):
+    now = dt.datetime.now(dt.timezone.utc)
+    _write_lock(tmp_path, pid=_dead_pid(), hostname="elsewhere.example",
+                started=now.isoformat())
+    with pytest.raises(UserError, match="on host elsewhere.example") as err:
+        with acquire(tmp_path):  # dead here means nothing on another host
+            pass
+    assert str(tmp_path) in str(err.value)
+    old = (now - dt.timedelta(hours=2)).isoformat()
+    _write_lock(tmp_path, pid=77, hostname="elsewhere.example", started=old)
+    with pytest.raises(UserError, match="pid 77"):
+        with acquire(tmp_path, max_age_s=None):
+            pass
+    with pytest.raises(UserError, match="pid 77"):
+        with acquire(tmp_path, max_age_s=3 * 3600):
+            pass
+    with acquire(tmp_path, max_age_s=3600):
+        assert _lock_info(tmp_path)["pid"] == os.getpid()
+
+
+def test_someone_elses_lock_is_not_removed(tmp_path):
+    with acquire(tmp_path):
+        other = _write_lock(tmp_path, pid=1, command="usurper")
+    assert _lock_info(tmp_path) == other
+
+
+def test_created_directory_is_removed_if_left_empty(tmp_path):
+    out = tmp_path / "a" / "b"
+    with acquire(out):
+        assert out.is_dir()
+    assert not out.exists()
+    with acquire(out):
+        (out / "summary.md").write_text("x")
+    assert out.is_dir() and not (out / LOCK_NAME).exists()
+    existing = tmp_path / "existing"
+    existing.mkdir()
+    with acquire(existing):
+        pass
+    assert existing.is_dir()
+
+
+def test_refused_lock_leaves_no_directory(tmp_path):
+    out = tmp_path / "out"
+    (tmp_path / "file").write_text("")
+    with pytest.raises(UserError, match="not a directory"):
+        with acquire(tmp_path / "file"):
+            pass
+    child = _spawn_holder(out)
+    try:
+        with pytest.raises(UserError):
+            with acquire(out):
+                pass
+    finally:
+        _stop(child)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["file"]
+
+
+RACE_SNIPPET = textwrap.dedent("""
+    import sys, time
+    from ftc_mc.errors import UserError
+    from ftc_mc.io.lock import acquire
+    go = float(sys.argv[2])
+    while time.time() < go:
+        time.sleep(0.001)
+    try:
+        with acquire(sys.argv[1]):
+            print("won", flush=True)
+            time.sleep(1.5)
+    except UserError:
+        print("refused", flush=True)
+""")
+
+
+def test_racing_takeover_of_a_stale_lock_has_one_winner(tmp_path):
+    _write_lock(tmp_path, pid=_dead_pid())
+    env = dict(os.environ, PYTHONPATH=str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", ""))
+    go = time.time() + 1.0
+    procs = [subprocess.Popen([sys.executable, "-c", RACE_SNIPPET, str(tmp_path), str(go)],
+                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                              env=env) for _ in range(6)]
+    outs = []
+    try:
+        for p in procs:
+            out, err = p.communicate(timeout=60)
+            assert p.returncode == 0, err
+            outs.append(out.strip())
+    finally:
+        for p in procs:
+            if p.poll() is None:
+                p.kill()
+                p.wait()
+    assert sorted(outs) == ["refused"] * 5 + ["won"], outs
+    assert not (tmp_path / LOCK_NAME).exists()
+    assert [p.name for p in tmp_path.iterdir()] == []  # no temporary files left
