@@ -66,11 +66,13 @@ def _default_out(config_path: str):
     """``results/<config stem>``, or the first ``-N`` suffix that holds no run."""
     from pathlib import Path
 
+    from .io.lock import holder
     from .io.results import RUN_FILES
 
     base = Path("results") / Path(config_path).stem
     cand, n = base, 1
-    while cand.exists() and any((cand / f).exists() for f in RUN_FILES):
+    while cand.exists() and (any((cand / f).exists() for f in RUN_FILES)
+                             or holder(cand) is not None):
         n += 1
         cand = base.with_name(f"{base.name}-{n}")
     return cand
@@ -98,6 +100,7 @@ def run(config, trials, seed, jobs, out, signature, controller, overwrite, quiet
 
     from .campaign.runner import resolve_config, run_campaign
     from .io.config import with_overrides
+    from .io.lock import acquire
     from .io.results import prepare_output_dir, provenance, write_run
 
     if jobs == 0 or jobs < -1:
@@ -106,11 +109,12 @@ def run(config, trials, seed, jobs, out, signature, controller, overwrite, quiet
     if controller is not None:
         cfg = with_overrides(cfg, controller={"kind": controller})
     out_dir = Path(out) if out else _default_out(config)
-    prepare_output_dir(out_dir, overwrite)
-    result = run_campaign(cfg, jobs=jobs, progress=not quiet)
-    meta = provenance(cfg.model_dump(mode="json"), cfg.campaign.seed, "run")
-    md = "# ftc-mc run summary\n\n" + result.markdown() + "\n"
-    write_run(out_dir, result.trials, result.resets, result.summary, md, meta)
+    with acquire(out_dir, command="ftc-mc run"):
+        prepare_output_dir(out_dir, overwrite)
+        result = run_campaign(cfg, jobs=jobs, progress=not quiet)
+        meta = provenance(cfg.model_dump(mode="json"), cfg.campaign.seed, "run")
+        md = "# ftc-mc run summary\n\n" + result.markdown() + "\n"
+        write_run(out_dir, result.trials, result.resets, result.summary, md, meta)
     click.echo(result.markdown())
     click.echo(f"\nwrote {out_dir}/: trials.parquet, resets.parquet, summary.parquet, "
                "summary.md")
@@ -128,6 +132,7 @@ def scenario(config, out, seed, overwrite):
     from pathlib import Path
 
     from .io.config import load_scenario
+    from .io.lock import acquire
     from .io.results import prepare_output_dir, provenance
     from .scenario import run_scenario, summary_markdown, write_scenario
 
@@ -135,15 +140,22 @@ def scenario(config, out, seed, overwrite):
     if seed is not None and seed < 0:
         raise UserError(f"--seed: must be >= 0, got {seed}")
     out_dir = Path(out) if out else _default_out(config)
-    prepare_output_dir(out_dir, overwrite)
-    res = run_scenario(sc, seed=seed)
-    meta = provenance(res.config.model_dump(mode="json"), res.config.scenario.seed,
-                      "scenario")
-    files = write_scenario(res, out_dir, meta)
+    with acquire(out_dir, command="ftc-mc scenario"):
+        prepare_output_dir(out_dir, overwrite)
+        res = run_scenario(sc, seed=seed)
+        meta = provenance(res.config.model_dump(mode="json"), res.config.scenario.seed,
+                          "scenario")
+        files = write_scenario(res, out_dir, meta)
     click.echo(summary_markdown(res))
     click.echo(f"wrote {out_dir}/: " + ", ".join(p.name for p in files))
 
 
 def main():
-    """Console-script entry point."""
+    """Console-script entry point (SIGTERM exits cleanly, releasing locks)."""
+    import signal
+
+    def _term(signum, frame):
+        raise SystemExit(128 + signum)
+
+    signal.signal(signal.SIGTERM, _term)
     cli(prog_name="ftc-mc")

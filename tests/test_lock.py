@@ -249,7 +249,16 @@ def test_created_directory_is_removed_if_left_empty(tmp_path):
     out = tmp_path / "a" / "b"
     with acquire(out):
         assert out.is_dir()
-    assert not out.exists()
+    assert not (tmp_path / "a").exists()  # parents created for it go too
+    with pytest.raises(ValueError):
+        with acquire(out):
+            raise ValueError("campaign failed before writing")
+    assert not (tmp_path / "a").exists()
+    (tmp_path / "a").mkdir()
+    (tmp_path / "a" / "other").write_text("x")
+    with acquire(out):
+        pass
+    assert sorted(p.name for p in (tmp_path / "a").iterdir()) == ["other"]
     with acquire(out):
         (out / "summary.md").write_text("x")
     assert out.is_dir() and not (out / LOCK_NAME).exists()
@@ -313,3 +322,10 @@ def test_racing_takeover_of_a_stale_lock_has_one_winner(tmp_path):
     assert sorted(outs) == ["refused"] * 5 + ["won"], outs
     assert not (tmp_path / LOCK_NAME).exists()
     assert [p.name for p in tmp_path.iterdir()] == []  # no temporary files left
+
+
+def test_lock_path_that_is_a_folder_is_a_user_error(tmp_path):
+    (tmp_path / LOCK_NAME).mkdir()
+    with pytest.raises(UserError, match="cannot use the lock file"):
+        with acquire(tmp_path):
+            pass

@@ -8,12 +8,15 @@ tag can construct a Python object.
 
 from __future__ import annotations
 
+import math
 import re
+import reprlib
 from pathlib import Path
 from typing import Annotated, Literal
 
 import yaml
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+from pydantic import (BaseModel, BeforeValidator, ConfigDict, Field, ValidationError,
+                      model_validator)
 
 from ..errors import UserError
 from ..model.airframe import X8
@@ -22,10 +25,18 @@ TRANSITIONS = ("elevon_lock", "elevon_unlock", "elevon_loss", "elevon_loss_recov
                "engine_lock", "engine_unlock", "engine_loss", "engine_loss_recover")
 """The eight transitions of the paper's Tables 2-3 (DESIGN.md section 6)."""
 
-Pos = Annotated[float, Field(gt=0, allow_inf_nan=False)]
-NonNeg = Annotated[float, Field(ge=0, allow_inf_nan=False)]
-Fraction = Annotated[float, Field(gt=0, lt=1, allow_inf_nan=False)]
-Finite = Annotated[float, Field(allow_inf_nan=False)]
+def _no_bool(value):
+    """YAML reads yes/no/on/off as booleans: never accept them as numbers."""
+    if isinstance(value, bool):
+        raise ValueError(f"expected a number, got the boolean {value!r}")
+    return value
+
+
+NoBool = BeforeValidator(_no_bool)
+Pos = Annotated[float, NoBool, Field(gt=0, allow_inf_nan=False)]
+NonNeg = Annotated[float, NoBool, Field(ge=0, allow_inf_nan=False)]
+Fraction = Annotated[float, NoBool, Field(gt=0, lt=1, allow_inf_nan=False)]
+Finite = Annotated[float, NoBool, Field(allow_inf_nan=False)]
 
 
 class _Strict(BaseModel):
@@ -37,9 +48,9 @@ class ModelConfig(_Strict):
 
     airspeed_mps: Pos = 20.0
     """Trim airspeed [m/s]."""
-    gamma_deg: Annotated[float, Field(gt=-30, lt=30, allow_inf_nan=False)] = -3.0
+    gamma_deg: Annotated[float, NoBool, Field(gt=-30, lt=30, allow_inf_nan=False)] = -3.0
     """Trim flight-path angle [deg]."""
-    dt_s: Annotated[float, Field(gt=0, le=1, allow_inf_nan=False)] = 0.1
+    dt_s: Annotated[float, NoBool, Field(gt=0, le=1, allow_inf_nan=False)] = 0.1
     """Control sampling period [s]."""
 
 
@@ -69,7 +80,7 @@ class ControllerConfig(_Strict):
 
     kind: Literal["nominal", "reconfiguring"] = "reconfiguring"
     """``nominal``: c0 only; ``reconfiguring``: c0/c1/c2 chosen by eqs. 45-47."""
-    discount: Annotated[float, Field(gt=0, lt=1, allow_inf_nan=False)] = 0.999
+    discount: Annotated[float, NoBool, Field(gt=0, lt=1, allow_inf_nan=False)] = 0.999
     """Discount factor alpha (< 1: a locked engine needs it, section 4.1.2)."""
     r_lqr: Pos = 0.1
     """R_lqr = r_lqr I_3."""
@@ -85,17 +96,17 @@ class ControllerConfig(_Strict):
 class ExcitationConfig(_Strict):
     """Excitation signals sent on covariance resets (sections 3.2.3, 4.1.1)."""
 
-    doublet_amplitude: Annotated[float, Field(gt=0, le=0.5, allow_inf_nan=False)] = 0.1
+    doublet_amplitude: Annotated[float, NoBool, Field(gt=0, le=0.5, allow_inf_nan=False)] = 0.1
     """Engine doublet amplitude [throttle fraction]."""
     doublet_half_period_s: Pos = 1.0
     """Duration of each half of the doublet [s] (engine time constant 0.3 s)."""
-    s3211_amplitude_rad: Annotated[float, Field(gt=0, le=0.3, allow_inf_nan=False)] = 0.05
+    s3211_amplitude_rad: Annotated[float, NoBool, Field(gt=0, le=0.3, allow_inf_nan=False)] = 0.05
     """Elevon 3211 amplitude [rad], + on the left and - on the right elevon."""
     s3211_unit_s: Pos = 0.2
     """One unit of the 3211 [s] (the signal lasts 7 units)."""
     resend_delay_s: NonNeg = 3.0
     """Delay after a thrust reset before the doublet re-check [s]."""
-    resend_b1_threshold: Annotated[float, Field(ge=0, le=1, allow_inf_nan=False)] = 0.7
+    resend_b1_threshold: Annotated[float, NoBool, Field(ge=0, le=1, allow_inf_nan=False)] = 0.7
     """Re-send the doublet if the estimated engine b1 exceeds this."""
 
 
@@ -115,8 +126,8 @@ class DrawsConfig(_Strict):
     """Absolute throttle lock position range; null = the command range [0, 1]."""
     elevon_lock_range_rad: tuple[Finite, Finite] | None = None
     """Absolute left-elevon lock position range [rad]; null = the command range."""
-    loss_b1_range: tuple[Annotated[float, Field(ge=0, le=1)],
-                         Annotated[float, Field(ge=0, le=1)]] = (0.0, 1.0)
+    loss_b1_range: tuple[Annotated[float, NoBool, Field(ge=0, le=1)],
+                         Annotated[float, NoBool, Field(ge=0, le=1)]] = (0.0, 1.0)
     """Uniform range of the effectiveness loss b1."""
 
     @model_validator(mode="after")
@@ -166,9 +177,9 @@ class ValidityConfig(_Strict):
     """Lowest true airspeed [m/s] (about 1.2 times the X8's stall speed at this weight)."""
     airspeed_max_mps: Pos = 30.0
     """Highest true airspeed [m/s] (1.5 times trim: beyond it the linearisation is poor)."""
-    alpha_min_deg: Annotated[float, Field(ge=-45, le=0, allow_inf_nan=False)] = -8.0
+    alpha_min_deg: Annotated[float, NoBool, Field(ge=-45, le=0, allow_inf_nan=False)] = -8.0
     """Lowest angle of attack [deg] (range of the aerodynamic fit)."""
-    alpha_max_deg: Annotated[float, Field(ge=0, le=45, allow_inf_nan=False)] = 12.0
+    alpha_max_deg: Annotated[float, NoBool, Field(ge=0, le=45, allow_inf_nan=False)] = 12.0
     """Highest angle of attack [deg] (below stall, range of the aerodynamic fit)."""
     psd_check_period_s: Pos = 1.0
     """Period of the full Cholesky check of the filter covariance [s]."""
@@ -186,15 +197,15 @@ class CampaignConfig(_Strict):
     transitions: list[Literal[TRANSITIONS]] = Field(default_factory=lambda: ["elevon_lock"],
                                                     min_length=1)
     """Transitions to run (names of DESIGN.md section 6)."""
-    trials: Annotated[int, Field(gt=0, le=10_000_000)] = 1000
+    trials: Annotated[int, NoBool, Field(gt=0, le=10_000_000)] = 1000
     """Trials per transition."""
-    seed: Annotated[int, Field(ge=0, lt=2 ** 63)] = 2026
+    seed: Annotated[int, NoBool, Field(ge=0, lt=2 ** 63)] = 2026
     """Root seed: trial i draws from numpy.random.default_rng([i, seed])."""
     signature: Literal["paper", "swapped", "both"] = "both"
     """Table 1 variant(s) run on the same draws and noise."""
-    chunk_size: Annotated[int, Field(gt=0, le=4096)] = 128
+    chunk_size: Annotated[int, NoBool, Field(gt=0, le=4096)] = 128
     """Trials per chunk (one kernel call, lanes); results do not depend on it."""
-    max_resets: Annotated[int, Field(gt=0, le=100_000)] = 256
+    max_resets: Annotated[int, NoBool, Field(gt=0, le=100_000)] = 256
     """Resets stored per trial (more are counted, not stored)."""
 
     @model_validator(mode="after")
@@ -236,6 +247,9 @@ class Config(_Strict):
                             ("validity.psd_check_period_s",
                              self.validity.psd_check_period_s)):
             steps = value / dt
+            if not math.isfinite(steps) or steps > 1e9:
+                raise ValueError(f"{name}: {value:g} s is more than 1e9 steps of "
+                                 f"model.dt_s ({dt:g} s)")
             if abs(steps - round(steps)) > 1e-9 * max(1.0, steps) or (
                     round(steps) < 1 and name != "excitation.resend_delay_s"):
                 raise ValueError(f"{name}: must be a positive multiple of model.dt_s "
@@ -253,6 +267,12 @@ class Config(_Strict):
         return int(round(seconds / self.model.dt_s))
 
 
+_REPR = reprlib.Repr()
+_REPR.maxstring = _REPR.maxother = 80
+_REPR.maxlevel = 2
+"""Bounded repr of rejected values: error lines stay short whatever the input."""
+
+
 def _format_error(exc: ValidationError, source: str) -> str:
     err = exc.errors()[0]
     loc = ".".join(str(p) for p in err["loc"]) or "(top level)"
@@ -266,8 +286,8 @@ def _format_error(exc: ValidationError, source: str) -> str:
         return f"{source}: {loc}: {prefix.group(2)}"
     got = err.get("input")
     extra = ""
-    if err["type"] not in ("missing",) and not isinstance(got, (dict, list)):
-        extra = f" (got {got!r})"
+    if err["type"] not in ("missing",) and not isinstance(got, (dict, list, tuple)):
+        extra = f" (got {_REPR.repr(got)})"
     more = len(exc.errors()) - 1
     tail = f" [and {more} more problem{'s' if more > 1 else ''}]" if more else ""
     return f"{source}: {loc}: {msg}{extra}{tail}"
@@ -302,9 +322,13 @@ def parse_config(data, source: str = "config") -> Config:
 def _read_yaml(path):
     """Parsed YAML of a file (safe loader), or :class:`UserError`."""
     path = Path(path)
-    if not path.exists():
+    try:
+        exists, is_file = path.exists(), path.is_file()
+    except OSError as exc:
+        raise UserError(f"{path}: cannot read ({exc.strerror})") from None
+    if not exists:
         raise UserError(f"{path}: no such file")
-    if not path.is_file():
+    if not is_file:
         raise UserError(f"{path}: not a regular file")
     try:
         text = path.read_bytes().decode("utf-8")
@@ -319,6 +343,11 @@ def _read_yaml(path):
         where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
         problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
         raise UserError(f"{path}: malformed YAML{where}: {problem}") from None
+    except RecursionError:
+        raise UserError(f"{path}: malformed YAML: nested too deeply") from None
+    except Exception as exc:  # PyYAML's constructors raise plain errors on bad tags
+        first = (str(exc).splitlines() or [type(exc).__name__])[0]
+        raise UserError(f"{path}: malformed YAML: {_REPR.repr(first)[1:-1]}") from None
 
 
 def load_config(path) -> Config:
@@ -411,7 +440,7 @@ class FaultEvent(_Strict):
     """Faulty actuator (``engine``, ``left_elevon``, ``right_elevon``); not for nominal."""
     position: Finite | Literal["trim"] | None = None
     """Lock position (absolute command: throttle [-] or elevon [rad]) or ``trim``."""
-    b1: Annotated[float, Field(ge=0, le=1, allow_inf_nan=False)] | None = None
+    b1: Annotated[float, NoBool, Field(ge=0, le=1, allow_inf_nan=False)] | None = None
     """Effectiveness loss of a ``loss`` fault (0 healthy, 1 no effect)."""
 
     @model_validator(mode="after")
@@ -434,7 +463,7 @@ class ScenarioSpec(_Strict):
 
     duration_s: Pos = 100.0
     """Simulated time [s] (paper: 100 s)."""
-    seed: Annotated[int, Field(ge=0, lt=2 ** 63)] = 2026
+    seed: Annotated[int, NoBool, Field(ge=0, lt=2 ** 63)] = 2026
     """Seed of the process and measurement noise."""
     signature: Literal["paper", "swapped"] = "swapped"
     """Table 1 variant (swapped: fewer inappropriate resets in ftc-mc run, see docs)."""
@@ -515,6 +544,9 @@ class ScenarioConfig(_Strict):
         for name, value in (("duration_s", sc.duration_s),
                             ("reconfiguration_period_s", sc.reconfiguration_period_s)):
             n = value / dt
+            if not math.isfinite(n) or n > 1e9:
+                raise ValueError(f"scenario.{name}: {value:g} s is more than 1e9 steps of "
+                                 f"model.dt_s ({dt:g} s)")
             if abs(n - round(n)) > 1e-9 * max(1.0, n) or round(n) < 1:
                 raise ValueError(f"scenario.{name}: must be a positive multiple of "
                                  f"model.dt_s ({dt:g} s), got {value:g}")
@@ -531,7 +563,7 @@ class ScenarioConfig(_Strict):
                                      f"[{lower[a]:g}, {upper[a]:g}]")
         for i, e in enumerate(self.scenario.schedule):
             n = e.time_s / dt
-            if abs(n - round(n)) > 1e-9 * max(1.0, n):
+            if not math.isfinite(n) or abs(n - round(n)) > 1e-9 * max(1.0, n):
                 raise ValueError(f"scenario.schedule.{i}.time_s: must be a multiple of "
                                  f"model.dt_s ({dt:g} s), got {e.time_s:g}")
         self.campaign_config()

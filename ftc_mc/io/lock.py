@@ -187,8 +187,8 @@ class OutputLock:
     Parameters
     ----------
     directory : str or Path
-        Output directory; created (with parents) if missing, and removed again on
-        release if this lock created it and it is still empty.
+        Output directory; created (with parents) if missing, and the folders this
+        lock created are removed again on release while they are empty.
     command : str, optional
         Recorded in the lock file for the message another process shows;
         default: this process's command line.
@@ -213,7 +213,7 @@ class OutputLock:
         self.info: dict | None = None
         self._payload: bytes | None = None
         self._owner_pid: int | None = None
-        self._created_dir = False
+        self._created_dirs: list[Path] = []
 
     # -- context manager ------------------------------------------------------
     def __enter__(self) -> OutputLock:
@@ -260,6 +260,10 @@ class OutputLock:
             else:
                 raise UserError(f"{self.directory}: could not take the output-directory "
                                 f"lock {self.path} (contended); try again")
+        except OSError as exc:  # e.g. the lock path is a folder, or no permission
+            self._cleanup_dir()
+            raise UserError(f"{self.directory}: cannot use the lock file {self.path} "
+                            f"({exc.strerror or exc})") from None
         except BaseException:
             self._cleanup_dir()
             raise
@@ -288,16 +292,23 @@ class OutputLock:
         try:
             if d.exists() and not d.is_dir():
                 raise UserError(f"--out: {d} exists and is not a directory")
-            self._created_dir = not d.exists()
+            missing, p = [], d.absolute()
+            while not p.exists() and p != p.parent:
+                missing.append(p)  # deepest first
+                p = p.parent
             d.mkdir(parents=True, exist_ok=True)
         except OSError as exc:
             raise UserError(f"--out: cannot create {d} ({exc.strerror})") from None
+        self._created_dirs = missing
 
     def _cleanup_dir(self) -> None:
-        if self._created_dir:
-            self._created_dir = False
-            with contextlib.suppress(OSError):
-                self.directory.rmdir()  # only succeeds if still empty
+        """Remove the folders this lock created, deepest first, while they are empty."""
+        created, self._created_dirs = self._created_dirs, []
+        for p in created:
+            try:
+                p.rmdir()  # only succeeds if still empty
+            except OSError:
+                break
 
     def _create(self, payload: bytes) -> bool:
         """Create the lock file with O_EXCL; False if it already exists."""
