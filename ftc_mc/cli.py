@@ -72,7 +72,7 @@ def _default_out(config_path: str):
     base = Path("results") / Path(config_path).stem
     cand, n = base, 1
     while cand.exists() and (any((cand / f).exists() for f in RUN_FILES)
-                             or holder(cand) is not None):
+                             or (cand / ".chunks").exists() or holder(cand) is not None):
         n += 1
         cand = base.with_name(f"{base.name}-{n}")
     return cand
@@ -92,13 +92,16 @@ def _default_out(config_path: str):
 @click.option("--controller", type=click.Choice(["nominal", "reconfiguring"]),
               help="Controller in the loop (overrides the config).")
 @click.option("--overwrite", is_flag=True, help="Replace results already in --out.")
+@click.option("--resume", is_flag=True,
+              help="Continue an interrupted run in --out, skipping its finished chunks.")
 @click.option("--quiet", is_flag=True, help="No progress bar.")
 @user_errors
-def run(config, trials, seed, jobs, out, signature, controller, overwrite, quiet):
+def run(config, trials, seed, jobs, out, signature, controller, overwrite, resume, quiet):
     """Run a Monte Carlo campaign (the paper's Tables 2-3) from CONFIG."""
     from pathlib import Path
 
     from .campaign.runner import resolve_config, run_campaign
+    from .io.chunks import ChunkStore
     from .io.config import with_overrides
     from .io.lock import acquire
     from .io.results import prepare_output_dir, provenance, write_run
@@ -108,13 +111,28 @@ def run(config, trials, seed, jobs, out, signature, controller, overwrite, quiet
     cfg = resolve_config(config, trials, seed, signature)
     if controller is not None:
         cfg = with_overrides(cfg, controller={"kind": controller})
+    if resume and not out:
+        raise UserError("--resume: name the run's directory with --out")
     out_dir = Path(out) if out else _default_out(config)
+    config_json = json.dumps(cfg.model_dump(mode="json"), sort_keys=True)
     with acquire(out_dir, command="ftc-mc run"):
         prepare_output_dir(out_dir, overwrite)
-        result = run_campaign(cfg, jobs=jobs, progress=not quiet)
+        store = ChunkStore(out_dir, config_json)
+        if overwrite:
+            store.remove()
+        elif resume and not store.exists():
+            raise UserError(f"--resume: {out_dir} holds no interrupted run")
+        store.open(resume)
+        try:
+            result = run_campaign(cfg, jobs=jobs, progress=not quiet, chunks=store)
+        except KeyboardInterrupt:
+            click.echo(f"\ninterrupted: finished chunks are kept in {store.folder}; "
+                       f"continue with --resume --out {out_dir}", err=True)
+            sys.exit(130)
         meta = provenance(cfg.model_dump(mode="json"), cfg.campaign.seed, "run")
         md = "# ftc-mc run summary\n\n" + result.markdown() + "\n"
         write_run(out_dir, result.trials, result.resets, result.summary, md, meta)
+        store.remove()
     click.echo(result.markdown())
     click.echo(f"\nwrote {out_dir}/: trials.parquet, resets.parquet, summary.parquet, "
                "summary.md")

@@ -119,7 +119,7 @@ def _sorted(df, order, vorder, extra):
 
 
 def run_campaign(config, *, trials=None, seed=None, signature=None, jobs: int = 1,
-                 progress: bool = True) -> CampaignResult:
+                 progress: bool = True, chunks=None) -> CampaignResult:
     """Run every transition of a configuration.
 
     Parameters
@@ -136,6 +136,10 @@ def run_campaign(config, *, trials=None, seed=None, signature=None, jobs: int = 
         identical for every value.
     progress : bool
         Show a tqdm bar counting finished trials.
+    chunks : ChunkStore, optional
+        Where finished chunks are stored as they complete; chunks already in it
+        are not run again (resume).  The result is then assembled from the
+        stored chunks, so it is the same whether or not the run was resumed.
 
     Returns
     -------
@@ -143,27 +147,39 @@ def run_campaign(config, *, trials=None, seed=None, signature=None, jobs: int = 
     """
     cfg = resolve_config(config, trials, seed, signature)
     setup = build_setup(cfg)
-    warm_up(setup, cfg)
     c = cfg.campaign
     variants = variants_of(c.signature)
     window = cfg.steps(cfg.timing.window_s)
-    chunks = plan_chunks(cfg)
+    plan = plan_chunks(cfg)
+    todo = [(n, ids) for n, ids in plan if chunks is None or not chunks.done(n, int(ids[0]))]
+    if todo:
+        warm_up(setup, cfg)
     n_jobs = auto_jobs(cfg, len(variants)) if jobs == -1 else max(1, int(jobs))
     total = c.trials * len(c.transitions)
     parts = []
     with tqdm(total=total, unit="trial", disable=not progress, desc="trials",
               dynamic_ncols=True) as bar:
+        bar.update(total - sum(len(ids) for _, ids in todo))
         gen = Parallel(n_jobs=n_jobs, return_as="generator")(
             delayed(run_chunk)(setup, name, ids, c.seed, variants, c.max_resets, window)
-            for name, ids in chunks)
-        for (name, ids), out in zip(chunks, gen):
-            parts.extend(dict(trials=t, resets=r) for t, r in out)
+            for name, ids in todo)
+        for (name, ids), out in zip(todo, gen):
+            part = [dict(trials=t, resets=r) for t, r in out]
+            if chunks is not None:
+                chunks.write(name, int(ids[0]), _frames(part, "trials"),
+                             _frames(part, "resets"))
+            else:
+                parts.extend(part)
             bar.update(len(ids))
-    trials_df = _frames(parts, "trials")
-    resets_df = _frames(parts, "resets")
+    if chunks is not None:
+        stored = [chunks.read(n, int(ids[0])) for n, ids in plan]
+        trials_df = pd.concat([t for t, _ in stored], ignore_index=True)
+        resets_df = pd.concat([r for _, r in stored], ignore_index=True)
+    else:
+        trials_df = _frames(parts, "trials")
+        resets_df = _frames(parts, "resets")
     order = {n: i for i, n in enumerate(c.transitions)}
     vorder = {v: i for i, v in enumerate(variants)}
-
     trials_df = _sorted(trials_df, order, vorder, ["trial_id"])
     resets_df = _sorted(resets_df, order, vorder, ["trial_id", "time_s"])
     return CampaignResult(trials=trials_df, resets=resets_df,

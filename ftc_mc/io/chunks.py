@@ -1,0 +1,96 @@
+"""Finished chunks of a campaign on disk, so a killed or interrupted run resumes.
+
+Layout inside the output directory::
+
+    .chunks/manifest.json                 the resolved config this run belongs to
+    .chunks/<transition>-<first id>.resets.parquet
+    .chunks/<transition>-<first id>.trials.parquet   written last: marks the chunk done
+
+Every file is written atomically (temporary name, then rename), so a chunk is
+either complete or absent whatever moment the process dies.  The final result
+files are assembled from the chunk files only, so a resumed run and an
+uninterrupted one produce the same bytes of result data.
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import pandas as pd
+import pyarrow as pa
+import pyarrow.parquet as pq
+
+from ..errors import UserError
+from .atomic import atomic_path, write_text
+
+FOLDER = ".chunks"
+
+
+class ChunkStore:
+    """Chunk files of one run directory.
+
+    Parameters
+    ----------
+    out : Path
+        The run's output directory.
+    config_json : str
+        Canonical JSON of the resolved configuration.
+    """
+
+    def __init__(self, out: Path, config_json: str):
+        self.folder = Path(out) / FOLDER
+        self.config_json = config_json
+
+    def exists(self) -> bool:
+        """Whether an unfinished run left chunks here."""
+        return (self.folder / "manifest.json").exists()
+
+    def open(self, resume: bool) -> None:
+        """Start a new chunk folder, or check the one being resumed.
+
+        Raises
+        ------
+        UserError
+            ``resume`` with chunks of another configuration, or without
+            ``resume`` over chunks of an unfinished run.
+        """
+        manifest = self.folder / "manifest.json"
+        if manifest.exists():
+            if not resume:
+                raise UserError(f"--out: {self.folder.parent} holds an unfinished run; pass "
+                                "--resume to continue it or --overwrite to start again")
+            try:
+                theirs = json.loads(manifest.read_text(encoding="utf-8"))["config"]
+            except (OSError, ValueError, KeyError):
+                raise UserError(f"--resume: {manifest} is unreadable") from None
+            if theirs != json.loads(self.config_json):
+                raise UserError(f"--resume: {self.folder.parent} was made by another "
+                                "configuration (or other --trials/--seed/--signature)")
+            return
+        self.folder.mkdir(parents=True, exist_ok=True)
+        write_text(manifest, json.dumps({"config": json.loads(self.config_json)},
+                                        sort_keys=True))
+
+    def _path(self, name: str, start: int, table: str) -> Path:
+        return self.folder / f"{name}-{start:09d}.{table}.parquet"
+
+    def done(self, name: str, start: int) -> bool:
+        """Whether chunk ``(name, start)`` was finished."""
+        return self._path(name, start, "trials").exists()
+
+    def write(self, name: str, start: int, trials: pd.DataFrame, resets: pd.DataFrame):
+        """Store one finished chunk (resets first, then the trials as the marker)."""
+        for table, df in (("resets", resets), ("trials", trials)):
+            with atomic_path(self._path(name, start, table), suffix=".parquet") as tmp:
+                pq.write_table(pa.Table.from_pandas(df, preserve_index=False), tmp)
+
+    def read(self, name: str, start: int):
+        """``(trials, resets)`` DataFrames of a finished chunk."""
+        return tuple(pq.read_table(self._path(name, start, t)).to_pandas()
+                     for t in ("trials", "resets"))
+
+    def remove(self) -> None:
+        """Delete the chunk folder (after the final files are written)."""
+        shutil.rmtree(self.folder, ignore_errors=True)
