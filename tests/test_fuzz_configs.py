@@ -45,7 +45,7 @@ SECTIONS = {"run": set(Config.model_fields), "scenario": set(ScenarioConfig.mode
 FULL = True  # every generator, including the inputs that once hit bugs
 RANDOM = os.environ.get("FTC_MC_FUZZ_RANDOM") == "1"
 
-MAX_SECONDS = 10.0
+MAX_SECONDS = 30.0  # "refused quickly": generous, so a loaded CI machine does not flake
 """A refused config must be refused this fast (imports are warmed up first)."""
 MAX_LINE = 2000
 """Longest acceptable error line (an alias bomb must not be echoed back)."""

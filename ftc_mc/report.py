@@ -1,0 +1,719 @@
+"""One Markdown report from finished run and scenario directories.
+
+:func:`build_report` reads only the Parquet files of each input directory (so a
+report can be rebuilt at any time without rerunning anything) and writes a
+Markdown file with:
+
+* for each run (``ftc-mc run``): Tables 2-3 beside the paper's counts, per
+  signature variant, with 95 % Wilson intervals; the excluded trials and why;
+  a paired comparison of the signature variants; a figure of the reset-delay
+  and detection-time distributions;
+* for each scenario (``ftc-mc scenario``): the event timeline beside the
+  paper's (section 5.2) and links to the scenario's own figures;
+* the provenance of every input (kind, version, git revision, seed, config).
+
+Inputs whose metadata show different package versions or git revisions are
+refused unless ``allow_mixed`` is set.  Figures go to ``<out stem>_figures/``
+beside the report and are linked by relative paths.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+from pathlib import Path
+from urllib.parse import quote
+
+import numpy as np
+import pandas as pd
+import scipy.stats
+import yaml
+
+from .campaign.summary import wilson
+from .campaign.transitions import PAPER_TABLES, TRANSITION_TABLE
+from .errors import UserError
+from .io.atomic import write_text
+from .io.chunks import FOLDER as CHUNKS_FOLDER
+from .io.lock import holder
+from .io.results import read_metadata
+from .scenario import PAPER_TIMELINE
+
+RUN_TABLES = ("trials.parquet", "summary.parquet")
+"""Parquet files a run directory must hold (``resets.parquet`` is optional)."""
+SCENARIO_TABLES = ("segments.parquet", "events.parquet")
+"""Parquet files a scenario directory must hold (``timeseries.parquet`` optional)."""
+PAPER_EXCITATIONS = {"doublet": (10.0, 12.6, 15.6, 30.0, 50.0, 70.0), "3211": (90.0,)}
+"""Excitations the paper reports in section 5.2 (same text as
+:func:`ftc_mc.scenario.summary_markdown`)."""
+SIGNIFICANCE = 0.05
+"""Level of the paired (McNemar) test between signature variants."""
+
+
+@dataclasses.dataclass
+class ResultDir:
+    """One input directory, as read from its Parquet files.
+
+    Attributes
+    ----------
+    path : Path
+        The directory as given.
+    kind : str
+        ``"run"`` or ``"scenario"``.
+    meta : dict
+        ``ftc_mc`` metadata of the main table (summary or segments).
+    file_meta : dict of str to dict
+        Metadata of every Parquet file in the directory, by file name.
+    tables : dict of str to DataFrame
+        The tables the report uses, by file stem.
+    """
+
+    path: Path
+    kind: str
+    meta: dict
+    file_meta: dict
+    tables: dict
+
+
+# ----------------------------------------------------------------------------- input
+
+
+def _kind_from_files(path: Path) -> str | None:
+    """``"run"``, ``"scenario"`` or None, from the Parquet files present."""
+    has_run = any((path / f).is_file() for f in RUN_TABLES)
+    has_scen = any((path / f).is_file() for f in SCENARIO_TABLES)
+    if has_run and has_scen:
+        raise UserError(f"{path}: holds both run and scenario files; give one "
+                        "directory per result")
+    return "run" if has_run else "scenario" if has_scen else None
+
+
+def _file_metadata(path: Path) -> dict:
+    """Metadata of every Parquet file of ``path``, by file name."""
+    metas = {}
+    for f in sorted(path.glob("*.parquet")):
+        try:
+            metas[f.name] = read_metadata(f)
+        except Exception as exc:  # pyarrow raises several types for a bad file
+            raise UserError(f"{f}: not a readable Parquet file ({exc})") from None
+        if not metas[f.name]:
+            raise UserError(f"{f}: has no ftc_mc metadata; not an ftc-mc result file")
+    return metas
+
+
+def _check_not_busy(path: Path) -> None:
+    """Refuse a directory that a live ``ftc-mc run``/``scenario`` is writing."""
+    owner = holder(path)
+    if owner is not None:
+        raise UserError(f"{path}: being written by `{owner.get('command')}` (pid "
+                        f"{owner.get('pid')}); build the report when it has finished")
+
+
+def load_result_dir(path) -> ResultDir:
+    """Read one run or scenario directory.
+
+    Parameters
+    ----------
+    path : str or Path
+
+    Returns
+    -------
+    ResultDir
+
+    Raises
+    ------
+    UserError
+        If ``path`` is not a directory, is being written by a live ``ftc-mc``
+        process, holds no results, misses a table, or its files disagree on
+        their kind.
+    """
+    path = Path(path)
+    if not path.is_dir():
+        raise UserError(f"{path}: not a directory")
+    _check_not_busy(path)
+    kind = _kind_from_files(path)
+    if kind is None:
+        unfinished = (" (only the chunks of an unfinished run: finish it with "
+                      "`ftc-mc run CONFIG --resume --out DIR`)"
+                      if (path / CHUNKS_FOLDER).is_dir() else "")
+        raise UserError(f"{path}: no ftc-mc results{unfinished} (expected trials.parquet "
+                        "and summary.parquet of a run, or segments.parquet and "
+                        "events.parquet of a scenario)")
+    needed = RUN_TABLES if kind == "run" else SCENARIO_TABLES
+    missing = [f for f in needed if not (path / f).is_file()]
+    if missing:
+        raise UserError(f"{path}: incomplete {kind} results, missing {', '.join(missing)}")
+    file_meta = _file_metadata(path)
+    kinds = {m.get("kind") for m in file_meta.values()}
+    if kinds != {kind}:
+        raise UserError(f"{path}: metadata kind {sorted(map(str, kinds))} does not match "
+                        f"the {kind} files it holds")
+    tables = {f[:-len(".parquet")]: pd.read_parquet(path / f) for f in needed}
+    return ResultDir(path=path, kind=kind, meta=file_meta[needed[-1]],
+                     file_meta=file_meta, tables=tables)
+
+
+def _unique_dirs(dirs) -> list:
+    """``dirs`` as Paths, duplicates (same resolved directory) dropped."""
+    seen, out = set(), []
+    for d in dirs:
+        key = Path(d).resolve()
+        if key not in seen:
+            seen.add(key)
+            out.append(Path(d))
+    return out
+
+
+# ------------------------------------------------------------------------ provenance
+
+
+def _stamp(meta: dict) -> tuple:
+    return (str(meta.get("version")), str(meta.get("git_revision")))
+
+
+def provenance_groups(inputs: list) -> dict:
+    """Inputs grouped by (version, git revision).
+
+    Returns
+    -------
+    dict of (str, str) to list of str
+        Each distinct stamp and where it occurs: a directory when all its files
+        carry the stamp, ``dir/file`` otherwise.
+    """
+    groups = {}
+    for r in inputs:
+        stamps = {name: _stamp(m) for name, m in r.file_meta.items()}
+        for s in dict.fromkeys(stamps.values()):
+            names = [n for n, v in stamps.items() if v == s]
+            where = ([str(r.path)] if len(set(stamps.values())) == 1
+                     else [str(r.path / n) for n in names])
+            groups.setdefault(s, []).extend(where)
+    return groups
+
+
+def mixed_message(groups: dict) -> str:
+    """One line saying which inputs differ in version or git revision."""
+    parts = [f"version {v}, git revision {g}: {', '.join(w)}"
+             for (v, g), w in groups.items()]
+    return "inputs come from different versions or git revisions (" + "; ".join(parts) + ")"
+
+
+def check_provenance(inputs: list, allow_mixed: bool) -> str | None:
+    """Refuse inputs of different versions or git revisions.
+
+    Parameters
+    ----------
+    inputs : list of ResultDir
+    allow_mixed : bool
+        Return a warning instead of raising.
+
+    Returns
+    -------
+    str or None
+        The warning (mixed inputs allowed), or None if all inputs agree.
+
+    Raises
+    ------
+    UserError
+        If the inputs differ and ``allow_mixed`` is false.
+    """
+    groups = provenance_groups(inputs)
+    if len(groups) <= 1:
+        return None
+    msg = mixed_message(groups)
+    if not allow_mixed:
+        raise UserError(f"{msg}; pass --allow-mixed (allow_mixed=True) to build the "
+                        "report anyway")
+    return msg
+
+
+# --------------------------------------------------------------------------- helpers
+
+
+def _rel_link(target: Path, report: Path) -> str:
+    """URL-quoted POSIX path of ``target`` relative to the report's folder."""
+    rel = os.path.relpath(Path(target).resolve(), Path(report).resolve().parent)
+    return quote(Path(rel).as_posix())
+
+
+def _num(x, fmt="{:.1f}") -> str:
+    return "-" if x is None or not np.isfinite(x) else fmt.format(x)
+
+
+def _count(k: int, n: int, ci: bool = True) -> str:
+    """``k/n (rate %, CI low-high)``."""
+    if not n:
+        return f"{k}/0"
+    text = f"{k}/{n} ({100 * k / n:.1f} %"
+    if ci:
+        lo, hi = wilson(k, n)
+        text += f", {100 * lo:.1f}-{100 * hi:.1f}"
+    return text + ")"
+
+
+def _slugs(inputs: list) -> list:
+    """A distinct file-name stem per input (its directory name, made unique)."""
+    out, used = [], set()
+    for r in inputs:
+        base = "".join(c if c.isalnum() or c in "-_." else "_"
+                       for c in r.path.resolve().name) or "input"
+        slug, n = base, 1
+        while slug in used:
+            n += 1
+            slug = f"{base}-{n}"
+        used.add(slug)
+        out.append(slug)
+    return out
+
+
+# ------------------------------------------------------------------------ run tables
+
+
+def _vs_paper(r: pd.Series) -> str:
+    """Where our 95 % interval lies wholly above or below the paper's."""
+    notes = []
+    for col in ("inappropriate", "no_reset"):
+        lo, hi = wilson(r[f"paper_{col}"], r["paper_trials"])
+        if r["trials"] and r[f"{col}_ci_low"] > hi:
+            notes.append(f"{col.replace('_', ' ')} higher")
+        elif r["trials"] and r[f"{col}_ci_high"] < lo:
+            notes.append(f"{col.replace('_', ' ')} lower")
+    return ", ".join(notes) or "consistent"
+
+
+def _paper_row(r: pd.Series) -> dict:
+    """One row of the ours-beside-the-paper table."""
+    n = int(r["trials"])
+    return {
+        "transition": r["label"], "judged": n,
+        "inappropriate: ours": _count(int(r["inappropriate"]), n),
+        "inappropriate: paper": _count(int(r["paper_inappropriate"]),
+                                       int(r["paper_trials"])),
+        "no reset: ours": _count(int(r["no_reset"]), n),
+        "no reset: paper": _count(int(r["paper_no_reset"]), int(r["paper_trials"])),
+        "no reset explained": _num(100 * r["no_reset_explained_share"], "{:.0f} %"),
+        "correct block": _count(int(r["correct"]), n, ci=False),
+        "reset delay median / p95 [s]":
+            f"{_num(r['delay_median_s'])} / {_num(r['delay_p95_s'])}",
+        "detection median / p95 [s]":
+            f"{_num(r['detection_median_s'])} / {_num(r['detection_p95_s'])}",
+        "false-alarm trials": int(r["false_alarm_trials"]),
+        "95 % CIs vs paper": _vs_paper(r),
+    }
+
+
+def paper_tables(summary: pd.DataFrame) -> list:
+    """Markdown lines: Tables 2-3 beside the paper's, one table per variant."""
+    lines = []
+    for variant, g in summary.groupby("variant", sort=False):
+        lines += [f"#### Signature `{variant}`", "",
+                  pd.DataFrame([_paper_row(r) for _, r in g.iterrows()])
+                  .to_markdown(index=False), ""]
+    lines += ["Counts are `k/n (rate %, 95 % Wilson CI)`, over judged trials only; the "
+              "paper's counts are from its Tables 2-3 (one set for both variants). "
+              "*95 % CIs vs paper* says where our interval lies wholly above or below "
+              "the paper's.", ""]
+    return lines
+
+
+def _exclusion_reason(t: pd.DataFrame, window_end_s: float | None) -> pd.Series:
+    """Why each trial of ``t`` (not judged) was excluded."""
+    numeric = t["status"].isin(["nonfinite", "covariance_not_psd"])
+    early = t["status"].ne("ok") & (t["stop_s"] <= window_end_s + 1e-9
+                                    if window_end_s is not None else True)
+    stopped = t["status"].where(numeric | early)
+    reason = stopped.fillna(pd.Series("resets_truncated", index=t.index)
+                            .where(t["resets_truncated"]))
+    return reason.fillna("unknown")
+
+
+def _why(reasons: pd.Series) -> str:
+    counts = reasons.value_counts()
+    return ", ".join(f"{k} {v}" for k, v in counts.items()) or "-"
+
+
+def _stopped(r: pd.Series) -> str:
+    cols = [c for c in r.index if c.startswith("stopped_")]
+    parts = [f"{c[len('stopped_'):]} {int(r[c])}" for c in cols if r[c]]
+    return ", ".join(parts) or "-"
+
+
+def exclusion_table(summary: pd.DataFrame, trials: pd.DataFrame, config: dict) -> list:
+    """Markdown lines: excluded trials per transition and variant, and why."""
+    timing = config.get("timing", {})
+    end = (timing["fault_time_s"] + timing["window_s"]
+           if {"fault_time_s", "window_s"} <= timing.keys() else None)
+    out = trials[~trials["judged"]]
+    reasons = _exclusion_reason(out, end) if len(out) else pd.Series(dtype=object)
+    rows = []
+    for _, r in summary.iterrows():
+        sel = (out["transition"] == r["transition"]) & (out["variant"] == r["variant"])
+        if not r["excluded"] and _stopped(r) == "-":
+            continue
+        rows.append({"transition": r["label"], "signature": r["variant"],
+                     "run": int(r["trials"] + r["excluded"]), "excluded": int(r["excluded"]),
+                     "why excluded": _why(reasons[sel]),
+                     "stopped at any time (stopped_*)": _stopped(r)})
+    if not rows:
+        return ["No trial was excluded or stopped early.", ""]
+    return [pd.DataFrame(rows).to_markdown(index=False), "",
+            "A trial is excluded from the rates when it failed numerically, left the "
+            "validity envelope before the end of the judging window"
+            + (f" ({end:g} s)" if end is not None else "")
+            + ", or had more resets than it could store (`resets_truncated`); a trial stopped "
+            "after the window still counts.", ""]
+
+
+# -------------------------------------------------------------------- variant choice
+
+
+def paired_counts(trials: pd.DataFrame, a: str, b: str, col: str) -> pd.DataFrame:
+    """Per transition, ``col`` of variants ``a`` and ``b`` on the same trials.
+
+    Only trials judged in both variants enter.  The p-value is the exact
+    McNemar test (binomial test on the discordant pairs).
+
+    Returns
+    -------
+    DataFrame
+        ``transition, n, a, b, only_a, only_b, p``.
+    """
+    rows = []
+    for name, g in trials.groupby("transition", sort=False):
+        wide = g.pivot_table(index="trial_id", columns="variant",
+                             values=[col, "judged"], aggfunc="first")
+        both = wide["judged"].reindex(columns=[a, b]).fillna(False).astype(bool).all(axis=1)
+        x = wide[col].reindex(columns=[a, b])[both].astype(bool)
+        only_a = int((x[a] & ~x[b]).sum())
+        only_b = int((x[b] & ~x[a]).sum())
+        p = (scipy.stats.binomtest(only_a, only_a + only_b).pvalue
+             if only_a + only_b else 1.0)
+        rows.append({"transition": name, "n": int(both.sum()), "a": int(x[a].sum()),
+                     "b": int(x[b].sum()), "only_a": only_a, "only_b": only_b, "p": p})
+    return pd.DataFrame(rows)
+
+
+def _label(name: str) -> str:
+    return TRANSITION_TABLE[name].label if name in TRANSITION_TABLE else name
+
+
+def _verdict(inap: pd.DataFrame, a: str, b: str) -> str:
+    """The sentence naming the better variant, with its numbers."""
+    sig = inap[inap["p"] < SIGNIFICANCE]
+    a_better = sig[sig["a"] < sig["b"]]
+    b_better = sig[sig["b"] < sig["a"]]
+
+    def cite(df):
+        return "; ".join(f"{_label(r.transition)}: {r.a}/{r.n} vs {r.b}/{r.n}, "
+                         f"p = {r.p:.2g}" for r in df.itertuples()) or "none"
+
+    n_tr = len(inap)
+    if len(a_better) and len(b_better):
+        head = (f"**Neither variant is better everywhere**: `{a}` has fewer inappropriate "
+                f"resets in {len(a_better)} transition(s) ({cite(a_better)}), `{b}` in "
+                f"{len(b_better)} ({cite(b_better)}).")
+    elif len(a_better) or len(b_better):
+        win, lose, df = (a, b, a_better) if len(a_better) else (b, a, b_better)
+        head = (f"**`{win}` is better**: fewer inappropriate resets than `{lose}` in "
+                f"{len(df)} of {n_tr} transitions ({cite(df)}) and more in none.")
+    else:
+        head = (f"**Neither variant is better on this data**: no transition shows a "
+                f"significant difference in inappropriate resets (of {n_tr}).")
+    tot = (f" Over all transitions: `{a}` {inap['a'].sum()}/{inap['n'].sum()}, "
+           f"`{b}` {inap['b'].sum()}/{inap['n'].sum()} inappropriate.")
+    return head + tot
+
+
+def _no_reset_note(nr: pd.DataFrame, a: str, b: str) -> str:
+    diff = nr[nr["a"] != nr["b"]]
+    if not len(diff):
+        return "The no-reset counts are identical for both variants in every transition."
+    return ("No-reset counts differ in " + "; ".join(
+        f"{_label(r.transition)} ({a} {r.a}/{r.n}, {b} {r.b}/{r.n}, p = {r.p:.2g})"
+        for r in diff.itertuples()) + "; weigh these against the inappropriate resets.")
+
+
+def variant_comparison(trials: pd.DataFrame) -> list:
+    """Markdown lines: which signature variant is better, from paired trials."""
+    variants = list(dict.fromkeys(trials["variant"]))
+    if len(variants) != 2:
+        return [f"Only the `{'`, `'.join(variants)}` variant was run; nothing to compare.",
+                ""]
+    a, b = variants
+    inap = paired_counts(trials, a, b, "inappropriate")
+    nr = paired_counts(trials, a, b, "no_reset")
+    table = pd.DataFrame({
+        "transition": inap["transition"].map(_label), "paired trials": inap["n"],
+        f"inappropriate `{a}`": inap["a"], f"inappropriate `{b}`": inap["b"],
+        f"only `{a}`": inap["only_a"], f"only `{b}`": inap["only_b"],
+        "McNemar p": inap["p"].map(lambda p: f"{p:.2g}"),
+        f"no reset `{a}`": nr["a"], f"no reset `{b}`": nr["b"]})
+    return [_verdict(inap, a, b) + " " + _no_reset_note(nr, a, b), "",
+            table.to_markdown(index=False), "",
+            "Both variants run on the same draws and noise, so the comparison is "
+            "paired: trial by trial on the trials judged in both variants, with an exact "
+            f"McNemar test (difference called significant at p < {SIGNIFICANCE}).", ""]
+
+
+# ------------------------------------------------------------------- delay figure
+
+
+def _box_data(trials: pd.DataFrame, col: str, names: list, variants: list) -> list:
+    judged = trials[trials["judged"]]
+    out = []
+    for name in names:
+        for v in variants:
+            x = judged.loc[(judged["transition"] == name) & (judged["variant"] == v), col]
+            out.append(x[np.isfinite(x)].to_numpy())
+    return out
+
+
+def _horizontal() -> dict:
+    """``boxplot`` keyword for horizontal boxes (``vert`` is deprecated in 3.11)."""
+    import matplotlib
+
+    major, minor = (int(x) for x in matplotlib.__version__.split(".")[:2])
+    return {"orientation": "horizontal"} if (major, minor) >= (3, 10) else {"vert": False}
+
+
+def _draw_boxes(ax, data: list, variants: list, colors: list) -> None:
+    """Horizontal boxes, one group of ``len(variants)`` boxes per transition."""
+    nv = len(variants)
+    pos = [k + k // nv for k in range(len(data))]  # a gap between transitions
+    for j, v in enumerate(variants):
+        d = [(p, x) for k, (p, x) in enumerate(zip(pos, data)) if k % nv == j and len(x)]
+        color = colors[j % len(colors)]
+        if d:
+            bp = ax.boxplot([x for _, x in d], positions=[p for p, _ in d], widths=0.7,
+                            patch_artist=True, whis=(5, 95), medianprops={"color": "k"},
+                            **_horizontal())
+            for box in bp["boxes"]:
+                box.set_facecolor(color)
+                box.set_alpha(0.6)
+        ax.plot([], [], "s", color=color, label=f"signature {v}")
+    for p, x in zip(pos, data):
+        if not len(x):
+            ax.text(0.01, p, "no data", transform=ax.get_yaxis_transform(), va="center",
+                    fontsize=7, color="0.4")
+
+
+def delay_figure(trials: pd.DataFrame, path: Path) -> Path:
+    """Box plots of ``first_reset_s`` and ``detection_s`` per transition and variant.
+
+    Parameters
+    ----------
+    trials : DataFrame
+        ``trials.parquet`` of a run (judged trials are plotted).
+    path : Path
+        PNG file, written atomically.
+
+    Returns
+    -------
+    Path
+    """
+    from .plots import plt, save
+
+    names = list(dict.fromkeys(trials["transition"]))
+    variants = list(dict.fromkeys(trials["variant"]))
+    nv = len(variants)
+    fig, axs = plt.subplots(1, 2, figsize=(11, 1.0 + 0.45 * nv * len(names)), sharey=True,
+                            layout="constrained")
+    colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    for ax, (col, title) in zip(axs, (("first_reset_s", "first reset after the switch [s]"),
+                                      ("detection_s", "detection of the new mode [s]"))):
+        _draw_boxes(ax, _box_data(trials, col, names, variants), variants, colors)
+        ax.set_xlabel(title)
+        ax.grid(alpha=0.3, axis="x")
+    axs[0].set_yticks([i * (nv + 1) + (nv - 1) / 2 for i in range(len(names))],
+                      [_label(n) for n in names], fontsize=8)
+    axs[0].invert_yaxis()
+    axs[1].legend(loc="best", fontsize=8)
+    fig.suptitle("Reset delay and detection time (judged trials; whiskers 5-95 %)")
+    return save(fig, path)
+
+
+# --------------------------------------------------------------------- run section
+
+
+def _run_header(cfg: dict) -> str:
+    c = cfg.get("campaign", {})
+    return (f"{len(c.get('transitions', []))} transition(s), {c.get('trials', '?')} trials "
+            f"each, seed {c.get('seed', '?')}, signature `{c.get('signature', '?')}`, "
+            f"controller `{cfg.get('controller', {}).get('kind', '?')}`.")
+
+
+def run_section(r: ResultDir, fig_dir: Path, slug: str, report: Path) -> list:
+    """Markdown lines of one run."""
+    summary, trials = r.tables["summary"], r.tables["trials"]
+    cfg = r.meta.get("config", {})
+    fig = delay_figure(trials, fig_dir / f"{slug}_delays.png")
+    return ([f"## Run `{r.path}`", "", _run_header(cfg), "",
+             "### Tables 2-3: ours beside the paper", ""] + paper_tables(summary)
+            + ["### Excluded trials", ""] + exclusion_table(summary, trials, cfg)
+            + ["### Which signature variant is better", ""] + variant_comparison(trials)
+            + ["### Delay distributions", "", f"![delays of {slug}]({_rel_link(fig, report)})",
+               ""])
+
+
+# ---------------------------------------------------------------- scenario section
+
+
+def _in_segment(ev: pd.DataFrame, kind: str, t0: float, t1: float) -> pd.DataFrame:
+    e = ev[ev["kind"] == kind]
+    return e[(e["time_s"] >= t0 - 1e-9) & (e["time_s"] < t1 - 1e-9)]
+
+
+def _segment_row(s, prev_mode, ev: pd.DataFrame) -> dict:
+    """One row of the timeline: what happened after one schedule entry."""
+    fault = _in_segment(ev, "fault_switch", s.start_s, s.start_s + 1e-6)
+    resets = _in_segment(ev, "reset", s.start_s, s.end_s)["detail"]
+    exc = _in_segment(ev, "excitation", s.start_s, s.end_s)
+    sw = _in_segment(ev, "controller_switch", s.start_s, s.end_s)
+    recovery = (PAPER_TIMELINE["tracking_recovery_s"]
+                if prev_mode == "engine" and s.truth_mode == "nominal" else np.nan)
+    return {
+        "from [s]": f"{s.start_s:g}", "fault": fault["detail"].iloc[0] if len(fault) else "",
+        "detection: ours [s]": _num(s.detection_s),
+        "detection: paper [s]": _num(s.paper_detection_s),
+        "resets thrust / elevons": f"{resets.str.startswith('thrust').sum()} / "
+                                   f"{resets.str.startswith('elevons').sum()}",
+        "excitations": ", ".join(f"{d} {t:.1f}" for t, d in zip(exc.time_s, exc.detail))
+                       or "-",
+        "controller switches": ", ".join(f"{t:.0f} s: {d}" for t, d in
+                                         zip(sw.time_s, sw.detail)) or "-",
+        "max cross-track [m]": _num(s.max_cross_track_m, "{:.2f}"),
+        "position recovery: ours [s]": _num(s.position_recovery_s),
+        "tracking recovery: paper [s]": _num(recovery),
+    }
+
+
+def timeline_table(segments: pd.DataFrame, events: pd.DataFrame) -> list:
+    """Markdown lines: one row per schedule entry, ours beside the paper."""
+    prev = [None] + list(segments["truth_mode"][:-1])
+    rows = [_segment_row(s, p, events) for s, p in zip(segments.itertuples(), prev)]
+    return [pd.DataFrame(rows).to_markdown(index=False), "",
+            "Detection: first belief update where the true mode is the most probable "
+            "(paper: faults 'in less than 3 s', engine recoveries 8 s and 6 s). Position "
+            "recovery: time after the entry from which the distance to the moving "
+            "reference point stays below 1 m (paper: tracking recovered 15 s after the "
+            "engine recovers). Paper values refer to the schedule of its Table 4.", ""]
+
+
+def _side_by_side(ours: list, paper: list, what: str) -> str:
+    n = max(len(ours), len(paper))
+    pad = lambda x: x + ["-"] * (n - len(x))  # noqa: E731
+    return pd.DataFrame({"#": range(1, n + 1), f"{what}: ours": pad(ours),
+                         f"{what}: paper": pad(paper)}).to_markdown(index=False)
+
+
+def switches_and_excitations(events: pd.DataFrame) -> list:
+    """Markdown lines: controller switches and excitations beside the paper's."""
+    sw = events[events["kind"] == "controller_switch"]
+    ours = [f"{t:.1f} s ({d})" for t, d in zip(sw.time_s, sw.detail)]
+    lines = [_side_by_side(ours, [f"{t:g} s" for t in
+                                  PAPER_TIMELINE["controller_switches_s"]],
+                           "controller switch"), ""]
+    for name, paper in PAPER_EXCITATIONS.items():
+        ex = events[(events["kind"] == "excitation") & (events["detail"] == name)]
+        lines += [f"`{name}`: ours {len(ex)} at "
+                  + (", ".join(f"{t:.1f}" for t in ex.time_s) or "-")
+                  + f" s; paper {len(paper)} at {', '.join(f'{t:g}' for t in paper)} s.", ""]
+    return lines
+
+
+def scenario_figures(r: ResultDir, report: Path) -> list:
+    """Markdown lines linking the scenario's own PNG figures, if present."""
+    figs = sorted(r.path.glob("fig*.png"))
+    if not figs:
+        return [f"No figures in `{r.path}` (the report does not redraw them).", ""]
+    return [line for f in figs for line in (f"![{f.stem}]({_rel_link(f, report)})", "")]
+
+
+def scenario_section(r: ResultDir, report: Path) -> list:
+    """Markdown lines of one scenario."""
+    seg, ev = r.tables["segments"], r.tables["events"]
+    sc = r.meta.get("config", {}).get("scenario", {})
+    details = ev.to_markdown(index=False, floatfmt=".1f")
+    return ([f"## Scenario `{r.path}`", "",
+             f"Signature `{sc.get('signature', '?')}`, controller "
+             f"`{r.meta.get('config', {}).get('controller', {}).get('kind', '?')}`, seed "
+             f"{sc.get('seed', '?')}, {sc.get('duration_s', '?')} s, "
+             f"{len(sc.get('schedule', []))} schedule entries.", "",
+             "### Event timeline beside the paper", ""] + timeline_table(seg, ev)
+            + ["### Controller switches and excitations", ""] + switches_and_excitations(ev)
+            + ["<details><summary>All events</summary>", "", details, "", "</details>", "",
+               "### Figures", ""] + scenario_figures(r, report))
+
+
+# ---------------------------------------------------------------- provenance section
+
+
+def provenance_section(inputs: list, warning: str | None) -> list:
+    """Markdown lines: kind, version, revision, seed and config of every input."""
+    rows = [{"directory": str(r.path), "kind": r.kind, "version": r.meta.get("version"),
+             "git revision": r.meta.get("git_revision") or "-", "seed": r.meta.get("seed"),
+             "files": ", ".join(r.file_meta)} for r in inputs]
+    lines = ["## Provenance", ""]
+    if warning:
+        lines += [f"> **Warning: mixed inputs.** {warning}.", ""]
+    lines += [pd.DataFrame(rows).to_markdown(index=False), ""]
+    for r in inputs:
+        cfg = yaml.safe_dump(r.meta.get("config", {}), sort_keys=False,
+                             default_flow_style=None, width=100).rstrip()
+        lines += [f"<details><summary>config of <code>{r.path}</code></summary>", "",
+                  "```yaml", cfg, "```", "", "</details>", ""]
+    return lines
+
+
+# ------------------------------------------------------------------------- report
+
+
+def _check_out(out: Path) -> None:
+    if out.is_dir():
+        raise UserError(f"-o/--output: {out} is a directory; give a Markdown file name")
+
+
+def build_report(dirs: list, out: Path, allow_mixed: bool = False) -> Path:
+    """Write one Markdown report of run and scenario directories.
+
+    Parameters
+    ----------
+    dirs : list of Path
+        Directories written by ``ftc-mc run`` or ``ftc-mc scenario``, in any mix;
+        only their Parquet files are read.
+    out : Path
+        The Markdown file, written atomically.  Figures go to
+        ``<out stem>_figures/`` beside it.
+    allow_mixed : bool
+        Build the report even if the inputs come from different package versions
+        or git revisions (a warning is added to the report).
+
+    Returns
+    -------
+    Path
+        ``out``.
+
+    Raises
+    ------
+    UserError
+        No input, an input without results, or mixed provenance without
+        ``allow_mixed``.  Nothing is written then.
+    """
+    out = Path(out)
+    _check_out(out)
+    if not dirs:
+        raise UserError("no input directories given")
+    inputs = [load_result_dir(d) for d in _unique_dirs(dirs)]
+    warning = check_provenance(inputs, allow_mixed)
+    fig_dir = out.parent / f"{out.stem}_figures"
+    lines = ["# ftc-mc report", "",
+             f"Built from the Parquet files of {len(inputs)} result director"
+             f"{'y' if len(inputs) == 1 else 'ies'}; rebuild it at any time with "
+             "`ftc-mc report`.", ""]
+    if warning:
+        lines += [f"> **Warning: mixed inputs.** {warning}.", ""]
+    for r, slug in zip(inputs, _slugs(inputs)):
+        lines += (run_section(r, fig_dir, slug, out) if r.kind == "run"
+                  else scenario_section(r, out))
+    lines += provenance_section(inputs, warning)
+    write_text(out, "\n".join(lines))
+    return out

@@ -1,0 +1,248 @@
+"""``ftc_mc.report.build_report``: one Markdown report of run and scenario dirs.
+
+What is checked, on a small real run (4 trials, nominal controller) and the
+paper scenario, both made once per module through the CLI:
+
+* the report holds the paper's counts and ours (with Wilson intervals), the
+  scenario timeline beside the paper's, and the provenance of every input;
+* every image link is relative and points to a non-empty PNG;
+* the report rebuilds from the Parquet files alone, to the same text;
+* refusals (no results, mixed versions or revisions) write nothing;
+  ``allow_mixed`` builds the report with a warning;
+* the signature-variant verdict and the exclusion reasons on synthetic trials.
+"""
+
+from __future__ import annotations
+
+import re
+import shutil
+from pathlib import Path
+from urllib.parse import unquote
+
+import numpy as np
+import pandas as pd
+import pytest
+from click.testing import CliRunner
+
+from ftc_mc.campaign.summary import wilson
+from ftc_mc.campaign.transitions import PAPER_TABLES, TRANSITION_TABLE
+from ftc_mc.cli import cli
+from ftc_mc.errors import UserError
+from ftc_mc.io.lock import acquire
+from ftc_mc.io.results import read_metadata, write_parquet
+from ftc_mc.report import build_report, exclusion_table, variant_comparison
+
+ROOT = Path(__file__).resolve().parents[1]
+PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+IMAGE = re.compile(r"!\[[^\]]*\]\(([^)]+)\)")
+
+
+def _count(k, n):
+    lo, hi = wilson(k, n)
+    return f"{k}/{n} ({100 * k / n:.1f} %, {100 * lo:.1f}-{100 * hi:.1f})"
+
+
+@pytest.fixture(scope="module")
+def inputs(tmp_path_factory):
+    """A finished run and a finished scenario directory."""
+    base = tmp_path_factory.mktemp("report_inputs")
+    run, scen = base / "run", base / "scen"
+    res = CliRunner().invoke(cli, ["run", str(ROOT / "configs" / "paper_tables.yaml"),
+                                   "--trials", "4", "--controller", "nominal", "--jobs", "1",
+                                   "--quiet", "--out", str(run)])
+    assert res.exit_code == 0, res.output
+    res = CliRunner().invoke(cli, ["scenario", str(ROOT / "configs" / "paper_scenario.yaml"),
+                                   "--out", str(scen)])
+    assert res.exit_code == 0, res.output
+    _same_stamp(run, scen)
+    return run, scen
+
+
+def _same_stamp(src: Path, dst: Path) -> None:
+    """Give ``dst``'s files the version and git revision of ``src``.
+
+    Other engineers commit and edit tracked files while the suite runs, so the
+    revision (and its ``+dirty`` suffix) can change between the two CLI calls.
+    """
+    ref = read_metadata(src / "summary.parquet")
+    for path in dst.glob("*.parquet"):
+        meta = read_metadata(path)
+        if (meta["version"], meta["git_revision"]) != (ref["version"], ref["git_revision"]):
+            meta.update(version=ref["version"], git_revision=ref["git_revision"])
+            write_parquet(pd.read_parquet(path), path, meta)
+
+
+@pytest.fixture(scope="module")
+def report(inputs, tmp_path_factory):
+    """The report of both inputs, in a folder of its own."""
+    out = tmp_path_factory.mktemp("report_out") / "report.md"
+    assert build_report(list(inputs), out) == out
+    return out
+
+
+def _rows(text: str, heading: str) -> list:
+    """Cells of the body rows of the first Markdown table after ``heading``."""
+    lines = text.split(heading + "\n", 1)[1].splitlines()
+    first = next(i for i, line in enumerate(lines) if line.startswith("|"))
+    table = []
+    for line in lines[first:]:
+        if not line.startswith("|"):
+            break
+        table.append([c.strip() for c in line.strip("|").split("|")])
+    return table[2:]
+
+
+def _copy(src: Path, dst: Path) -> Path:
+    shutil.copytree(src, dst)
+    return dst
+
+
+def test_report_has_paper_and_our_numbers(inputs, report):
+    text = report.read_text(encoding="utf-8")
+    summary = pd.read_parquet(inputs[0] / "summary.parquet")
+    for variant, g in summary.groupby("variant"):
+        rows = {r[0]: r for r in _rows(text, f"#### Signature `{variant}`")}
+        assert len(rows) == len(g) == len(PAPER_TABLES)
+        for r in g.itertuples():
+            n, inap, no_reset = PAPER_TABLES[r.transition]
+            row = rows[TRANSITION_TABLE[r.transition].label]
+            assert row[1] == str(r.trials)
+            assert row[3] == _count(inap, n) and row[5] == _count(no_reset, n)
+            if r.trials:
+                assert row[2] == _count(r.inappropriate, r.trials)
+                assert row[4] == _count(r.no_reset, r.trials)
+    for heading in ("#### Signature `paper`", "#### Signature `swapped`",
+                    "### Excluded trials", "### Which signature variant is better",
+                    "### Event timeline beside the paper", "## Provenance"):
+        assert heading in text
+
+
+def test_report_has_scenario_timeline_and_provenance(inputs, report):
+    text = report.read_text(encoding="utf-8")
+    seg = pd.read_parquet(inputs[1] / "segments.parquet")
+    ev = pd.read_parquet(inputs[1] / "events.parquet")
+    rows = _rows(text, "### Event timeline beside the paper")
+    assert [r[0] for r in rows] == [f"{t:g}" for t in seg.start_s]
+    for r, s in zip(rows, seg.itertuples()):
+        for cell, value in ((r[2], s.detection_s), (r[3], s.paper_detection_s)):
+            assert cell == ("-" if np.isnan(value) else f"{value:.1f}")
+    for detail in ev.loc[ev.kind == "controller_switch", "detail"]:
+        assert detail in text
+    for d in inputs:
+        meta = read_metadata(next(d.glob("*.parquet")))
+        assert str(d) in text
+        assert meta["version"] in text and str(meta["git_revision"]) in text
+        assert f"seed: {meta['seed']}" in text  # from the YAML config block
+
+
+def test_figures_exist_with_working_relative_links(inputs, report):
+    links = IMAGE.findall(report.read_text(encoding="utf-8"))
+    names = {Path(unquote(link)).name for link in links}
+    assert "run_delays.png" in names
+    assert {p.name for p in inputs[1].glob("fig*.png")} <= names
+    for link in links:
+        assert not Path(unquote(link)).is_absolute(), link
+        target = report.parent / unquote(link)
+        assert target.is_file(), link
+        assert target.stat().st_size > 1000
+        assert target.read_bytes()[:8] == PNG_SIGNATURE
+    assert (report.parent / "report_figures" / "run_delays.png").is_file()
+
+
+def test_rebuild_from_parquet_files_only(inputs, tmp_path):
+    run = _copy(inputs[0], tmp_path / "run")
+    scen = _copy(inputs[1], tmp_path / "scen")
+    out = tmp_path / "out" / "r.md"
+    first = build_report([run, scen], out).read_text(encoding="utf-8")
+    for p in list(tmp_path.rglob("*")):
+        if p.is_file() and p.suffix != ".parquet":
+            p.unlink()
+    second = build_report([run, scen], out).read_text(encoding="utf-8")
+    assert (tmp_path / "out" / "r_figures" / "run_delays.png").stat().st_size > 1000
+    assert "No figures in" in second
+    cut = "### Figures"
+    assert first.split(cut)[0] == second.split(cut)[0]
+    assert first.split("## Provenance")[1] == second.split("## Provenance")[1]
+
+
+def test_directory_without_results_is_refused(inputs, tmp_path):
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    (empty / "summary.md").write_text("not a result\n")
+    out = tmp_path / "r.md"
+    with pytest.raises(UserError, match=re.escape(str(empty))):
+        build_report([inputs[0], empty], out)
+    with pytest.raises(UserError, match="not a directory"):
+        build_report([tmp_path / "missing"], out)
+    with pytest.raises(UserError, match="is a directory"):
+        build_report([inputs[0]], tmp_path)
+    assert not out.exists() and not (tmp_path / "r_figures").exists()
+
+
+def test_directory_being_written_is_refused(inputs, tmp_path):
+    run = _copy(inputs[0], tmp_path / "run")
+    out = tmp_path / "r.md"
+    with acquire(run, command="ftc-mc run test"):
+        with pytest.raises(UserError, match="being written by `ftc-mc run test`"):
+            build_report([run], out)
+    assert not out.exists()
+    (tmp_path / "unfinished" / ".chunks").mkdir(parents=True)
+    with pytest.raises(UserError, match="--resume"):
+        build_report([tmp_path / "unfinished"], out)
+
+
+@pytest.mark.parametrize("field,value", [("version", "9.9.9"),
+                                         ("git_revision", "0" * 40 + "+dirty")])
+def test_mixed_provenance_is_refused_unless_allowed(inputs, tmp_path, field, value):
+    run = _copy(inputs[0], tmp_path / "run")
+    path = run / "summary.parquet"
+    meta = read_metadata(path)
+    meta[field] = value
+    write_parquet(pd.read_parquet(path), path, meta)
+    out = tmp_path / "out" / "r.md"
+    with pytest.raises(UserError) as exc:
+        build_report([run, inputs[1]], out)
+    msg = str(exc.value)
+    assert "--allow-mixed" in msg and value in msg and str(inputs[1]) in msg
+    assert str(path) in msg  # only one file of the run differs
+    assert "\n" not in msg
+    assert not out.exists() and not (tmp_path / "out").exists()
+    text = build_report([run, inputs[1]], out, allow_mixed=True).read_text(encoding="utf-8")
+    assert "**Warning: mixed inputs.**" in text and value in text
+
+
+def _synthetic_trials(inap_paper, inap_swapped, n=20):
+    rows = []
+    for variant, k in (("paper", inap_paper), ("swapped", inap_swapped)):
+        for i in range(n):
+            rows.append({"transition": "elevon_lock", "variant": variant, "trial_id": i,
+                         "inappropriate": i < k, "no_reset": False, "judged": True})
+    return pd.DataFrame(rows)
+
+
+def test_variant_verdict_from_paired_trials():
+    text = "\n".join(variant_comparison(_synthetic_trials(15, 0)))
+    assert "**`swapped` is better**" in text and "15/20 vs 0/20" in text
+    text = "\n".join(variant_comparison(_synthetic_trials(0, 15)))
+    assert "**`paper` is better**" in text
+    text = "\n".join(variant_comparison(_synthetic_trials(1, 2)))
+    assert "Neither variant is better on this data" in text
+    one = _synthetic_trials(1, 2)
+    assert "nothing to compare" in variant_comparison(one[one.variant == "paper"])[0]
+
+
+def test_exclusion_reasons():
+    trials = pd.DataFrame({
+        "transition": "engine_lock", "variant": "paper", "trial_id": range(4),
+        "judged": [True, False, False, True],
+        "status": ["ok", "airspeed_out_of_bounds", "ok", "alpha_out_of_bounds"],
+        "stop_s": [np.nan, 25.0, np.nan, 40.0],
+        "resets_truncated": [False, False, True, False]})
+    summary = pd.DataFrame([{
+        "transition": "engine_lock", "label": "L", "variant": "paper", "trials": 2,
+        "excluded": 2, "stopped_nonfinite": 0, "stopped_airspeed_out_of_bounds": 1,
+        "stopped_alpha_out_of_bounds": 1}])
+    text = "\n".join(exclusion_table(summary, trials, {"timing": {"fault_time_s": 20.0,
+                                                                  "window_s": 10.0}}))
+    assert "airspeed_out_of_bounds 1, resets_truncated 1" in text
+    assert "airspeed_out_of_bounds 1, alpha_out_of_bounds 1" in text
