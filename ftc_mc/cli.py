@@ -168,6 +168,29 @@ def scenario(config, out, seed, overwrite):
     click.echo(f"wrote {out_dir}/: " + ", ".join(p.name for p in files))
 
 
+@cli.command()
+@click.argument("dirs", nargs=-1, required=True, metavar="DIR...", type=click.Path())
+@click.option("-o", "--output", default="report.md", show_default=True,
+              type=click.Path(dir_okay=False),
+              help="Markdown file to write; figures go to <name>_figures/ beside it.")
+@click.option("--allow-mixed", is_flag=True,
+              help="Build the report even if the inputs come from different package "
+              "versions or git revisions (the report then carries a warning).")
+@user_errors
+def report(dirs, output, allow_mixed):
+    """Write one Markdown report of finished run and scenario directories DIR...
+
+    Reads only their Parquet files, so a report can be rebuilt at any time
+    without rerunning anything.
+    """
+    from pathlib import Path
+
+    from .report import build_report
+
+    out = build_report([Path(d) for d in dirs], Path(output), allow_mixed=allow_mixed)
+    click.echo(f"wrote {out}")
+
+
 def main():
     """Console-script entry point (SIGTERM exits cleanly, releasing locks)."""
     import signal

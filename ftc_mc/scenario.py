@@ -133,8 +133,10 @@ def run_scenario(sc: ScenarioConfig, seed: int | None = None,
     ts = _timeseries(setup, sc, rec, k_sw, b0, b1)
     events = _events(ts, sc, rec, setup)
     segments = _segments(ts, sc, modes, setup)
+    status = STATUS_NAMES[int(rec.status[0])]
+    segments["run_status"] = status
     return ScenarioResult(timeseries=ts, events=events, segments=segments, config=sc,
-                          status=STATUS_NAMES[int(rec.status[0])])
+                          status=status)
 
 
 def _timeseries(setup, sc, rec, k_sw, b0, b1) -> pd.DataFrame:
@@ -293,7 +295,8 @@ def summary_markdown(res: ScenarioResult) -> str:
     sw = ev[ev.kind == "controller_switch"]
     lines.append(sw[["time_s", "detail"]].to_markdown(index=False, floatfmt=".1f")
                  if len(sw) else "No switch: c0 throughout.")
-    lines += ["", "Paper: c1 at 11 s (before the engine fault is detected at 13 s), "
+    lines += ["", "Paper: c1 at 11 s (before the engine fault is detected at 13 s; the "
+              "text also says the controller changes at 12 s once it is), "
               "c1 kept after the engine recovers (the penalty outweighs the gain), "
               "c2 at 91 s.", "", "## Excitations and resets", ""]
     ex = ev[ev.kind == "excitation"]
