@@ -180,9 +180,10 @@ def _assert_refused(cmd, config_path, data, res, elapsed, before, after, workdir
     rest = line[len(prefix):]
     if not any(rest.startswith(p) for p in FILE_PROBLEMS):
         loc = rest.split(": ", 1)[0]
-        first = loc.split(".", 1)[0]
         keys = {str(k) for k in data} if isinstance(data, dict) else set()
-        assert first in keys | SECTIONS[cmd], f"no field named ({loc!r}){where}"
+        # a top-level key may itself contain dots ("x.y"): match whole prefixes
+        assert any(loc == k or loc.startswith(k + ".") for k in keys | SECTIONS[cmd]), (
+            f"no field named ({loc!r}){where}")
         assert ": " in rest and rest.split(": ", 1)[1].strip(), f"no problem stated{where}"
     assert elapsed < MAX_SECONDS, f"took {elapsed:.1f} s{where}"
     assert after == before, (f"files changed: {set(after) ^ set(before) or 'contents'}"
