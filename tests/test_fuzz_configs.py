@@ -179,12 +179,13 @@ def _assert_refused(cmd, config_path, data, res, elapsed, before, after, workdir
     assert line.startswith(prefix), f"line does not name the file{where}"
     rest = line[len(prefix):]
     if not any(rest.startswith(p) for p in FILE_PROBLEMS):
-        loc = rest.split(": ", 1)[0]
         keys = {str(k) for k in data} if isinstance(data, dict) else set()
-        # a top-level key may itself contain dots ("x.y"): match whole prefixes
-        assert any(loc == k or loc.startswith(k + ".") for k in keys | SECTIONS[cmd]), (
-            f"no field named ({loc!r}){where}")
-        assert ": " in rest and rest.split(": ", 1)[1].strip(), f"no problem stated{where}"
+        # the line starts with a field path: a top-level key (which may itself
+        # contain dots or ": ", e.g. "x.y" or "a: b"), then ".sub" or ": problem"
+        named = [k for k in keys | SECTIONS[cmd]
+                 if rest.startswith(k + ": ") or rest.startswith(k + ".")]
+        assert named, f"no field named{where}"
+        assert any(rest.split(": ", 1)[1].strip() for _ in named), f"no problem stated{where}"
     assert elapsed < MAX_SECONDS, f"took {elapsed:.1f} s{where}"
     assert after == before, (f"files changed: {set(after) ^ set(before) or 'contents'}"
                              f"{where}")

@@ -122,3 +122,17 @@ Reconfig = namedtuple("Reconfig", [
     "penalty",   # (3, 3) switching penalty P(c, a) (eq. 46)
 ])
 """Controller selection settings (paper section 4.2)."""
+
+LaneState = namedtuple("LaneState", [
+    "x",        # (9, L) true plant state (deviation from trim)
+    "xa",       # (14, L) augmented estimate
+    "P",        # (14, 14, L) covariance
+    "d_start",  # (L,) int64 step the running doublet started at (or far past)
+    "s_start",  # (L,) int64 step the running 3211 started at (or far past)
+    "recheck",  # (L,) int64 step of the pending doublet re-check, or -1
+    "belief",   # (4, L) mode probabilities
+    "alive",    # (L,) bool: the trial is still valid (see trial.advance)
+    "cur",      # (L,) int64 controller in use
+    "rmax",     # (2, L) largest r_q and r_nx seen so far (threshold sharing)
+])
+"""Everything a trial carries from one step to the next (core/trial.py)."""

@@ -34,6 +34,7 @@ from .belief import belief_update
 from .control import C_ELEVON, controller_command, select_controller
 from .excitation import doublet, saturate, signal_3211
 from .jit import kernel
+from .settings import LaneState
 
 STATUS_OK = 0
 STATUS_NONFINITE = 1      # estimate or covariance not finite
@@ -83,8 +84,8 @@ def is_psd(P, l, work):
 
 
 @kernel
-def run_trials(fm, det, bs, ctl, exc, tim, val, rc, eng, inp, rec):
-    """Simulate ``L`` trials to the end, writing their records.
+def advance(fm, det, bs, ctl, exc, tim, val, rc, eng, inp, rec, st, k0, k1):
+    """Advance ``L`` trials from step ``k0`` to ``k1``, writing their records.
 
     Parameters
     ----------
@@ -109,20 +110,27 @@ def run_trials(fm, det, bs, ctl, exc, tim, val, rc, eng, inp, rec):
     inp : TrialInputs
         Per-lane fault schedule, initial estimates and noise.
     rec : TrialRecord
-        Preallocated outputs, overwritten.
+        Outputs, continued from step ``k0`` (initialised by :func:`init_state`).
+    st : LaneState
+        The trials' state at step ``k0``, advanced in place to ``k1``.  It holds
+        everything a trial carries from one step to the next, so a state saved
+        at some step and advanced later gives bit-identical results.
+    k0, k1 : int
+        First step and end step (``0 <= k0 <= k1 <= tim.n_steps``).
     """
-    n_steps = tim.n_steps
     L = inp.w.shape[2]
     nx = 9
     n_res_max = rec.reset_k.shape[0]
-    x = np.zeros((nx, L))
+    x = st.x
+    xa = st.xa
+    P = st.P
+    d_start = st.d_start
+    s_start = st.s_start
+    recheck = st.recheck
+    belief = st.belief
+    alive = st.alive
+    cur = st.cur
     xn = np.zeros((nx, L))
-    xa = inp.xa0.copy()
-    P = np.empty((14, 14, L))
-    for i in range(14):
-        for j in range(14):
-            for l in range(L):
-                P[i, j, l] = inp.P0[i, j]
     u = np.zeros((3, L))
     e = np.zeros((3, L))
     z = np.zeros((12, L))
@@ -131,17 +139,11 @@ def run_trials(fm, det, bs, ctl, exc, tim, val, rc, eng, inp, rec):
     phi = np.zeros((9, 5, L))
     T = np.zeros((9, 14, L))
     work = np.zeros((STEP_ROWS, 14, L))
-    d_start = np.full(L, NO_SIGNAL, dtype=np.int64)
-    s_start = np.full(L, NO_SIGNAL, dtype=np.int64)
-    recheck = np.full(L, -1, dtype=np.int64)
-    belief = np.zeros((4, L))
     bl = np.zeros(4)
     bh = np.zeros(5)
     bv = np.zeros(5)
     bwork = np.zeros(8)
     chol = np.zeros((14, 14))
-    alive = np.ones(L, dtype=np.bool_)
-    cur = np.zeros(L, dtype=np.int64)
     xl = np.zeros(14)
     Ul = np.zeros(3)
     Pl = np.zeros((14, 14))
@@ -153,18 +155,12 @@ def run_trials(fm, det, bs, ctl, exc, tim, val, rc, eng, inp, rec):
     bsel = np.zeros(4)
     exc_now = np.zeros((4, L))
     n_hist = rec.hist_x.shape[0]
-    for l in range(L):
-        rec.stop_k[l] = -1
-        belief[inp.mode_pre[l], l] = 1.0
-        rec.n_resets[l] = 0
-        rec.detect_k[l] = -1
-        rec.status[l] = STATUS_OK
     d_len = 2 * exc.doublet_half
     s_len = 7 * exc.s3211_unit
-    period = 0
+    period = k0 // tim.reconf_every
     ev = 0
     n_ev = inp.k_switch.shape[0]
-    for k in range(n_steps):
+    for k in range(k0, k1):
         # 1. controller and saturation with excitation headroom (eqs. 15-25, 44)
         if rc.kind == 0:
             for i in range(3):
@@ -237,6 +233,9 @@ def run_trials(fm, det, bs, ctl, exc, tim, val, rc, eng, inp, rec):
                         z[r, l] += crj * x[j, l]
         # 3. estimator
         filter_step_lanes(xa, P, u, z, fm, det, phi, T, work, res, block)
+        for l in range(L):
+            st.rmax[0, l] = max(st.rmax[0, l], res[0, l])
+            st.rmax[1, l] = max(st.rmax[1, l], res[1, l])
         kn = k + 1
         # validity of the trial: numerics and the linear model's envelope
         check_psd = kn % val.psd_every == 0
@@ -332,3 +331,54 @@ def run_trials(fm, det, bs, ctl, exc, tim, val, rc, eng, inp, rec):
     for i in range(14):
         for l in range(L):
             rec.xa_end[i, l] = xa[i, l]
+
+
+@kernel
+def init_state(inp, st, rec):
+    """Initial state of every lane (trim, the initial estimate, the belief one-hot
+    on the initial mode, no excitation) and the record's per-lane fields."""
+    L = inp.w.shape[2]
+    for l in range(L):
+        for i in range(9):
+            st.x[i, l] = 0.0
+        for i in range(14):
+            st.xa[i, l] = inp.xa0[i, l]
+            for j in range(14):
+                st.P[i, j, l] = inp.P0[i, j]
+        st.d_start[l] = NO_SIGNAL
+        st.s_start[l] = NO_SIGNAL
+        st.recheck[l] = -1
+        for m in range(4):
+            st.belief[m, l] = 0.0
+        st.belief[inp.mode_pre[l], l] = 1.0
+        st.alive[l] = True
+        st.cur[l] = 0
+        st.rmax[0, l] = 0.0
+        st.rmax[1, l] = 0.0
+        rec.stop_k[l] = -1
+        rec.n_resets[l] = 0
+        rec.detect_k[l] = -1
+        rec.status[l] = STATUS_OK
+
+
+@kernel
+def new_state(L):
+    """A :class:`LaneState` of ``L`` lanes (contents set by :func:`init_state`)."""
+    return LaneState(x=np.zeros((9, L)), xa=np.zeros((14, L)), P=np.zeros((14, 14, L)),
+                     d_start=np.zeros(L, dtype=np.int64),
+                     s_start=np.zeros(L, dtype=np.int64),
+                     recheck=np.zeros(L, dtype=np.int64), belief=np.zeros((4, L)),
+                     alive=np.zeros(L, dtype=np.bool_), cur=np.zeros(L, dtype=np.int64),
+                     rmax=np.zeros((2, L)))
+
+
+@kernel
+def run_trials(fm, det, bs, ctl, exc, tim, val, rc, eng, inp, rec):
+    """Simulate ``L`` trials from the start to the end (see :func:`advance`).
+
+    Parameters are those of :func:`advance` without the state and step range;
+    ``rec`` is overwritten.
+    """
+    st = new_state(inp.w.shape[2])
+    init_state(inp, st, rec)
+    advance(fm, det, bs, ctl, exc, tim, val, rc, eng, inp, rec, st, 0, tim.n_steps)
