@@ -169,6 +169,58 @@ def scenario(config, out, seed, overwrite):
 
 
 @cli.command()
+@click.argument("config", type=click.Path(dir_okay=True))
+@click.option("--thresholds", help="t_q = t_nx values: start:stop:step or a,b,c.")
+@click.option("--tq", help="t_q values (a grid with --tnx).")
+@click.option("--tnx", help="t_nx values (a grid with --tq).")
+@click.option("--transitions", help="Comma list of transitions (overrides the config).")
+@click.option("--signature", type=click.Choice(["paper", "swapped", "both"]),
+              help="Table 1 variant(s) (overrides the config).")
+@click.option("--trials", type=int, help="Trials per transition (overrides the config).")
+@click.option("--flights", type=int, help="Fault-free flights per point [default: trials].")
+@click.option("--jobs", type=int, default=-1, show_default=True,
+              help="Worker processes; -1: every core. Results do not depend on it.")
+@click.option("--out", type=click.Path(file_okay=False),
+              help="Output directory [default: results/<config name>, never reused].")
+@click.option("--overwrite", is_flag=True, help="Replace results already in --out.")
+@click.option("--quiet", is_flag=True, help="No progress bar.")
+@user_errors
+def sweep(config, thresholds, tq, tnx, transitions, signature, trials, flights, jobs, out,
+          overwrite, quiet):
+    """Sweep the Table 1 thresholds: Tables 2-3 and false resets per flight hour."""
+    from pathlib import Path
+
+    from .campaign.runner import resolve_config
+    from .campaign.sweep import run_sweep, sweep_markdown, threshold_points
+    from .io.atomic import write_text
+    from .io.config import with_overrides
+    from .io.lock import acquire
+    from .io.results import prepare_output_dir, provenance, write_parquet
+
+    cfg = resolve_config(config, trials, None, signature)
+    if transitions is not None:
+        names = [t.strip() for t in transitions.split(",") if t.strip()]
+        cfg = with_overrides(cfg, campaign={"transitions": names})
+    points = threshold_points(thresholds, tq, tnx)
+    if flights is not None and flights < 1:
+        raise UserError(f"--flights: must be >= 1, got {flights}")
+    if jobs == 0 or jobs < -1:
+        raise UserError(f"--jobs: must be a positive count or -1, got {jobs}")
+    out_dir = Path(out) if out else _default_out(config)
+    with acquire(out_dir, command="ftc-mc sweep"):
+        prepare_output_dir(out_dir, overwrite)
+        res = run_sweep(cfg, points, flights=flights, jobs=jobs, progress=not quiet)
+        meta = provenance(cfg.model_dump(mode="json"), cfg.campaign.seed, "sweep")
+        meta["points"] = [list(p) for p in points]
+        meta["trial_steps"] = {"simulated": res.simulated_steps, "alone": res.alone_steps}
+        write_parquet(res.table, out_dir / "sweep.parquet", meta)
+        md = sweep_markdown(res)
+        write_text(out_dir / "sweep.md", md)
+    click.echo(md)
+    click.echo(f"wrote {out_dir}/: sweep.parquet, sweep.md")
+
+
+@cli.command()
 @click.argument("dirs", nargs=-1, required=True, metavar="DIR...", type=click.Path())
 @click.option("-o", "--output", default="report.md", show_default=True,
               type=click.Path(dir_okay=False),
