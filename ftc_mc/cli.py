@@ -94,9 +94,14 @@ def _default_out(config_path: str):
 @click.option("--overwrite", is_flag=True, help="Replace results already in --out.")
 @click.option("--resume", is_flag=True,
               help="Continue an interrupted run in --out, skipping its finished chunks.")
+@click.option("--backend", type=click.Choice(["loky", "dask"]), default="loky",
+              show_default=True, help="Worker processes here (loky) or a Dask cluster.")
+@click.option("--scheduler", help="Dask scheduler address, e.g. tcp://10.0.0.5:8786 "
+              "[default: a local cluster].")
 @click.option("--quiet", is_flag=True, help="No progress bar.")
 @user_errors
-def run(config, trials, seed, jobs, out, signature, controller, overwrite, resume, quiet):
+def run(config, trials, seed, jobs, out, signature, controller, overwrite, resume, backend,
+        scheduler, quiet):
     """Run a Monte Carlo campaign (the paper's Tables 2-3) from CONFIG."""
     from pathlib import Path
 
@@ -124,7 +129,8 @@ def run(config, trials, seed, jobs, out, signature, controller, overwrite, resum
             raise UserError(f"--resume: {out_dir} holds no interrupted run")
         store.open(resume)
         try:
-            result = run_campaign(cfg, jobs=jobs, progress=not quiet, chunks=store)
+            result = run_campaign(cfg, jobs=jobs, progress=not quiet, chunks=store,
+                                  backend=backend, scheduler=scheduler)
         except KeyboardInterrupt:
             click.echo(f"\ninterrupted: finished chunks are kept in {store.folder}; "
                        f"continue with --resume --out {out_dir}", err=True)
@@ -183,10 +189,14 @@ def scenario(config, out, seed, overwrite):
 @click.option("--out", type=click.Path(file_okay=False),
               help="Output directory [default: results/<config name>, never reused].")
 @click.option("--overwrite", is_flag=True, help="Replace results already in --out.")
+@click.option("--backend", type=click.Choice(["loky", "dask"]), default="loky",
+              show_default=True, help="Worker processes here (loky) or a Dask cluster.")
+@click.option("--scheduler", help="Dask scheduler address, e.g. tcp://10.0.0.5:8786 "
+              "[default: a local cluster].")
 @click.option("--quiet", is_flag=True, help="No progress bar.")
 @user_errors
 def sweep(config, thresholds, tq, tnx, transitions, signature, trials, flights, jobs, out,
-          overwrite, quiet):
+          overwrite, backend, scheduler, quiet):
     """Sweep the Table 1 thresholds: Tables 2-3 and false resets per flight hour."""
     from pathlib import Path
 
@@ -209,7 +219,8 @@ def sweep(config, thresholds, tq, tnx, transitions, signature, trials, flights, 
     out_dir = Path(out) if out else _default_out(config)
     with acquire(out_dir, command="ftc-mc sweep"):
         prepare_output_dir(out_dir, overwrite)
-        res = run_sweep(cfg, points, flights=flights, jobs=jobs, progress=not quiet)
+        res = run_sweep(cfg, points, flights=flights, jobs=jobs, progress=not quiet,
+                        backend=backend, scheduler=scheduler)
         meta = provenance(cfg.model_dump(mode="json"), cfg.campaign.seed, "sweep")
         meta["points"] = [list(p) for p in points]
         meta["trial_steps"] = {"simulated": res.simulated_steps, "alone": res.alone_steps}

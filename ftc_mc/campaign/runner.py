@@ -22,6 +22,7 @@ from tqdm.auto import tqdm
 
 from ..io.config import Config, load_config, parse_config, with_overrides
 from .chunk import run_chunk
+from .parallel import backend as parallel_backend
 from .setup import CampaignSetup, build_setup, variants_of
 from .summary import markdown_table, summarize
 
@@ -119,7 +120,8 @@ def _sorted(df, order, vorder, extra):
 
 
 def run_campaign(config, *, trials=None, seed=None, signature=None, jobs: int = 1,
-                 progress: bool = True, chunks=None) -> CampaignResult:
+                 progress: bool = True, chunks=None, backend: str = "loky",
+                 scheduler: str | None = None) -> CampaignResult:
     """Run every transition of a configuration.
 
     Parameters
@@ -136,6 +138,10 @@ def run_campaign(config, *, trials=None, seed=None, signature=None, jobs: int = 
         identical for every value.
     progress : bool
         Show a tqdm bar counting finished trials.
+    backend : {"loky", "dask"}
+        Where chunks run (:mod:`ftc_mc.campaign.parallel`).
+    scheduler : str, optional
+        Dask scheduler address (``backend="dask"``); a local cluster if None.
     chunks : ChunkStore, optional
         Where finished chunks are stored as they complete; chunks already in it
         are not run again (resume).  The result is then assembled from the
@@ -160,17 +166,20 @@ def run_campaign(config, *, trials=None, seed=None, signature=None, jobs: int = 
     with tqdm(total=total, unit="trial", disable=not progress, desc="trials",
               dynamic_ncols=True) as bar:
         bar.update(total - sum(len(ids) for _, ids in todo))
-        gen = Parallel(n_jobs=n_jobs, return_as="generator")(
-            delayed(run_chunk)(setup, name, ids, c.seed, variants, c.max_resets, window)
-            for name, ids in todo)
-        for (name, ids), out in zip(todo, gen):
-            part = [dict(trials=t, resets=r) for t, r in out]
-            if chunks is not None:
-                chunks.write(name, int(ids[0]), _frames(part, "trials"),
-                             _frames(part, "resets"))
-            else:
-                parts.extend(part)
-            bar.update(len(ids))
+        if backend == "dask":
+            n_jobs = os.cpu_count() if jobs == -1 else n_jobs
+        with parallel_backend(backend, scheduler, n_jobs):
+            gen = Parallel(n_jobs=n_jobs, return_as="generator")(
+                delayed(run_chunk)(setup, name, ids, c.seed, variants, c.max_resets, window)
+                for name, ids in todo)
+            for (name, ids), out in zip(todo, gen):
+                part = [dict(trials=t, resets=r) for t, r in out]
+                if chunks is not None:
+                    chunks.write(name, int(ids[0]), _frames(part, "trials"),
+                                 _frames(part, "resets"))
+                else:
+                    parts.extend(part)
+                bar.update(len(ids))
     if chunks is not None:
         stored = [chunks.read(n, int(ids[0])) for n, ids in plan]
         trials_df = pd.concat([t for t, _ in stored], ignore_index=True)

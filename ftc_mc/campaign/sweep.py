@@ -35,6 +35,7 @@ from ..errors import UserError
 from ..estimator import detection
 from ..io.config import Config
 from .chunk import build_inputs, classify, new_record
+from .parallel import backend as parallel_backend
 from .runner import _sorted, plan_chunks
 from .setup import CampaignSetup, build_setup, estimator_settings, variants_of
 from .summary import summarize
@@ -257,7 +258,8 @@ def _poisson_ci(k: int, exposure: float):
 
 
 def run_sweep(cfg: Config, points, *, flights: int | None = None, jobs: int = 1,
-              progress: bool = True) -> SweepResult:
+              progress: bool = True, backend: str = "loky",
+              scheduler: str | None = None) -> SweepResult:
     """Run a threshold sweep.
 
     Parameters
@@ -273,6 +275,8 @@ def run_sweep(cfg: Config, points, *, flights: int | None = None, jobs: int = 1,
         Worker processes; results do not depend on it.
     progress : bool
         Show a tqdm bar.
+    backend, scheduler
+        Where chunks run (:mod:`ftc_mc.campaign.parallel`).
     """
     setup = build_setup(cfg)
     c = cfg.campaign
@@ -294,12 +298,13 @@ def run_sweep(cfg: Config, points, *, flights: int | None = None, jobs: int = 1,
     sim = alone = 0
     with tqdm(total=sum(sizes), unit="trial", disable=not progress, desc="sweep",
               dynamic_ncols=True) as bar:
-        results = Parallel(n_jobs=n_jobs, return_as="generator")(tasks)
-        for i, (out, (s, a)) in enumerate(results):
-            (parts if i < len(chunks) else frows).append(out)
-            sim += s
-            alone += a
-            bar.update(sizes[i])
+        with parallel_backend(backend, scheduler, n_jobs):
+            results = Parallel(n_jobs=n_jobs, return_as="generator")(tasks)
+            for i, (out, (s, a)) in enumerate(results):
+                (parts if i < len(chunks) else frows).append(out)
+                sim += s
+                alone += a
+                bar.update(sizes[i])
     trials = pd.DataFrame({k: np.concatenate([p[k] for p in parts]) for k in parts[0]})
     order = {n: i for i, n in enumerate(c.transitions)}
     vorder = {v: i for i, v in enumerate(variants)}
