@@ -78,6 +78,26 @@ def _default_out(config_path: str):
     return cand
 
 
+def _open_chunks(out_dir, identity_json: str, overwrite: bool, resume: bool):
+    """The chunk store of a run or sweep directory, new or resumed."""
+    from .io.chunks import ChunkStore
+
+    store = ChunkStore(out_dir, identity_json)
+    if overwrite:
+        store.remove()
+    elif resume and not store.exists():
+        raise UserError(f"--resume: {out_dir} holds no interrupted run")
+    store.open(resume)
+    return store
+
+
+def _interrupted(store, out_dir):
+    """Ctrl-C: say where the finished chunks are and how to continue."""
+    click.echo(f"\ninterrupted: finished chunks are kept in {store.folder}; "
+               f"continue with --resume --out {out_dir}", err=True)
+    sys.exit(130)
+
+
 @cli.command()
 @click.argument("config", type=click.Path(dir_okay=True))
 @click.option("--trials", type=int, help="Trials per transition (overrides the config).")
@@ -106,7 +126,6 @@ def run(config, trials, seed, jobs, out, signature, controller, overwrite, resum
     from pathlib import Path
 
     from .campaign.runner import resolve_config, run_campaign
-    from .io.chunks import ChunkStore
     from .io.config import with_overrides
     from .io.lock import acquire
     from .io.results import prepare_output_dir, provenance, write_run
@@ -122,19 +141,12 @@ def run(config, trials, seed, jobs, out, signature, controller, overwrite, resum
     config_json = json.dumps(cfg.model_dump(mode="json"), sort_keys=True)
     with acquire(out_dir, command="ftc-mc run"):
         prepare_output_dir(out_dir, overwrite)
-        store = ChunkStore(out_dir, config_json)
-        if overwrite:
-            store.remove()
-        elif resume and not store.exists():
-            raise UserError(f"--resume: {out_dir} holds no interrupted run")
-        store.open(resume)
+        store = _open_chunks(out_dir, config_json, overwrite, resume)
         try:
             result = run_campaign(cfg, jobs=jobs, progress=not quiet, chunks=store,
                                   backend=backend, scheduler=scheduler)
         except KeyboardInterrupt:
-            click.echo(f"\ninterrupted: finished chunks are kept in {store.folder}; "
-                       f"continue with --resume --out {out_dir}", err=True)
-            sys.exit(130)
+            _interrupted(store, out_dir)
         meta = provenance(cfg.model_dump(mode="json"), cfg.campaign.seed, "run")
         md = "# ftc-mc run summary\n\n" + result.markdown() + "\n"
         write_run(out_dir, result.trials, result.resets, result.summary, md, meta)
@@ -189,6 +201,8 @@ def scenario(config, out, seed, overwrite):
 @click.option("--out", type=click.Path(file_okay=False),
               help="Output directory [default: results/<config name>, never reused].")
 @click.option("--overwrite", is_flag=True, help="Replace results already in --out.")
+@click.option("--resume", is_flag=True,
+              help="Continue an interrupted sweep in --out, skipping its finished chunks.")
 @click.option("--backend", type=click.Choice(["loky", "dask"]), default="loky",
               show_default=True, help="Worker processes here (loky) or a Dask cluster.")
 @click.option("--scheduler", help="Dask scheduler address, e.g. tcp://10.0.0.5:8786 "
@@ -196,7 +210,7 @@ def scenario(config, out, seed, overwrite):
 @click.option("--quiet", is_flag=True, help="No progress bar.")
 @user_errors
 def sweep(config, thresholds, tq, tnx, transitions, signature, trials, flights, jobs, out,
-          overwrite, backend, scheduler, quiet):
+          overwrite, resume, backend, scheduler, quiet):
     """Sweep the Table 1 thresholds: Tables 2-3 and false resets per flight hour."""
     from pathlib import Path
 
@@ -216,17 +230,27 @@ def sweep(config, thresholds, tq, tnx, transitions, signature, trials, flights, 
         raise UserError(f"--flights: must be >= 1, got {flights}")
     if jobs == 0 or jobs < -1:
         raise UserError(f"--jobs: must be a positive count or -1, got {jobs}")
+    if resume and not out:
+        raise UserError("--resume: name the sweep's directory with --out")
     out_dir = Path(out) if out else _default_out(config)
+    identity = {"config": cfg.model_dump(mode="json"), "points": [list(p) for p in points],
+                "flights": flights}
     with acquire(out_dir, command="ftc-mc sweep"):
         prepare_output_dir(out_dir, overwrite)
-        res = run_sweep(cfg, points, flights=flights, jobs=jobs, progress=not quiet,
-                        backend=backend, scheduler=scheduler)
+        store = _open_chunks(out_dir, json.dumps(identity, sort_keys=True), overwrite,
+                             resume)
+        try:
+            res = run_sweep(cfg, points, flights=flights, jobs=jobs, progress=not quiet,
+                            backend=backend, scheduler=scheduler, chunks=store)
+        except KeyboardInterrupt:
+            _interrupted(store, out_dir)
         meta = provenance(cfg.model_dump(mode="json"), cfg.campaign.seed, "sweep")
         meta["points"] = [list(p) for p in points]
         meta["trial_steps"] = {"simulated": res.simulated_steps, "alone": res.alone_steps}
         write_parquet(res.table, out_dir / "sweep.parquet", meta)
         md = sweep_markdown(res)
         write_text(out_dir / "sweep.md", md)
+        store.remove()
     click.echo(md)
     click.echo(f"wrote {out_dir}/: sweep.parquet, sweep.md")
 

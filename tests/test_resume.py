@@ -121,3 +121,44 @@ def test_sigint_keeps_finished_chunks(tmp_path, reference):
         for f, df in ref.items():
             pd.testing.assert_frame_equal(_data(out)[f], df, check_exact=True)
     assert os.path.exists(out / "summary.md")
+
+
+SWEEP = ["--thresholds", "6,12,25", "--flights", "8", "--jobs", "1", "--quiet"]
+
+
+def _sweep(args):
+    return subprocess.Popen([sys.executable, "-m", "ftc_mc", "sweep", *args],
+                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+
+
+@pytest.fixture(scope="module")
+def sweep_reference(tmp_path_factory):
+    d = tmp_path_factory.mktemp("sref")
+    cfg = d / "cfg.yaml"
+    cfg.write_text(CONFIG)
+    p = _sweep([str(cfg), "--out", str(d / "out"), *SWEEP])
+    assert p.wait(timeout=300) == 0, p.stderr.read()
+    return cfg, pq.read_table(d / "out" / "sweep.parquet").to_pandas()
+
+
+@pytest.mark.parametrize("kill_after", [2, 9])
+def test_sweep_sigkill_then_resume(tmp_path, sweep_reference, kill_after):
+    cfg, ref = sweep_reference
+    out = tmp_path / "out"
+    p = _sweep([str(cfg), "--out", str(out), *SWEEP])
+    chunks = out / ".chunks"
+    while len(list(chunks.glob("*.trials.parquet"))) < kill_after and p.poll() is None:
+        time.sleep(0.01)
+    p.send_signal(signal.SIGKILL)
+    p.wait()
+    assert p.returncode == -signal.SIGKILL and not (out / "sweep.parquet").exists()
+    for f in chunks.glob("*.parquet"):
+        pq.read_table(f)
+    res = CliRunner().invoke(cli, ["sweep", str(cfg), "--out", str(out), "--resume",
+                                   *SWEEP])
+    assert res.exit_code == 0, res.output
+    pd.testing.assert_frame_equal(pq.read_table(out / "sweep.parquet").to_pandas(), ref,
+                                  check_exact=True)
+    bad = CliRunner().invoke(cli, ["sweep", str(cfg), "--out", str(tmp_path / "o2"),
+                                   "--resume", *SWEEP])
+    assert bad.exit_code == 2 and "no interrupted run" in bad.output

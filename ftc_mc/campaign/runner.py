@@ -176,7 +176,7 @@ def run_campaign(config, *, trials=None, seed=None, signature=None, jobs: int = 
                 part = [dict(trials=t, resets=r) for t, r in out]
                 if chunks is not None:
                     chunks.write(name, int(ids[0]), _frames(part, "trials"),
-                                 _frames(part, "resets"))
+                                 resets=_frames(part, "resets"))
                 else:
                     parts.extend(part)
                 bar.update(len(ids))

@@ -259,7 +259,7 @@ def _poisson_ci(k: int, exposure: float):
 
 def run_sweep(cfg: Config, points, *, flights: int | None = None, jobs: int = 1,
               progress: bool = True, backend: str = "loky",
-              scheduler: str | None = None) -> SweepResult:
+              scheduler: str | None = None, chunks=None) -> SweepResult:
     """Run a threshold sweep.
 
     Parameters
@@ -277,40 +277,58 @@ def run_sweep(cfg: Config, points, *, flights: int | None = None, jobs: int = 1,
         Show a tqdm bar.
     backend, scheduler
         Where chunks run (:mod:`ftc_mc.campaign.parallel`).
+    chunks : ChunkStore, optional
+        Finished chunks are stored there and skipped when resuming; the result
+        is assembled from the stored chunks either way.
     """
     setup = build_setup(cfg)
     c = cfg.campaign
     variants = variants_of(c.signature)
     window = cfg.steps(cfg.timing.window_s)
     flights = c.trials if flights is None else int(flights)
-    chunks = plan_chunks(cfg)
-    fchunks = [np.arange(s, min(s + c.chunk_size, flights))
-               for s in range(0, flights, c.chunk_size)]
-    from .runner import warm_up
-    warm_up(setup, cfg)
+    units = [(name, ids) for name, ids in plan_chunks(cfg)]
+    units += [(FLIGHT, np.arange(s, min(s + c.chunk_size, flights)))
+              for s in range(0, flights, c.chunk_size)]
+    todo = [(n, ids) for n, ids in units if chunks is None or not chunks.done(n, int(ids[0]))]
+    if todo:
+        from .runner import warm_up
+        warm_up(setup, cfg)
     n_jobs = (os.cpu_count() or 1) if jobs == -1 else max(1, int(jobs))
-    tasks = ([delayed(sweep_chunk)(setup, cfg, name, ids, points, variants, c.max_resets,
-                                   window) for name, ids in chunks]
-             + [delayed(flight_chunk)(setup, cfg, ids, points, variants, c.max_resets)
-                for ids in fchunks])
-    sizes = [len(ids) for _, ids in chunks] + [len(ids) for ids in fchunks]
-    parts, frows = [], []
-    sim = alone = 0
-    with tqdm(total=sum(sizes), unit="trial", disable=not progress, desc="sweep",
-              dynamic_ncols=True) as bar:
+
+    def task(name, ids):
+        if name == FLIGHT:
+            return delayed(flight_chunk)(setup, cfg, ids, points, variants, c.max_resets)
+        return delayed(sweep_chunk)(setup, cfg, name, ids, points, variants, c.max_resets,
+                                    window)
+
+    done = {}
+    with tqdm(total=sum(len(ids) for _, ids in units), unit="trial", disable=not progress,
+              desc="sweep", dynamic_ncols=True) as bar:
+        bar.update(sum(len(ids) for _, ids in units) - sum(len(ids) for _, ids in todo))
         with parallel_backend(backend, scheduler, n_jobs):
-            results = Parallel(n_jobs=n_jobs, return_as="generator")(tasks)
-            for i, (out, (s, a)) in enumerate(results):
-                (parts if i < len(chunks) else frows).append(out)
-                sim += s
-                alone += a
-                bar.update(sizes[i])
-    trials = pd.DataFrame({k: np.concatenate([p[k] for p in parts]) for k in parts[0]})
+            results = Parallel(n_jobs=n_jobs, return_as="generator")(
+                task(n, ids) for n, ids in todo)
+            for (name, ids), (out, (s, a)) in zip(todo, results):
+                frame = pd.DataFrame(out)
+                steps = pd.DataFrame({"simulated": [s], "alone": [a]})
+                if chunks is not None:
+                    chunks.write(name, int(ids[0]), frame, steps=steps)
+                else:
+                    done[name, int(ids[0])] = (frame, steps)
+                bar.update(len(ids))
+    if chunks is not None:
+        done = {(n, int(ids[0])): chunks.read(n, int(ids[0]), ("trials", "steps"))
+                for n, ids in units}
+    parts = [done[n, int(ids[0])][0] for n, ids in units if n != FLIGHT]
+    frows = [done[n, int(ids[0])][0] for n, ids in units if n == FLIGHT]
+    sim = int(sum(int(v[1]["simulated"].iloc[0]) for v in done.values()))
+    alone = int(sum(int(v[1]["alone"].iloc[0]) for v in done.values()))
+    trials = pd.concat(parts, ignore_index=True)
     order = {n: i for i, n in enumerate(c.transitions)}
     vorder = {v: i for i, v in enumerate(variants)}
     trials = _sorted(trials, order, vorder, ["trial_id"])
     trials = trials.sort_values(["t_q", "t_nx"], kind="stable").reset_index(drop=True)
-    flights_df = pd.DataFrame([r for rows in frows for r in rows])
+    flights_df = pd.concat(frows, ignore_index=True)
     hours = cfg.timing.duration_s / 3600.0
     fsum = flights_df.groupby(["t_q", "t_nx", "variant"], as_index=False)[
         ["flights", "judged", "resets"]].sum()

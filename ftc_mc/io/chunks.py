@@ -80,16 +80,16 @@ class ChunkStore:
         """Whether chunk ``(name, start)`` was finished."""
         return self._path(name, start, "trials").exists()
 
-    def write(self, name: str, start: int, trials: pd.DataFrame, resets: pd.DataFrame):
-        """Store one finished chunk (resets first, then the trials as the marker)."""
-        for table, df in (("resets", resets), ("trials", trials)):
+    def write(self, name: str, start: int, trials: pd.DataFrame, **others: pd.DataFrame):
+        """Store one finished chunk: the other tables first, then ``trials`` as the
+        marker that the chunk is complete."""
+        for table, df in [*others.items(), ("trials", trials)]:
             with atomic_path(self._path(name, start, table), suffix=".parquet") as tmp:
                 pq.write_table(pa.Table.from_pandas(df, preserve_index=False), tmp)
 
-    def read(self, name: str, start: int):
-        """``(trials, resets)`` DataFrames of a finished chunk."""
-        return tuple(pq.read_table(self._path(name, start, t)).to_pandas()
-                     for t in ("trials", "resets"))
+    def read(self, name: str, start: int, tables=("trials", "resets")):
+        """DataFrames of a finished chunk, one per name in ``tables``."""
+        return tuple(pq.read_table(self._path(name, start, t)).to_pandas() for t in tables)
 
     def remove(self) -> None:
         """Delete the chunk folder (after the final files are written)."""
