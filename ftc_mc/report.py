@@ -42,6 +42,11 @@ RUN_TABLES = ("trials.parquet", "summary.parquet")
 """Parquet files a run directory must hold (``resets.parquet`` is optional)."""
 SCENARIO_TABLES = ("segments.parquet", "events.parquet")
 """Parquet files a scenario directory must hold (``timeseries.parquet`` optional)."""
+SWEEP_TABLES = ("sweep.parquet",)
+"""Parquet file of a sweep directory."""
+FALSE_RESET_TARGET_PER_H = 0.01
+"""Largest acceptable false-reset rate when recommending a threshold: one per
+100 flight hours."""
 PAPER_EXCITATIONS = {"doublet": (10.0, 12.6, 15.6, 30.0, 50.0, 70.0), "3211": (90.0,)}
 """Excitations the paper reports in section 5.2 (same text as
 :func:`ftc_mc.scenario.summary_markdown`)."""
@@ -79,12 +84,13 @@ class ResultDir:
 
 def _kind_from_files(path: Path) -> str | None:
     """``"run"``, ``"scenario"`` or None, from the Parquet files present."""
-    has_run = any((path / f).is_file() for f in RUN_TABLES)
-    has_scen = any((path / f).is_file() for f in SCENARIO_TABLES)
-    if has_run and has_scen:
-        raise UserError(f"{path}: holds both run and scenario files; give one "
+    found = [k for k, files in (("run", RUN_TABLES), ("scenario", SCENARIO_TABLES),
+                                ("sweep", SWEEP_TABLES))
+             if any((path / f).is_file() for f in files)]
+    if len(found) > 1:
+        raise UserError(f"{path}: holds {' and '.join(found)} files; give one "
                         "directory per result")
-    return "run" if has_run else "scenario" if has_scen else None
+    return found[0] if found else None
 
 
 def _file_metadata(path: Path) -> dict:
@@ -138,7 +144,7 @@ def load_result_dir(path) -> ResultDir:
         raise UserError(f"{path}: no ftc-mc results{unfinished} (expected trials.parquet "
                         "and summary.parquet of a run, or segments.parquet and "
                         "events.parquet of a scenario)")
-    needed = RUN_TABLES if kind == "run" else SCENARIO_TABLES
+    needed = {"run": RUN_TABLES, "scenario": SCENARIO_TABLES, "sweep": SWEEP_TABLES}[kind]
     missing = [f for f in needed if not (path / f).is_file()]
     if missing:
         raise UserError(f"{path}: incomplete {kind} results, missing {', '.join(missing)}")
@@ -672,6 +678,106 @@ def _check_out(out: Path) -> None:
         raise UserError(f"-o/--output: {out} is a directory; give a Markdown file name")
 
 
+# ----------------------------------------------------------------------------- sweep
+
+
+def recommend_threshold(table: pd.DataFrame, variant: str,
+                        target: float = FALSE_RESET_TARGET_PER_H):
+    """The threshold point a sweep recommends for one signature variant.
+
+    Among the points whose false-reset rate per flight hour is at most
+    ``target``, the one with the smallest mean over transitions of the
+    inappropriate-reset rate plus the *unexplained* no-reset rate (no-reset
+    trials not explained by a small ``b1`` or a lock near trim).  If no point
+    meets the target, the point with the fewest false resets.
+
+    Returns
+    -------
+    (float, float, str)
+        ``t_q``, ``t_nx`` and the reasoning in one sentence.
+    """
+    g = table[table["variant"] == variant].copy()
+    explained = g["no_reset_explained_share"].fillna(0.0)
+    g["cost"] = g["inappropriate_rate"] + g["no_reset_rate"] * (1.0 - explained)
+    per = g.groupby(["t_q", "t_nx"]).agg(cost=("cost", "mean"),
+                                         false=("false_resets_per_hour", "first"),
+                                         upper=("false_resets_per_hour_ci_high", "first"))
+    ok = per[per["false"] <= target]
+    if len(ok):
+        (tq, tnx), row = ok["cost"].idxmin(), ok.loc[ok["cost"].idxmin()]
+        why = (f"lowest mean inappropriate + unexplained no-reset rate "
+               f"({100 * row['cost']:.2f} %) among the {len(ok)} points with at most "
+               f"{target:g} false resets per flight hour (here {row['false']:.3g}; "
+               f"95 % upper bound {row['upper']:.3g} from the flights flown)")
+    else:
+        (tq, tnx) = per["false"].idxmin()
+        row = per.loc[(tq, tnx)]
+        why = (f"no point reaches {target:g} false resets per flight hour; this one has "
+               f"the fewest ({row['false']:.3g}); more fault-free flights or higher "
+               "thresholds are needed")
+    return float(tq), float(tnx), why
+
+
+def sweep_figure(table: pd.DataFrame, path: Path) -> Path:
+    """Inappropriate and no-reset rates per transition, and false resets per hour,
+    against the threshold (the point index when t_q and t_nx differ)."""
+    import matplotlib.pyplot as plt
+
+    from .plots import save
+
+    same = bool((table["t_q"] == table["t_nx"]).all())
+    names = list(dict.fromkeys(table["transition"]))
+    ncols = 3
+    nrows = (len(names) + 1 + ncols - 1) // ncols
+    fig, axs = plt.subplots(nrows, ncols, figsize=(12, 3.2 * nrows), squeeze=False)
+    pts = table[["t_q", "t_nx"]].drop_duplicates().reset_index(drop=True)
+    xkey = {(a, b): (a if same else i) for i, (a, b) in enumerate(zip(pts["t_q"], pts["t_nx"]))}
+    styles = {"paper": "-", "swapped": "--"}
+    for ax, name in zip(axs.flat, names):
+        for variant, g in table[table["transition"] == name].groupby("variant"):
+            x = [xkey[(a, b)] for a, b in zip(g["t_q"], g["t_nx"])]
+            ls = styles.get(variant, ":")
+            ax.plot(x, 100 * g["inappropriate_rate"], "r" + ls, label=f"inappropriate {variant}")
+            ax.plot(x, 100 * g["no_reset_rate"], "b" + ls, label=f"no reset {variant}")
+        ax.set_title(_label(name), fontsize=9)
+        ax.set_ylabel("% of trials")
+        ax.grid(alpha=0.3)
+    ax = axs.flat[len(names)]
+    for variant, g in table.groupby("variant"):
+        g = g.drop_duplicates(["t_q", "t_nx"])
+        x = [xkey[(a, b)] for a, b in zip(g["t_q"], g["t_nx"])]
+        ax.semilogy(x, g["false_resets_per_hour"].clip(lower=1e-3), "k" + styles.get(variant, ":"),
+                    label=variant)
+    ax.axhline(FALSE_RESET_TARGET_PER_H, color="g", lw=0.8, label="1 per 100 h")
+    ax.set_title("false resets per flight hour", fontsize=9)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7)
+    for extra in list(axs.flat)[len(names) + 1:]:
+        extra.axis("off")
+    axs.flat[0].legend(fontsize=7)
+    for a in axs.flat:
+        a.set_xlabel("threshold t_q = t_nx" if same else "threshold point")
+    fig.tight_layout()
+    return save(fig, path)
+
+
+def sweep_section(r: ResultDir, fig_dir: Path, slug: str, report: Path) -> list:
+    """Report section of one sweep: trade-off plots and the recommended threshold."""
+    t = r.tables["sweep"]
+    fig = sweep_figure(t, fig_dir / f"{slug}_sweep.png")
+    lines = [f"## Sweep `{r.path}`", "",
+             f"{t[['t_q', 't_nx']].drop_duplicates().shape[0]} threshold points, "
+             f"{t['transition'].nunique()} transition(s), variants "
+             f"{', '.join(sorted(t['variant'].unique()))}.", "",
+             f"![threshold trade-off]({_rel_link(fig, report)})", "",
+             "### Recommended threshold", ""]
+    for variant in sorted(t["variant"].unique()):
+        tq, tnx, why = recommend_threshold(t, variant)
+        lines.append(f"- `{variant}`: **t_q = {tq:g}, t_nx = {tnx:g}**: {why}.")
+    lines.append("")
+    return lines
+
+
 def build_report(dirs: list, out: Path, allow_mixed: bool = False) -> Path:
     """Write one Markdown report of run and scenario directories.
 
@@ -712,8 +818,12 @@ def build_report(dirs: list, out: Path, allow_mixed: bool = False) -> Path:
     if warning:
         lines += [f"> **Warning: mixed inputs.** {warning}.", ""]
     for r, slug in zip(inputs, _slugs(inputs)):
-        lines += (run_section(r, fig_dir, slug, out) if r.kind == "run"
-                  else scenario_section(r, out))
+        if r.kind == "run":
+            lines += run_section(r, fig_dir, slug, out)
+        elif r.kind == "sweep":
+            lines += sweep_section(r, fig_dir, slug, out)
+        else:
+            lines += scenario_section(r, out)
     lines += provenance_section(inputs, warning)
     write_text(out, "\n".join(lines))
     return out

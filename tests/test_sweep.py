@@ -90,3 +90,11 @@ def test_cli_sweep(tmp_path):
     r = CliRunner().invoke(cli, ["sweep", str(cfg), "--thresholds", "10", "--out", str(out)])
     assert r.exit_code == 2 and "already holds results" in r.output
     assert np.isfinite(table["inappropriate_rate"]).all()
+    # the report plots the trade-off and names a threshold
+    rep = tmp_path / "rep" / "report.md"
+    r = CliRunner().invoke(cli, ["report", str(out), "-o", str(rep)])
+    assert r.exit_code == 0, r.output
+    text = rep.read_text()
+    assert "Recommended threshold" in text and "t_q = " in text
+    png = rep.parent / "report_figures" / "out_sweep.png"
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and png.stat().st_size > 10_000
