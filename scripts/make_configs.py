@@ -27,6 +27,12 @@ def campaign_configs() -> dict:
     cfg = Config.model_validate({"campaign": {"transitions": list(TRANSITION_TABLE)}})
     files["paper_tables.yaml"] = render_yaml(
         cfg, "ftc-mc run configs/paper_tables.yaml -- all eight rows of Tables 2-3")
+    cfg = Config.model_validate({"campaign": {"transitions": list(TRANSITION_TABLE)},
+                                 "controller": {"kind": "nominal"}})
+    files["sweep.yaml"] = render_yaml(
+        cfg, "ftc-mc sweep configs/sweep.yaml --thresholds 5:100:5 -- the threshold "
+             "trade-off over all eight rows of Tables 2-3 (nominal controller: the "
+             "thresholds act on the estimator)")
     files["paper_scenario.yaml"] = render_yaml(
         ScenarioConfig(), "ftc-mc scenario configs/paper_scenario.yaml -- the paper's 100 s "
                           "landing approach (Table 4) with the full reconfiguring loop")

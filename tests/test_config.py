@@ -25,6 +25,11 @@ def test_shipped_configs_are_current():
             assert load_config(path).campaign.trials == 1000
 
 
+def test_sweep_config():
+    cfg = load_config(ROOT / "configs" / "sweep.yaml")
+    assert len(cfg.campaign.transitions) == 8 and cfg.controller.kind == "nominal"
+
+
 def test_paper_tables_has_all_eight_rows():
     cfg = load_config(ROOT / "configs" / "paper_tables.yaml")
     assert len(cfg.campaign.transitions) == 8
