@@ -1,4 +1,4 @@
-"""Hostile and malformed configs for ``ftc-mc run`` and ``ftc-mc scenario``.
+"""Hostile and malformed configs for ``ftc-mc run``, ``sweep`` and ``scenario``.
 
 Starting from the shipped configs/elevon_lock.yaml and configs/paper_scenario.yaml,
 hypothesis mutates the parsed YAML (wrong types, missing and unknown keys, NaN and
@@ -39,9 +39,13 @@ from ftc_mc.io.config import Config, ScenarioConfig, parse_config
 
 ROOT = Path(__file__).resolve().parents[1]
 SHIPPED = {"run": ROOT / "configs" / "elevon_lock.yaml",
-           "scenario": ROOT / "configs" / "paper_scenario.yaml"}
+           "scenario": ROOT / "configs" / "paper_scenario.yaml",
+           "sweep": ROOT / "configs" / "sweep.yaml"}
+EXTRA_ARGS = {"sweep": ["--thresholds", "10"]}
+"""Options a command needs besides its config."""
 BASES = {cmd: yaml.safe_load(p.read_text(encoding="utf-8")) for cmd, p in SHIPPED.items()}
-SECTIONS = {"run": set(Config.model_fields), "scenario": set(ScenarioConfig.model_fields)}
+SECTIONS = {"run": set(Config.model_fields), "scenario": set(ScenarioConfig.model_fields),
+            "sweep": set(Config.model_fields)}
 FULL = True  # every generator, including the inputs that once hit bugs
 RANDOM = os.environ.get("FTC_MC_FUZZ_RANDOM") == "1"
 
@@ -123,7 +127,7 @@ def _oracle(cmd: str, raw: bytes):
     if not isinstance(data, dict):
         return False, data
     try:
-        if cmd == "run":
+        if cmd in ("run", "sweep"):
             parse_config(data)
         else:
             ScenarioConfig.model_validate(data)
@@ -141,10 +145,11 @@ def _invoke(cmd, config_path, out_mode, monkeypatch, workdir: Path):
         empty = workdir / ".warm.yaml"
         empty.write_text("")
         monkeypatch.chdir(workdir)
-        CliRunner().invoke(cli, [cmd, str(empty), "--out", str(workdir / "warm-out")])
+        CliRunner().invoke(cli, [cmd, str(empty), *EXTRA_ARGS.get(cmd, []), "--out",
+                                 str(workdir / "warm-out")])
         empty.unlink()
         _WARM.add(cmd)
-    args = [cmd, str(config_path)]
+    args = [cmd, str(config_path), *EXTRA_ARGS.get(cmd, [])]
     if out_mode == "new":
         args += ["--out", str(workdir / "out" / "new")]
     elif out_mode == "existing":
@@ -377,7 +382,7 @@ def test_fuzz_scenario_config(raw, out_mode, monkeypatch):
 
 
 @settings(FUZZ, max_examples=60)
-@given(cmd=st.sampled_from(["run", "scenario"]), data=st.data())
+@given(cmd=st.sampled_from(["run", "scenario", "sweep"]), data=st.data())
 def test_fuzz_wrong_values_in_fields(cmd, data, monkeypatch):
     """One field at a time: a wrong type, NaN/inf, huge or negative, or deleted."""
     cfg = copy.deepcopy(BASES[cmd])
@@ -392,7 +397,7 @@ def test_fuzz_wrong_values_in_fields(cmd, data, monkeypatch):
 
 
 @settings(FUZZ, max_examples=60)
-@given(cmd=st.sampled_from(["run", "scenario"]), data=st.data())
+@given(cmd=st.sampled_from(["run", "scenario", "sweep"]), data=st.data())
 def test_fuzz_python_tags_construct_nothing(cmd, data, monkeypatch):
     cfg = copy.deepcopy(BASES[cmd])
     path = data.draw(st.sampled_from(PATHS[cmd]), label="path")
@@ -405,7 +410,7 @@ def test_fuzz_python_tags_construct_nothing(cmd, data, monkeypatch):
 
 
 @settings(FUZZ, max_examples=60)
-@given(cmd=st.sampled_from(["run", "scenario"]), levels=st.integers(2, 9),
+@given(cmd=st.sampled_from(["run", "scenario", "sweep"]), levels=st.integers(2, 9),
        width=st.integers(2, 9), kind=st.sampled_from(["list", "dict"]), data=st.data())
 def test_fuzz_alias_bombs_are_refused_quickly(cmd, levels, width, kind, data, monkeypatch):
     cfg = copy.deepcopy(BASES[cmd])
@@ -423,7 +428,7 @@ def test_fuzz_alias_bombs_are_refused_quickly(cmd, levels, width, kind, data, mo
 
 
 @settings(FUZZ, max_examples=60)
-@given(cmd=st.sampled_from(["run", "scenario"]), data=st.data())
+@given(cmd=st.sampled_from(["run", "scenario", "sweep"]), data=st.data())
 def test_fuzz_non_utf8_bytes(cmd, data, monkeypatch):
     raw = SHIPPED[cmd].read_bytes()
     for _ in range(data.draw(st.integers(1, 3), label="n")):

@@ -162,3 +162,38 @@ def test_sweep_sigkill_then_resume(tmp_path, sweep_reference, kill_after):
     bad = CliRunner().invoke(cli, ["sweep", str(cfg), "--out", str(tmp_path / "o2"),
                                    "--resume", *SWEEP])
     assert bad.exit_code == 2 and "no interrupted run" in bad.output
+
+
+SCENARIO = Path(__file__).resolve().parents[1] / "configs" / "paper_scenario.yaml"
+
+
+@pytest.fixture(scope="module")
+def scenario_reference(tmp_path_factory):
+    d = tmp_path_factory.mktemp("scen") / "out"
+    p = subprocess.run([sys.executable, "-m", "ftc_mc", "scenario", str(SCENARIO), "--out",
+                        str(d)], capture_output=True, timeout=300)
+    assert p.returncode == 0, p.stderr
+    return {f: pq.read_table(d / f).to_pandas()
+            for f in ("timeseries.parquet", "events.parquet", "segments.parquet")}
+
+
+@pytest.mark.parametrize("delay", [0.8, 1.6, 2.4, 3.2])
+def test_scenario_sigkill_leaves_only_whole_files(tmp_path, scenario_reference, delay):
+    out = tmp_path / "out"
+    p = subprocess.Popen([sys.executable, "-m", "ftc_mc", "scenario", str(SCENARIO),
+                          "--out", str(out)], stdout=subprocess.DEVNULL,
+                         stderr=subprocess.DEVNULL)
+    time.sleep(delay)
+    p.send_signal(signal.SIGKILL)
+    p.wait()
+    for f in out.glob("*.parquet") if out.exists() else []:
+        pq.read_table(f)  # whole, or absent
+    for f in out.glob("*.png") if out.exists() else []:
+        assert f.read_bytes().endswith(b"IEND\xaeB`\x82"), f
+    # the stale lock is taken over and a rerun gives the same data
+    res = CliRunner().invoke(cli, ["scenario", str(SCENARIO), "--out", str(out),
+                                   "--overwrite"])
+    assert res.exit_code == 0, res.output
+    for f, df in scenario_reference.items():
+        pd.testing.assert_frame_equal(pq.read_table(out / f).to_pandas(), df,
+                                      check_exact=True)
