@@ -78,6 +78,16 @@ def _default_out(config_path: str):
     return cand
 
 
+def parallel_options(func):
+    """``--backend``, ``--scheduler`` and ``--quiet`` of ``run`` and ``sweep``."""
+    func = click.option("--quiet", is_flag=True, help="No progress bar.")(func)
+    func = click.option("--scheduler", help="Dask scheduler address, e.g. "
+                        "tcp://10.0.0.5:8786 [default: a local cluster].")(func)
+    return click.option("--backend", type=click.Choice(["loky", "dask"]), default="loky",
+                        show_default=True,
+                        help="Worker processes here (loky) or a Dask cluster.")(func)
+
+
 def _open_chunks(out_dir, identity_json: str, overwrite: bool, resume: bool):
     """The chunk store of a run or sweep directory, new or resumed."""
     from .io.chunks import ChunkStore
@@ -114,11 +124,7 @@ def _interrupted(store, out_dir):
 @click.option("--overwrite", is_flag=True, help="Replace results already in --out.")
 @click.option("--resume", is_flag=True,
               help="Continue an interrupted run in --out, skipping its finished chunks.")
-@click.option("--backend", type=click.Choice(["loky", "dask"]), default="loky",
-              show_default=True, help="Worker processes here (loky) or a Dask cluster.")
-@click.option("--scheduler", help="Dask scheduler address, e.g. tcp://10.0.0.5:8786 "
-              "[default: a local cluster].")
-@click.option("--quiet", is_flag=True, help="No progress bar.")
+@parallel_options
 @user_errors
 def run(config, trials, seed, jobs, out, signature, controller, overwrite, resume, backend,
         scheduler, quiet):
@@ -203,11 +209,7 @@ def scenario(config, out, seed, overwrite):
 @click.option("--overwrite", is_flag=True, help="Replace results already in --out.")
 @click.option("--resume", is_flag=True,
               help="Continue an interrupted sweep in --out, skipping its finished chunks.")
-@click.option("--backend", type=click.Choice(["loky", "dask"]), default="loky",
-              show_default=True, help="Worker processes here (loky) or a Dask cluster.")
-@click.option("--scheduler", help="Dask scheduler address, e.g. tcp://10.0.0.5:8786 "
-              "[default: a local cluster].")
-@click.option("--quiet", is_flag=True, help="No progress bar.")
+@parallel_options
 @user_errors
 def sweep(config, thresholds, tq, tnx, transitions, signature, trials, flights, jobs, out,
           overwrite, resume, backend, scheduler, quiet):

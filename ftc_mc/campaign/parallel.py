@@ -53,7 +53,7 @@ def backend(name: str = "loky", scheduler: str | None = None, n_workers: int = 2
     try:
         if scheduler is None:
             cluster = LocalCluster(n_workers=max(1, n_workers), threads_per_worker=1,
-                                   processes=True, dashboard_address=None)
+                                   processes=True, dashboard_address=":0")
             client = Client(cluster)
         else:
             client = Client(scheduler, timeout=30)

@@ -134,6 +134,18 @@ def _rerun(setup, det, inp, rec, lanes, max_resets):
     return len(lanes) * setup.tim.n_steps
 
 
+def _shared_start(setup, cfg, inp, k_end: int, max_resets: int):
+    """Record and state of every lane advanced to ``k_end`` with resets disabled:
+    the part of a trial that every threshold point shares (module docstring)."""
+    L = inp.w.shape[2]
+    rec0 = new_record(setup, L, max_resets)
+    st0 = new_state(L)
+    init_state(inp, st0, rec0)
+    _run(setup, _point_det(setup, cfg, "paper", math.inf, math.inf), inp, rec0, st0, 0,
+         k_end)
+    return rec0, st0
+
+
 def sweep_chunk(setup: CampaignSetup, cfg: Config, tr_name: str, trial_ids, points,
                 variants, max_resets: int, window: int):
     """Every threshold point and variant of one chunk; returns trials and a step count.
@@ -148,11 +160,7 @@ def sweep_chunk(setup: CampaignSetup, cfg: Config, tr_name: str, trial_ids, poin
     inp, draws = build_inputs(setup, tr_name, trial_ids, cfg.campaign.seed)
     L = len(trial_ids)
     n, kf = setup.tim.n_steps, setup.tim.k_fault
-    inf = _point_det(setup, cfg, "paper", math.inf, math.inf)
-    rec0 = new_record(setup, L, max_resets)
-    st0 = new_state(L)
-    init_state(inp, st0, rec0)
-    _run(setup, inf, inp, rec0, st0, 0, kf)
+    rec0, st0 = _shared_start(setup, cfg, inp, kf, max_resets)
     simulated = L * kf
     parts = []
     for tq, tnx in points:
@@ -200,11 +208,7 @@ def flight_chunk(setup: CampaignSetup, cfg: Config, ids, points, variants,
     """
     inp = flight_inputs(setup, ids, cfg.campaign.seed)
     L, n = len(ids), setup.tim.n_steps
-    inf = _point_det(setup, cfg, "paper", math.inf, math.inf)
-    rec0 = new_record(setup, L, max_resets)
-    st0 = new_state(L)
-    init_state(inp, st0, rec0)
-    _run(setup, inf, inp, rec0, st0, 0, n)
+    rec0, st0 = _shared_start(setup, cfg, inp, n, max_resets)
     simulated = L * n
     rows = []
     for tq, tnx in points:
