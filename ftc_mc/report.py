@@ -30,7 +30,7 @@ import scipy.stats
 import yaml
 
 from .campaign.summary import wilson
-from .campaign.transitions import PAPER_TABLES, TRANSITION_TABLE
+from .campaign.transitions import TRANSITION_TABLE
 from .errors import UserError
 from .io.atomic import write_text
 from .io.chunks import FOLDER as CHUNKS_FOLDER

@@ -12,7 +12,7 @@ import math
 import numpy as np
 
 from ..core.interp import EngineTables
-from ..core.settings import (Belief, Controller, Detection, Excitation, FilterModel,
+from ..core.settings import (Belief, Controller, Excitation, FilterModel,
                              Reconfig, Timing, Validity)
 from ..design.terminal import terminal_costs
 from ..design.theorem41 import cached_engine_tables
