@@ -496,6 +496,10 @@ class ScenarioSpec(_Strict):
         return self
 
 
+SHARED_SECTIONS = ("model", "estimator", "controller", "excitation", "noise", "validity")
+"""Sections a scenario file has in common with a campaign config."""
+
+
 class ScenarioConfig(_Strict):
     """A scenario file: ``ftc-mc scenario CONFIG``."""
 
@@ -515,10 +519,7 @@ class ScenarioConfig(_Strict):
         try:
             return Config.model_validate({
                 "campaign": {"signature": sc.signature, "trials": 1, "seed": sc.seed},
-                "model": self.model.model_dump(), "estimator": self.estimator.model_dump(),
-                "controller": self.controller.model_dump(),
-                "excitation": self.excitation.model_dump(),
-                "noise": self.noise.model_dump(), "validity": self.validity.model_dump(),
+                **{name: getattr(self, name).model_dump() for name in SHARED_SECTIONS},
                 "timing": {"duration_s": sc.duration_s,
                            "fault_time_s": last if last > 0 else dt,
                            "window_s": max(sc.duration_s - last, dt) if last > 0 else dt,
