@@ -62,20 +62,48 @@ def model(as_json, save, airspeed, gamma_deg, dt):
     click.echo(json.dumps(summary, indent=2) if as_json else format_summary(summary))
 
 
-def _default_out(config_path: str):
-    """``results/<config stem>``, or the first ``-N`` suffix that holds no run."""
+def _default_out(config_path: str, cfg=None):
+    """``results/<config stem>``, or the first ``-N`` suffix that holds no run.
+
+    A truth plant other than the paper's (linear, still air) is named in the
+    stem, e.g. ``results/paper_tables-nonlinear-moderate``.
+    """
     from pathlib import Path
 
     from .io.lock import holder
     from .io.results import RUN_FILES
 
-    base = Path("results") / Path(config_path).stem
+    stem = Path(config_path).stem
+    if cfg is not None and (cfg.plant.kind, cfg.plant.turbulence) != ("linear", "none"):
+        stem += f"-{cfg.plant.kind}" + (f"-{cfg.plant.turbulence}"
+                                        if cfg.plant.turbulence != "none" else "")
+    base = Path("results") / stem
     cand, n = base, 1
     while cand.exists() and (any((cand / f).exists() for f in RUN_FILES)
                              or (cand / ".chunks").exists() or holder(cand) is not None):
         n += 1
         cand = base.with_name(f"{base.name}-{n}")
     return cand
+
+
+def plant_options(func):
+    """``--plant`` and ``--turbulence`` of ``run``, ``sweep`` and ``scenario``."""
+    func = click.option("--turbulence",
+                        type=click.Choice(["none", "light", "moderate", "severe"]),
+                        help="MIL-F-8785C Dryden gusts on the truth plant (overrides "
+                        "plant.turbulence).")(func)
+    return click.option("--plant", type=click.Choice(["linear", "nonlinear"]),
+                        help="Truth plant: the linear model of eq. (1) or the nonlinear "
+                        "X8 (overrides plant.kind; the estimator stays linear).")(func)
+
+
+def _with_plant(cfg, plant, turbulence):
+    """``cfg`` with the ``--plant`` and ``--turbulence`` overrides."""
+    from .io.config import with_overrides
+
+    if plant is None and turbulence is None:
+        return cfg
+    return with_overrides(cfg, plant={"kind": plant, "turbulence": turbulence})
 
 
 def parallel_options(func):
@@ -124,10 +152,11 @@ def _interrupted(store, out_dir):
 @click.option("--overwrite", is_flag=True, help="Replace results already in --out.")
 @click.option("--resume", is_flag=True,
               help="Continue an interrupted run in --out, skipping its finished chunks.")
+@plant_options
 @parallel_options
 @user_errors
 def run(config, trials, seed, jobs, out, signature, controller, overwrite, resume, backend,
-        scheduler, quiet):
+        scheduler, quiet, plant, turbulence):
     """Run a Monte Carlo campaign (the paper's Tables 2-3) from CONFIG."""
     from pathlib import Path
 
@@ -141,9 +170,10 @@ def run(config, trials, seed, jobs, out, signature, controller, overwrite, resum
     cfg = resolve_config(config, trials, seed, signature)
     if controller is not None:
         cfg = with_overrides(cfg, controller={"kind": controller})
+    cfg = _with_plant(cfg, plant, turbulence)
     if resume and not out:
         raise UserError("--resume: name the run's directory with --out")
-    out_dir = Path(out) if out else _default_out(config)
+    out_dir = Path(out) if out else _default_out(config, cfg)
     config_json = json.dumps(cfg.model_dump(mode="json"), sort_keys=True)
     with acquire(out_dir, command="ftc-mc run"):
         prepare_output_dir(out_dir, overwrite)
@@ -168,8 +198,9 @@ def run(config, trials, seed, jobs, out, signature, controller, overwrite, resum
               help="Output directory [default: results/<config name>, never reused].")
 @click.option("--seed", type=int, help="Noise seed (overrides the config).")
 @click.option("--overwrite", is_flag=True, help="Replace results already in --out.")
+@plant_options
 @user_errors
-def scenario(config, out, seed, overwrite):
+def scenario(config, out, seed, overwrite, plant, turbulence):
     """Run the closed-loop scenario of CONFIG (the paper's Table 4 by default)."""
     from pathlib import Path
 
@@ -178,10 +209,10 @@ def scenario(config, out, seed, overwrite):
     from .io.results import prepare_output_dir, provenance
     from .scenario import run_scenario, summary_markdown, write_scenario
 
-    sc = load_scenario(config)
+    sc = _with_plant(load_scenario(config), plant, turbulence)
     if seed is not None and seed < 0:
         raise UserError(f"--seed: must be >= 0, got {seed}")
-    out_dir = Path(out) if out else _default_out(config)
+    out_dir = Path(out) if out else _default_out(config, sc)
     with acquire(out_dir, command="ftc-mc scenario"):
         prepare_output_dir(out_dir, overwrite)
         res = run_scenario(sc, seed=seed)
@@ -209,10 +240,11 @@ def scenario(config, out, seed, overwrite):
 @click.option("--overwrite", is_flag=True, help="Replace results already in --out.")
 @click.option("--resume", is_flag=True,
               help="Continue an interrupted sweep in --out, skipping its finished chunks.")
+@plant_options
 @parallel_options
 @user_errors
 def sweep(config, thresholds, tq, tnx, transitions, signature, trials, flights, jobs, out,
-          overwrite, resume, backend, scheduler, quiet):
+          overwrite, resume, backend, scheduler, quiet, plant, turbulence):
     """Sweep the Table 1 thresholds: Tables 2-3 and false resets per flight hour."""
     from pathlib import Path
 
@@ -227,6 +259,7 @@ def sweep(config, thresholds, tq, tnx, transitions, signature, trials, flights, 
     if transitions is not None:
         names = [t.strip() for t in transitions.split(",") if t.strip()]
         cfg = with_overrides(cfg, campaign={"transitions": names})
+    cfg = _with_plant(cfg, plant, turbulence)
     points = threshold_points(thresholds, tq, tnx)
     if flights is not None and flights < 1:
         raise UserError(f"--flights: must be >= 1, got {flights}")
@@ -234,7 +267,7 @@ def sweep(config, thresholds, tq, tnx, transitions, signature, trials, flights, 
         raise UserError(f"--jobs: must be a positive count or -1, got {jobs}")
     if resume and not out:
         raise UserError("--resume: name the sweep's directory with --out")
-    out_dir = Path(out) if out else _default_out(config)
+    out_dir = Path(out) if out else _default_out(config, cfg)
     identity = {"config": cfg.model_dump(mode="json"), "points": [list(p) for p in points],
                 "flights": flights}
     with acquire(out_dir, command="ftc-mc sweep"):

@@ -18,7 +18,7 @@ import pandas as pd
 
 from .campaign.chunk import new_record
 from .campaign.setup import CampaignSetup, build_setup
-from .campaign.transitions import mode_of
+from .campaign.transitions import draw_gusts, gust_lanes, mode_of
 from .core.settings import TrialInputs
 from .core.trial import STATUS_NAMES, run_trials
 from .estimator import MODE_NAMES
@@ -86,6 +86,40 @@ def schedule_arrays(sc: ScenarioConfig, u0: np.ndarray, dt: float):
     return k, b0, b1
 
 
+def scenario_inputs(sc: ScenarioConfig, setup: CampaignSetup):
+    """The kernel inputs of a scenario (one lane) and its schedule arrays.
+
+    The noise is ``default_rng([0, seed])``: process noise, measurement noise,
+    then (in turbulence) the gust draws and the initial gust state.
+
+    Returns
+    -------
+    inp : TrialInputs
+    k_switch, b0, b1 : ndarray
+        See :func:`schedule_arrays`.
+    modes : ndarray, shape (E,)
+        Mode of each schedule entry.
+    """
+    plant = setup.plant
+    k_sw, b0, b1 = schedule_arrays(sc, plant.u0, plant.dt)
+    n = setup.tim.n_steps
+    rng = np.random.default_rng([0, sc.scenario.seed])
+    w = rng.standard_normal((n, 9)) * setup.q_std
+    v = rng.standard_normal((n, 12)) * setup.r_std
+    eta, g0 = gust_lanes(n, 1, setup.gust_chol is not None)
+    gust = draw_gusts(rng, n, setup.gust_chol)
+    if gust is not None:
+        eta[:, :, 0], g0[:, 0] = gust
+    modes = np.array([mode_of(b, *setup.beta) for b in b1], dtype=np.int64)
+    xa0 = np.zeros((14, 1))
+    xa0[9:, 0] = [b0[0, 0], b0[0, 1] + b0[0, 2], *b1[0]]
+    inp = TrialInputs(k_switch=k_sw, b0=b0[:, :, None].copy(), b1=b1[:, :, None].copy(),
+                      mode_pre=modes[:1].copy(), mode_post=modes[-1:].copy(), xa0=xa0,
+                      P0=setup.P0, w=w[:, :, None].copy(), v=v[:, :, None].copy(),
+                      eta=eta, g0=g0)
+    return inp, k_sw, b0, b1, modes
+
+
 def run_scenario(sc: ScenarioConfig, seed: int | None = None,
                  setup: CampaignSetup | None = None) -> ScenarioResult:
     """Simulate the scenario.
@@ -108,7 +142,6 @@ def run_scenario(sc: ScenarioConfig, seed: int | None = None,
     if setup is None:
         setup = build_setup(cfg)
     plant = setup.plant
-    dt = plant.dt
     for i, e in enumerate(sc.scenario.schedule):
         if e.fault == "lock" and e.position != "trim":
             a = ACTUATOR_NAMES.index(e.actuator)
@@ -116,20 +149,10 @@ def run_scenario(sc: ScenarioConfig, seed: int | None = None,
                 raise ValueError(f"scenario.schedule.{i}.position: {e.position:g} is outside "
                                  f"the {e.actuator} command range "
                                  f"[{plant.u_lower[a]:g}, {plant.u_upper[a]:g}]")
-    k_sw, b0, b1 = schedule_arrays(sc, plant.u0, dt)
-    n = setup.tim.n_steps
-    rng = np.random.default_rng([0, sc.scenario.seed])
-    w = rng.standard_normal((n, 9)) * setup.q_std
-    v = rng.standard_normal((n, 12)) * setup.r_std
-    modes = np.array([mode_of(b, *setup.beta) for b in b1], dtype=np.int64)
-    xa0 = np.zeros((14, 1))
-    xa0[9:, 0] = [b0[0, 0], b0[0, 1] + b0[0, 2], *b1[0]]
-    inp = TrialInputs(k_switch=k_sw, b0=b0[:, :, None].copy(), b1=b1[:, :, None].copy(),
-                      mode_pre=modes[:1].copy(), mode_post=modes[-1:].copy(), xa0=xa0,
-                      P0=setup.P0, w=w[:, :, None].copy(), v=v[:, :, None].copy())
+    inp, k_sw, b0, b1, modes = scenario_inputs(sc, setup)
     rec = new_record(setup, 1, 100_000, history=True)
     run_trials(setup.fm, setup.det[sc.scenario.signature], setup.bs, setup.ctl, setup.exc,
-               setup.tim, setup.val, setup.rc, setup.eng, inp, rec)
+               setup.tim, setup.val, setup.rc, setup.eng, setup.truth, inp, rec)
     ts = _timeseries(setup, sc, rec, k_sw, b0, b1)
     events = _events(ts, sc, rec, setup)
     segments = _segments(ts, sc, modes, setup)
@@ -142,7 +165,8 @@ def run_scenario(sc: ScenarioConfig, seed: int | None = None,
 def _timeseries(setup, sc, rec, k_sw, b0, b1) -> pd.DataFrame:
     """Columns: time, true and estimated states, tracking errors, true and
     estimated fault parameters with their standard deviations, residuals and
-    thresholds, belief, controller, absolute commands, excitation, resets."""
+    thresholds, gusts (zero in still air), belief, controller, absolute commands,
+    excitation, resets."""
     plant = setup.plant
     dt = plant.dt
     n = rec.hist_x.shape[0]
@@ -168,6 +192,8 @@ def _timeseries(setup, sc, rec, k_sw, b0, b1) -> pd.DataFrame:
         cols[nm] = rec.hist_res[:, j, 0]
     cols["t_q"] = np.full(n, setup.det[sc.scenario.signature].t_q)
     cols["t_nx"] = np.full(n, setup.det[sc.scenario.signature].t_nx)
+    for j, nm in enumerate(("gust_u_mps", "gust_w_mps", "gust_q_radps")):
+        cols[nm] = rec.hist_wind[:, j, 0]  # zero in still air
     every = setup.tim.reconf_every
     per = np.clip((np.arange(n) + 1) // every - 1, -1, rec.belief.shape[0] - 1)
     for m, nm in enumerate(MODE_NAMES):

@@ -84,25 +84,10 @@ def design_times(config: Path) -> dict:
 
 
 def kernel_inputs(sc, setup):
-    """The kernel arguments of ``run_scenario`` (same code path, built once)."""
-    import numpy as np
+    """The kernel inputs of ``run_scenario`` (same code path, built once)."""
+    from ftc_mc.scenario import scenario_inputs
 
-    from ftc_mc.campaign.transitions import mode_of
-    from ftc_mc.core.settings import TrialInputs
-    from ftc_mc.scenario import schedule_arrays
-
-    plant = setup.plant
-    k_sw, b0, b1 = schedule_arrays(sc, plant.u0, plant.dt)
-    n = setup.tim.n_steps
-    rng = np.random.default_rng([0, sc.scenario.seed])
-    w = rng.standard_normal((n, 9)) * setup.q_std
-    v = rng.standard_normal((n, 12)) * setup.r_std
-    modes = np.array([mode_of(b, *setup.beta) for b in b1], dtype=np.int64)
-    xa0 = np.zeros((14, 1))
-    xa0[9:, 0] = [b0[0, 0], b0[0, 1] + b0[0, 2], *b1[0]]
-    return TrialInputs(k_switch=k_sw, b0=b0[:, :, None].copy(), b1=b1[:, :, None].copy(),
-                       mode_pre=modes[:1].copy(), mode_post=modes[-1:].copy(), xa0=xa0,
-                       P0=setup.P0, w=w[:, :, None].copy(), v=v[:, :, None].copy())
+    return scenario_inputs(sc, setup)[0]
 
 
 def median_time(fn, repeat):
@@ -146,7 +131,7 @@ def main():
 
     def kernel():
         run_trials(setup.fm, det, setup.bs, setup.ctl, setup.exc, setup.tim, setup.val,
-                   setup.rc, setup.eng, inp, next(it))
+                   setup.rc, setup.eng, setup.truth, inp, next(it))
 
     kernel_s, kernel_min, kernel_max = median_time(kernel, args.repeat)
     # the timed kernel is the one run_scenario runs

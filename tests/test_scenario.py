@@ -49,7 +49,7 @@ COLUMNS = (
     + [f"{s}_{kind}" for s in STATES for kind in ("true", "est")]
     + ["along_track_error_m", "cross_track_error_m", "x_est_error_m", "z_est_error_m"]
     + [f"{p}_{kind}" for p in FAULT_PARAMS for kind in ("true", "est", "sd")]
-    + ["r_q", "r_nx", "r_nz", "t_q", "t_nx"]
+    + ["r_q", "r_nx", "r_nz", "t_q", "t_nx", "gust_u_mps", "gust_w_mps", "gust_q_radps"]
     + [f"belief_{m}" for m in MODES]
     + ["controller"]
     + [f"cmd_{a}{suffix}" for a in ("throttle", "elevon_left", "elevon_right")

@@ -29,7 +29,7 @@ def _run(setup, inp=None, ids=np.arange(4)):
         draws = np.zeros(len(ids))
     rec = new_record(setup, len(ids), 256)
     run_trials(setup.fm, setup.det["paper"], setup.bs, setup.ctl, setup.exc, setup.tim,
-               setup.val, setup.rc, setup.eng, inp, rec)
+               setup.val, setup.rc, setup.eng, setup.truth, inp, rec)
     trials, _ = classify(setup, "elevon_lock", "paper", ids, draws, inp, rec, 20)
     return rec, trials
 

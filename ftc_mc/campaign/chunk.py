@@ -12,7 +12,7 @@ from ..core.settings import TrialInputs, TrialRecord
 from ..core.trial import STATUS_NAMES, STATUS_NONFINITE, STATUS_NOT_PSD, run_trials
 from .setup import CampaignSetup
 from .transitions import (BLOCK_NAMES, TRANSITION_TABLE, draw_trial, estimator_params,
-                          faulty_params, mode_of)
+                          faulty_params, gust_lanes, mode_of)
 
 MODE_NAMES = ("nominal", "engine", "left_elevon", "right_elevon")
 
@@ -37,13 +37,16 @@ def build_inputs(setup: CampaignSetup, tr_name: str, trial_ids, seed: int):
     mode_f = np.zeros(L, dtype=np.int64)
     xa0 = np.zeros((14, L))
     draws = np.empty(L)
+    eta, g0 = gust_lanes(n, L, setup.gust_chol is not None)
     lock_range = setup.lock_range[tr.actuator]
     for l, tid in enumerate(trial_ids):
-        value, wl, vl = draw_trial(int(tid), seed, tr, lock_range, setup.loss_range, n,
-                                   setup.q_std, setup.r_std)
+        value, wl, vl, gust = draw_trial(int(tid), seed, tr, lock_range, setup.loss_range,
+                                         n, setup.q_std, setup.r_std, setup.gust_chol)
         draws[l] = value
         w[:, :, l] = wl
         v[:, :, l] = vl
+        if gust is not None:
+            eta[:, :, l], g0[:, l] = gust
         fb0, fb1 = faulty_params(tr, value)
         b0[True][:, l] = fb0
         b1[True][:, l] = fb1
@@ -59,7 +62,7 @@ def build_inputs(setup: CampaignSetup, tr_name: str, trial_ids, seed: int):
         xa0[9:, l] = estimator_params(b0_sched[0, :, l], b1_sched[0, :, l])
     inp = TrialInputs(k_switch=np.array([0, tim.k_fault], dtype=np.int64), b0=b0_sched,
                       b1=b1_sched, mode_pre=mode_pre, mode_post=mode_post, xa0=xa0,
-                      P0=setup.P0, w=w, v=v)
+                      P0=setup.P0, w=w, v=v, eta=eta, g0=g0)
     return inp, draws
 
 
@@ -85,6 +88,7 @@ def new_record(setup: CampaignSetup, L: int, max_resets: int, history: bool = Fa
         hist_pdiag=np.zeros((n_hist, 5, L)), hist_u=np.zeros((n_hist, 3, L)),
         hist_res=np.zeros((n_hist, 3, L)), hist_exc=np.zeros((n_hist, 4, L)),
         hist_block=np.zeros((n_hist, L), dtype=np.int64),
+        hist_wind=np.zeros((n_hist, 3, L)),
         xa_end=np.zeros((14, L)))
 
 
@@ -210,7 +214,7 @@ def run_chunk(setup: CampaignSetup, tr_name: str, trial_ids, seed: int, variants
     for variant in variants:
         rec = new_record(setup, len(trial_ids), max_resets)
         run_trials(setup.fm, setup.det[variant], setup.bs, setup.ctl, setup.exc,
-                   setup.tim, setup.val, setup.rc, setup.eng, inp, rec)
+                   setup.tim, setup.val, setup.rc, setup.eng, setup.truth, inp, rec)
         out.append(classify(setup, tr_name, variant, trial_ids, draws, inp, rec,
                             window_steps))
     return out

@@ -13,7 +13,7 @@ import numpy as np
 
 from ..core.interp import EngineTables
 from ..core.settings import (Belief, Controller, Excitation, FilterModel,
-                             Reconfig, Timing, Validity)
+                             Reconfig, Timing, TruthPlant, Validity)
 from ..design.terminal import terminal_costs
 from ..design.theorem41 import cached_engine_tables
 from ..design.lqr import discounted_lqr, paper_q_lqr
@@ -22,6 +22,8 @@ from ..estimator import (EstimatorSettings, belief_settings, detection, filter_m
 from ..io.config import Config
 from ..model.airframe import X8
 from ..model.linear import LinearPlant, build_plant
+from ..model.turbulence import DrydenModel
+from ..truth import truth_plant
 
 VARIANTS = ("paper", "swapped")
 
@@ -55,6 +57,12 @@ class CampaignSetup:
         ``(beta_engine, beta_elevon)``.
     near_trim : tuple
         ``(engine, elevon)`` half-widths of a lock 'near trim'.
+    truth : TruthPlant
+        The simulated plant (linear or nonlinear, gusts or still air).
+    gust : DrydenModel or None
+        The gust model (None in still air).
+    gust_chol : ndarray or None
+        Cholesky factor of the stationary gust-state covariance (None in still air).
     """
 
     plant: LinearPlant
@@ -74,6 +82,9 @@ class CampaignSetup:
     loss_range: tuple
     beta: tuple
     near_trim: tuple
+    truth: TruthPlant
+    gust: DrydenModel | None
+    gust_chol: np.ndarray | None
 
 
 def variants_of(signature: str) -> tuple:
@@ -151,6 +162,8 @@ def build_setup(cfg: Config) -> CampaignSetup:
             raise ValueError(f"{name}: must lie within the command range "
                              f"[{plant.u_lower[a]:g}, {plant.u_upper[a]:g}], "
                              f"got {[lo, hi]}")
+    pc = cfg.plant
+    truth, gust = truth_plant(plant, pc.kind, pc.substeps, pc.turbulence, pc.altitude_m)
     return CampaignSetup(
         plant=plant, fm=fm, det=det, bs=bs, ctl=ctl, exc=exc, tim=tim, val=val, rc=rc,
         eng=eng,
@@ -162,4 +175,5 @@ def build_setup(cfg: Config) -> CampaignSetup:
         lock_range=lock_range, loss_range=tuple(d.loss_b1_range),
         beta=(cfg.estimator.beta_engine, cfg.estimator.beta_elevon),
         near_trim=(cfg.explain.engine_lock_near_trim,
-                   cfg.explain.elevon_lock_near_trim_rad))
+                   cfg.explain.elevon_lock_near_trim_rad),
+        truth=truth, gust=gust, gust_chol=None if gust is None else gust.P0_chol)

@@ -39,7 +39,7 @@ from .parallel import backend as parallel_backend
 from .runner import _sorted, plan_chunks
 from .setup import CampaignSetup, build_setup, estimator_settings, variants_of
 from .summary import summarize
-from .transitions import draw_trial
+from .transitions import draw_trial, gust_lanes
 
 FLIGHT = "fault_free"
 
@@ -111,7 +111,7 @@ def _point_det(setup: CampaignSetup, cfg: Config, variant: str, tq: float, tnx: 
 
 def _args(setup):
     return (setup.fm, None, setup.bs, setup.ctl, setup.exc, setup.tim, setup.val,
-            setup.rc, setup.eng)
+            setup.rc, setup.eng, setup.truth)
 
 
 def _run(setup, det, inp, rec, st, k0, k1):
@@ -183,17 +183,20 @@ def flight_inputs(setup: CampaignSetup, ids, seed: int) -> TrialInputs:
     n, L = setup.tim.n_steps, len(ids)
     w = np.empty((n, 9, L))
     v = np.empty((n, 12, L))
+    eta, g0 = gust_lanes(n, L, setup.gust_chol is not None)
     tr = type("T", (), {"kind": "loss"})()
     for l, tid in enumerate(ids):
-        _, wl, vl = draw_trial(int(tid), seed, tr, (0.0, 1.0), setup.loss_range, n,
-                               setup.q_std, setup.r_std)
+        _, wl, vl, gust = draw_trial(int(tid), seed, tr, (0.0, 1.0), setup.loss_range, n,
+                                     setup.q_std, setup.r_std, setup.gust_chol)
         w[:, :, l] = wl
         v[:, :, l] = vl
+        if gust is not None:
+            eta[:, :, l], g0[:, l] = gust
     zeros = np.zeros((1, 3, L))
     modes = np.zeros(L, dtype=np.int64)
     return TrialInputs(k_switch=np.zeros(1, dtype=np.int64), b0=zeros, b1=zeros.copy(),
                        mode_pre=modes, mode_post=modes.copy(), xa0=np.zeros((14, L)),
-                       P0=setup.P0, w=w, v=v)
+                       P0=setup.P0, w=w, v=v, eta=eta, g0=g0)
 
 
 def flight_chunk(setup: CampaignSetup, cfg: Config, ids, points, variants,

@@ -128,7 +128,7 @@ def estimator_params(b0: np.ndarray, b1: np.ndarray) -> np.ndarray:
 
 
 def draw_trial(trial_id: int, seed: int, tr: Transition, lock_range, loss_range,
-               n_steps: int, q_std: np.ndarray, r_std: np.ndarray):
+               n_steps: int, q_std: np.ndarray, r_std: np.ndarray, gust_chol=None):
     """All random draws of one trial.
 
     Parameters
@@ -143,6 +143,9 @@ def draw_trial(trial_id: int, seed: int, tr: Transition, lock_range, loss_range,
         Process-noise standard deviations.
     r_std : ndarray, shape (12,)
         Measurement-noise standard deviations.
+    gust_chol : ndarray, shape (4, 4), optional
+        Cholesky factor of the stationary Dryden state covariance
+        (:class:`~ftc_mc.model.turbulence.DrydenModel`); ``None`` in still air.
 
     Returns
     -------
@@ -150,10 +153,31 @@ def draw_trial(trial_id: int, seed: int, tr: Transition, lock_range, loss_range,
         The fault draw (lock position or ``b1``).
     w : ndarray, shape (n_steps, 9)
     v : ndarray, shape (n_steps, 12)
+    gust : tuple or None
+        ``(eta, g0)``: the gust draws, shape (n_steps, 4), and the initial gust
+        state, shape (4,), drawn after everything else so that the still-air
+        draws of a trial are the same with and without turbulence.
     """
     rng = np.random.default_rng([trial_id, seed])
     lo, hi = lock_range if tr.kind == "lock" else loss_range
     value = rng.uniform(lo, hi)
     w = rng.standard_normal((n_steps, 9)) * q_std
     v = rng.standard_normal((n_steps, 12)) * r_std
-    return value, w, v
+    return value, w, v, draw_gusts(rng, n_steps, gust_chol)
+
+
+def draw_gusts(rng: np.random.Generator, n_steps: int, gust_chol):
+    """Gust draws ``(eta, g0)`` from ``rng`` (see :func:`draw_trial`), or None.
+
+    The initial state is stationary: ``g0 = gust_chol @ N(0, I_4)``.
+    """
+    if gust_chol is None:
+        return None
+    eta = rng.standard_normal((n_steps, 4))
+    g0 = gust_chol @ rng.standard_normal(4)
+    return eta, g0
+
+
+def gust_lanes(n_steps: int, L: int, turbulent: bool):
+    """Empty lane arrays ``eta`` (n_steps or 0, 4, L) and ``g0`` (4, L) of TrialInputs."""
+    return np.zeros((n_steps if turbulent else 0, 4, L)), np.zeros((4, L))

@@ -73,6 +73,9 @@ TrialInputs = namedtuple("TrialInputs", [
     "P0",         # (14, 14) initial covariance (shared)
     "w",          # (n_steps, 9, L) process noise, already scaled
     "v",          # (n_steps, 12, L) measurement noise, already scaled
+    "eta",        # (n_steps, 4, L) standard normal gust draws, or (0, 4, L) without
+                  #           turbulence (core/dryden.py)
+    "g0",         # (4, L) initial gust filter state (stationary draw, or zeros)
 ])
 """Per-lane inputs of :func:`ftc_mc.core.trial.run_trials` (a fault schedule)."""
 
@@ -98,6 +101,7 @@ TrialRecord = namedtuple("TrialRecord", [
     "hist_exc",     # (n_hist, 4, L) doublet (engine) and 3211 (left elevon) values,
                     #      then 1.0 where each signal started at that step
     "hist_block",   # (n_hist, L) int64 block reset at each step
+    "hist_wind",    # (n_hist, 3, L) gust u_g, w_g [m/s], q_g [rad/s] held over each step
 ])
 """Per-lane outputs of :func:`ftc_mc.core.trial.run_trials`."""
 
@@ -134,5 +138,25 @@ LaneState = namedtuple("LaneState", [
     "alive",    # (L,) bool: the trial is still valid (see trial.advance)
     "cur",      # (L,) int64 controller in use
     "rmax",     # (2, L) largest r_q and r_nx seen so far (threshold sharing)
+    "gust",     # (4, L) Dryden gust filter state (zeros without turbulence)
 ])
 """Everything a trial carries from one step to the next (core/trial.py)."""
+
+TruthPlant = namedtuple("TruthPlant", [
+    "kind",   # 0: the linear plant of eq. (1) (the filter's model); 1: the nonlinear
+              #    X8 of core/nonlinear.py integrated by RK4
+    "n_sub",  # RK4 sub-steps per control period (nonlinear plant)
+    "dt",     # control period [s]
+    "p",      # (25,) packed airframe parameters (model/dynamics.pack_parameters)
+    "x0",     # (9,) trim state, absolute (the truth state is kept as x - x0)
+    "y0",     # (12,) trim outputs (measurements are y - y0 + v)
+    "turb",   # 0: still air; 1: Dryden gusts from TrialInputs.eta
+    "Ad",     # (4, 4) discrete Dryden transition (model/turbulence.py)
+    "Bd",     # (4, 4) discrete Dryden noise input
+    "Cd",     # (3, 4) gust outputs u_g, w_g, q_g
+    "Bw",     # (9, 3) linear plant: discrete (zero-order hold) input matrix of the gust
+    "Dw",     # (12, 3) linear plant: gust feed-through into the outputs
+])
+"""The truth plant a trial simulates (issue 7): linear or nonlinear, with or
+without turbulence.  The estimator and the controllers always use the linear
+model (:class:`FilterModel`)."""

@@ -1,6 +1,7 @@
 """Monte Carlo trials of the semi-closed estimation loop, many at once (lanes).
 
-One lane is one trial: the linear plant with the injected fault (eq. 4) and
+One lane is one trial: the truth plant (the linear model of eq. 4, or the
+nonlinear X8, each with or without Dryden gusts) with the injected fault and
 process/measurement noise, the nominal discounted-LQR controller with the
 saturation of eqs. (15-16), the doublet / 3211 excitation on reset requests and
 the re-sent doublet (section 4.1.1), the estimator (eqs. 5-11, Table 1), and the
@@ -14,7 +15,11 @@ Timeline of step ``k -> k+1`` (time ``t = k dt``):
 
 1. controller ``U = -K x_hat_k``; commands ``u_k = f(U, s_k, A_k)`` (eq. 15);
 2. truth: fault parameters of the schedule's current entry; effect
-   ``e_k`` (eq. 2); ``x_{k+1} = A x_k + B e_k + w_k``; ``z_{k+1} = C x_{k+1} + v_k``;
+   ``e_k`` (eq. 2); gust ``g_k`` held over the step (none in still air); linear
+   plant: ``x_{k+1} = A x_k + B e_k + B_w g_k + w_k`` and
+   ``z_{k+1} = C x_{k+1} + D_w g_{k+1} + v_k``; nonlinear plant:
+   ``x_{k+1} = RK4(x_k, u0 + e_k, g_k) + w_k`` and
+   ``z_{k+1} = h(x_{k+1}, g_{k+1}) - y_0 + v_k`` (absolute state ``x0 + x``);
 3. filter step with ``u_k`` and ``z_{k+1}`` (see :mod:`ftc_mc.core.step`);
 4. a reset of the thrust block starts the doublet on the engine (unless one is
    running) and schedules a re-check ``resend_delay`` steps later, when the
@@ -32,8 +37,10 @@ import numpy as np
 from .batch import STEP_ROWS, filter_step_lanes
 from .belief import belief_update
 from .control import C_ELEVON, controller_command, select_controller
+from .dryden import gust_step
 from .excitation import doublet, saturate, signal_3211
 from .jit import kernel
+from .nonlinear import N_WORK, outputs_nb, propagate
 from .settings import LaneState
 
 STATUS_OK = 0
@@ -84,7 +91,13 @@ def is_psd(P, l, work):
 
 
 @kernel
-def advance(fm, det, bs, ctl, exc, tim, val, rc, eng, inp, rec, st, k0, k1):
+def make_work_nb():
+    """Work array of :func:`ftc_mc.core.nonlinear.propagate` (inside a kernel)."""
+    return np.zeros((N_WORK, 9))
+
+
+@kernel
+def advance(fm, det, bs, ctl, exc, tim, val, rc, eng, pl, inp, rec, st, k0, k1):
     """Advance ``L`` trials from step ``k0`` to ``k1``, writing their records.
 
     Parameters
@@ -99,14 +112,23 @@ def advance(fm, det, bs, ctl, exc, tim, val, rc, eng, inp, rec, st, k0, k1):
         A lane stops being recorded (its ``status`` and ``stop_k`` are set, later
         resets and detections are ignored) when its estimate or covariance is
         not finite, its covariance fails the Cholesky test (every
-        ``psd_every`` steps), or the true airspeed or angle of attack (trim plus
-        the linear outputs) leaves the validity bounds.
+        ``psd_every`` steps), or the true airspeed or angle of attack leaves
+        the validity bounds.  Both are air-relative, as the aerodynamics see
+        them (linear plant: trim plus the linear outputs with the gust
+        feed-through; nonlinear: its outputs).  The inertial angle of attack
+        would be the wrong test in turbulence: the aircraft follows the air
+        mass, so its inertial angle swings with the gust (1 sigma 4.8 deg in
+        moderate turbulence) while the aerodynamic one stays near 1.5 deg.
     rc : Reconfig
         ``rc.kind == 0``: the nominal controller c0 throughout; ``1``: the
         controller is re-selected every reconfiguration period (eqs. 45-47)
         among c0, c1 and c2 (:mod:`ftc_mc.core.control`).
     eng : EngineTables
         Theorem 4.1 tables of c1.
+    pl : TruthPlant
+        The simulated plant: the linear model of eq. (1) or the nonlinear X8
+        (:mod:`ftc_mc.core.nonlinear`, RK4 with ``pl.n_sub`` sub-steps), each
+        with or without Dryden gusts (:mod:`ftc_mc.core.dryden`).
     inp : TrialInputs
         Per-lane fault schedule, initial estimates and noise.
     rec : TrialRecord
@@ -154,6 +176,18 @@ def advance(fm, det, bs, ctl, exc, tim, val, rc, eng, inp, rec, st, k0, k1):
     T1 = np.zeros((9, 14))
     bsel = np.zeros(4)
     exc_now = np.zeros((4, L))
+    turb = pl.turb != 0
+    wind = np.zeros((3, L))
+    wind_next = np.zeros((3, L))
+    gs = np.zeros(4)
+    eta = np.zeros(4)
+    wl = np.zeros(3)
+    xabs = np.zeros(nx)
+    cmd = np.zeros(3)
+    yl = np.zeros(12)
+    nl_work = make_work_nb()
+    va_now = np.zeros(L)
+    al_now = np.zeros(L)
     n_hist = rec.hist_x.shape[0]
     d_len = 2 * exc.doublet_half
     s_len = 7 * exc.s3211_unit
@@ -201,7 +235,7 @@ def advance(fm, det, bs, ctl, exc, tim, val, rc, eng, inp, rec, st, k0, k1):
             exc_now[3, l] = 1.0 if ks == 0 else 0.0
             u[1, l] = saturate(u[1, l], s, a, ctl.lo_dev[1], ctl.hi_dev[1])
             u[2, l] = saturate(u[2, l], -s, a, ctl.lo_dev[2], ctl.hi_dev[2])
-        # 2. truth: actuator effect (eq. 2) and plant (eq. 4)
+        # 2. truth: actuator effect (eq. 2), gusts, plant (eq. 4 or nonlinear)
         while ev + 1 < n_ev and k >= inp.k_switch[ev + 1]:
             ev += 1
         for i in range(3):
@@ -209,28 +243,85 @@ def advance(fm, det, bs, ctl, exc, tim, val, rc, eng, inp, rec, st, k0, k1):
             for l in range(L):
                 b1il = inp.b1[ev, i, l]
                 e[i, l] = inp.b0[ev, i, l] + (1.0 - b1il) * u[i, l] - b1il * u0
-        for i in range(nx):
+        if turb:
             for l in range(L):
-                xn[i, l] = inp.w[k, i, l]
-            for j in range(nx):
-                aij = fm.A[i, j]
+                for i in range(4):
+                    gs[i] = st.gust[i, l]
+                    eta[i] = inp.eta[k, i, l]
+                gust_step(gs, eta, pl.Ad, pl.Bd, pl.Cd, wl)
+                for i in range(4):
+                    st.gust[i, l] = gs[i]
+                for i in range(3):
+                    wind[i, l] = wl[i]
+                    # the gust at the next sample, seen by its measurement
+                    acc = 0.0
+                    for j in range(4):
+                        acc += pl.Cd[i, j] * gs[j]
+                    wind_next[i, l] = acc
+        if pl.kind == 0:
+            for i in range(nx):
                 for l in range(L):
-                    xn[i, l] += aij * x[j, l]
-            for j in range(3):
-                bij = fm.B[i, j]
-                for l in range(L):
-                    xn[i, l] += bij * e[j, l]
-        for i in range(nx):
-            for l in range(L):
-                x[i, l] = xn[i, l]
-        for r in range(12):
-            for l in range(L):
-                z[r, l] = inp.v[k, r, l]
-            for j in range(nx):
-                crj = fm.C[r, j]
-                if crj != 0.0:
+                    xn[i, l] = inp.w[k, i, l]
+                for j in range(nx):
+                    aij = fm.A[i, j]
                     for l in range(L):
-                        z[r, l] += crj * x[j, l]
+                        xn[i, l] += aij * x[j, l]
+                for j in range(3):
+                    bij = fm.B[i, j]
+                    for l in range(L):
+                        xn[i, l] += bij * e[j, l]
+                if turb:
+                    for j in range(3):
+                        bij = pl.Bw[i, j]
+                        for l in range(L):
+                            xn[i, l] += bij * wind[j, l]
+            for i in range(nx):
+                for l in range(L):
+                    x[i, l] = xn[i, l]
+            for r in range(12):
+                for l in range(L):
+                    z[r, l] = inp.v[k, r, l]
+                for j in range(nx):
+                    crj = fm.C[r, j]
+                    if crj != 0.0:
+                        for l in range(L):
+                            z[r, l] += crj * x[j, l]
+                if turb:
+                    for j in range(3):
+                        drj = pl.Dw[r, j]
+                        for l in range(L):
+                            z[r, l] += drj * wind_next[j, l]
+            # airspeed and angle of attack for the validity check
+            for l in range(L):
+                va = val.va_trim
+                al = val.alpha_trim
+                for j in range(nx):
+                    va += fm.C[OUT_VA, j] * x[j, l]
+                    al += fm.C[OUT_ALPHA, j] * x[j, l]
+                if turb:
+                    for j in range(3):
+                        va += pl.Dw[OUT_VA, j] * wind_next[j, l]
+                        al += pl.Dw[OUT_ALPHA, j] * wind_next[j, l]
+                va_now[l] = va
+                al_now[l] = al
+        else:
+            for l in range(L):
+                for i in range(nx):
+                    xabs[i] = pl.x0[i] + x[i, l]
+                for i in range(3):
+                    cmd[i] = fm.u0[i] + e[i, l]
+                    wl[i] = wind[i, l]
+                propagate(xabs, cmd, pl.p, wl, pl.dt, pl.n_sub, nl_work)
+                for i in range(nx):
+                    xabs[i] += inp.w[k, i, l]
+                    x[i, l] = xabs[i] - pl.x0[i]
+                for i in range(3):
+                    wl[i] = wind_next[i, l]
+                outputs_nb(xabs, pl.p, wl, yl)
+                for r in range(12):
+                    z[r, l] = inp.v[k, r, l] + (yl[r] - pl.y0[r])
+                va_now[l] = yl[OUT_VA]
+                al_now[l] = yl[OUT_ALPHA]
         # 3. estimator
         filter_step_lanes(xa, P, u, z, fm, det, phi, T, work, res, block)
         for l in range(L):
@@ -243,11 +334,8 @@ def advance(fm, det, bs, ctl, exc, tim, val, rc, eng, inp, rec, st, k0, k1):
             if not alive[l]:
                 continue
             status = STATUS_OK
-            va = val.va_trim
-            al = val.alpha_trim
-            for j in range(nx):
-                va += fm.C[OUT_VA, j] * x[j, l]
-                al += fm.C[OUT_ALPHA, j] * x[j, l]
+            va = va_now[l]
+            al = al_now[l]
             finite = np.isfinite(va) and np.isfinite(al)
             for i in range(14):
                 if not (np.isfinite(xa[i, l]) and np.isfinite(P[i, i, l])):
@@ -298,6 +386,8 @@ def advance(fm, det, bs, ctl, exc, tim, val, rc, eng, inp, rec, st, k0, k1):
                     rec.hist_res[k, i, l] = res[i, l]
                 for i in range(4):
                     rec.hist_exc[k, i, l] = exc_now[i, l]
+                for i in range(3):
+                    rec.hist_wind[k, i, l] = wind[i, l]
                 rec.hist_block[k, l] = block[l]
         # 5. belief every reconfiguration period (eqs. 13-14) and controller
         #    selection (eqs. 45-47)
@@ -359,6 +449,8 @@ def init_state(inp, st, rec):
         rec.n_resets[l] = 0
         rec.detect_k[l] = -1
         rec.status[l] = STATUS_OK
+        for i in range(4):
+            st.gust[i, l] = inp.g0[i, l]
 
 
 @kernel
@@ -369,11 +461,11 @@ def new_state(L):
                      s_start=np.zeros(L, dtype=np.int64),
                      recheck=np.zeros(L, dtype=np.int64), belief=np.zeros((4, L)),
                      alive=np.zeros(L, dtype=np.bool_), cur=np.zeros(L, dtype=np.int64),
-                     rmax=np.zeros((2, L)))
+                     rmax=np.zeros((2, L)), gust=np.zeros((4, L)))
 
 
 @kernel
-def run_trials(fm, det, bs, ctl, exc, tim, val, rc, eng, inp, rec):
+def run_trials(fm, det, bs, ctl, exc, tim, val, rc, eng, pl, inp, rec):
     """Simulate ``L`` trials from the start to the end (see :func:`advance`).
 
     Parameters are those of :func:`advance` without the state and step range;
@@ -381,4 +473,4 @@ def run_trials(fm, det, bs, ctl, exc, tim, val, rc, eng, inp, rec):
     """
     st = new_state(inp.w.shape[2])
     init_state(inp, st, rec)
-    advance(fm, det, bs, ctl, exc, tim, val, rc, eng, inp, rec, st, 0, tim.n_steps)
+    advance(fm, det, bs, ctl, exc, tim, val, rc, eng, pl, inp, rec, st, 0, tim.n_steps)

@@ -54,6 +54,19 @@ class ModelConfig(_Strict):
     """Control sampling period [s]."""
 
 
+class PlantConfig(_Strict):
+    """Truth plant the trials fly (the estimator and controllers keep the linear model)."""
+
+    kind: Literal["linear", "nonlinear"] = "linear"
+    """linear: the model of eq. (1), as in the paper; nonlinear: the X8 equations, RK4."""
+    substeps: Annotated[int, NoBool, Field(ge=1, le=1000)] = 10
+    """RK4 sub-steps per control period of the nonlinear plant (10: 6e-7 m/s error)."""
+    turbulence: Literal["none", "light", "moderate", "severe"] = "none"
+    """MIL-F-8785C Dryden gusts: W20 = 0, 15, 30, 45 kt."""
+    altitude_m: Annotated[float, NoBool, Field(ge=3.048, le=304.8, allow_inf_nan=False)] = 100.0
+    """Altitude for the Dryden scale lengths [m] (low-altitude model: 10-1000 ft)."""
+
+
 class EstimatorConfig(_Strict):
     """Filter noise, Table 1 thresholds and mode boxes (sections 3.2-3.3, 5.1)."""
 
@@ -220,6 +233,7 @@ class Config(_Strict):
 
     campaign: CampaignConfig = Field(default_factory=CampaignConfig)
     model: ModelConfig = Field(default_factory=ModelConfig)
+    plant: PlantConfig = Field(default_factory=PlantConfig)
     estimator: EstimatorConfig = Field(default_factory=EstimatorConfig)
     controller: ControllerConfig = Field(default_factory=ControllerConfig)
     excitation: ExcitationConfig = Field(default_factory=ExcitationConfig)
@@ -369,19 +383,30 @@ def load_config(path) -> Config:
     return parse_config(_read_yaml(path), str(path))
 
 
-def with_overrides(cfg: Config, **sections) -> Config:
+def with_overrides(cfg, **sections):
     """Return ``cfg`` with fields replaced, re-validated.
 
     Parameters
     ----------
-    cfg : Config
+    cfg : Config or ScenarioConfig
     **sections : dict
-        ``section={field: value}`` pairs, e.g. ``campaign={"trials": 10}``.
+        ``section={field: value}`` pairs, e.g. ``campaign={"trials": 10}``;
+        ``None`` values are left as they are.
+
+    Raises
+    ------
+    UserError
+        Naming the field and the problem (source ``options``).
     """
     data = cfg.model_dump()
     for section, fields in sections.items():
         data[section].update({k: v for k, v in fields.items() if v is not None})
-    return parse_config(data, "options")
+    if isinstance(cfg, Config):
+        return parse_config(data, "options")
+    try:
+        return type(cfg).model_validate(data)
+    except ValidationError as exc:
+        raise UserError(_format_error(exc, "options")) from None
 
 
 
@@ -496,7 +521,7 @@ class ScenarioSpec(_Strict):
         return self
 
 
-SHARED_SECTIONS = ("model", "estimator", "controller", "excitation", "noise", "validity")
+SHARED_SECTIONS = ("model", "plant", "estimator", "controller", "excitation", "noise", "validity")
 """Sections a scenario file has in common with a campaign config."""
 
 
@@ -505,6 +530,7 @@ class ScenarioConfig(_Strict):
 
     scenario: ScenarioSpec = Field(default_factory=ScenarioSpec)
     model: ModelConfig = Field(default_factory=ModelConfig)
+    plant: PlantConfig = Field(default_factory=PlantConfig)
     estimator: EstimatorConfig = Field(default_factory=EstimatorConfig)
     controller: ControllerConfig = Field(default_factory=ControllerConfig)
     excitation: ExcitationConfig = Field(default_factory=ExcitationConfig)

@@ -109,7 +109,7 @@ def trim(airframe: Airframe = X8, V0: float = 20.0, gamma0_deg: float = -3.0
                      gamma0=gamma0, params=p)
 
 
-def _jacobian(fun, at):
+def jacobian(fun, at):
     """Jacobian of a scalar-loop function by scipy's adaptive finite differences."""
     def vectorised(v):
         flat = v.reshape(v.shape[0], -1)
@@ -189,10 +189,10 @@ def linearise(tp: TrimPoint):
         outputs(x, p, y)
         return y
 
-    Cc = _jacobian(h_x, tp.x0)
+    Cc = jacobian(h_x, tp.x0)
     # the first six outputs are the first six states: make those rows exact
     Cc[:6] = np.eye(N_OUTPUT, N_STATE)[:6]
-    return _jacobian(f_x, tp.x0), _jacobian(f_u, tp.u0), Cc
+    return jacobian(f_x, tp.x0), jacobian(f_u, tp.u0), Cc
 
 
 def build_plant(airframe: Airframe = X8, V0: float = 20.0, gamma0_deg: float = -3.0,
