@@ -58,6 +58,11 @@ def wind_matrices(plant: LinearPlant):
     zero = np.zeros(3)
     Ewc = jacobian(f_w, zero)
     Dw = jacobian(h_w, zero)
+    # structural zeros (the finite differences leave ~1e-12 there): the
+    # kinematics, attitude and actuator rates and the first six outputs (the
+    # states themselves) do not depend on the air's motion
+    Ewc[3:] = 0.0
+    Dw[:6] = 0.0
     _, Bw, _, _, _ = scipy.signal.cont2discrete(
         (plant.Ac, Ewc, plant.Cc, np.zeros((N_OUTPUT, 3))), plant.dt, method="zoh")
     return np.ascontiguousarray(Bw), np.ascontiguousarray(Dw), Ewc
