@@ -10,11 +10,16 @@ Markdown file with:
   and detection-time distributions;
 * for each scenario (``ftc-mc scenario``): the event timeline beside the
   paper's (section 5.2) and links to the scenario's own figures;
+* when at least two runs flew different truth plants or turbulence levels
+  (config section ``plant``): their rates side by side per transition, with
+  false resets per flight hour and the changes against the reference plant;
 * the provenance of every input (kind, version, git revision, seed, config).
 
-Inputs whose metadata show different package versions or git revisions are
-refused unless ``allow_mixed`` is set.  Figures go to ``<out stem>_figures/``
-beside the report and are linked by relative paths.
+Every section names the truth plant and turbulence of its input (results
+written before the ``plant`` section existed flew the linear plant without
+turbulence).  Inputs whose metadata show different package versions or git
+revisions are refused unless ``allow_mixed`` is set.  Figures go to
+``<out stem>_figures/`` beside the report and are linked by relative paths.
 """
 
 from __future__ import annotations
@@ -30,13 +35,16 @@ import scipy.stats
 import yaml
 
 from .campaign.summary import wilson
+from .campaign.sweep import poisson_ci
 from .campaign.transitions import TRANSITION_TABLE
 from .errors import UserError
 from .io.atomic import write_text
 from .io.chunks import FOLDER as CHUNKS_FOLDER
+from .io.config import TRANSITIONS, TimingConfig
 from .io.lock import holder
 from .io.results import read_metadata
 from .scenario import PAPER_TIMELINE
+from .truth import PLANT_KINDS, TURBULENCE_LEVELS
 
 RUN_TABLES = ("trials.parquet", "summary.parquet")
 """Parquet files a run directory must hold (``resets.parquet`` is optional)."""
@@ -52,6 +60,14 @@ PAPER_EXCITATIONS = {"doublet": (10.0, 12.6, 15.6, 30.0, 50.0, 70.0), "3211": (9
 :func:`ftc_mc.scenario.summary_markdown`)."""
 SIGNIFICANCE = 0.05
 """Level of the paired (McNemar) test between signature variants."""
+DEFAULT_PLANT = ("linear", "none")
+"""Truth plant of results written before the ``plant`` section existed; the
+reference condition of the plant comparison."""
+IGNORED_CAMPAIGN_KEYS = ("trials", "seed", "chunk_size")
+"""``campaign`` fields that may differ between compared runs without a warning
+(results do not depend on ``chunk_size``)."""
+PLANT_FIGURE = "plant_turbulence.png"
+"""File name of the plant-comparison figure in the figure folder."""
 
 
 @dataclasses.dataclass
@@ -540,11 +556,37 @@ def delay_figure(trials: pd.DataFrame, path: Path) -> Path:
 # --------------------------------------------------------------------- run section
 
 
+def plant_condition(cfg: dict) -> tuple:
+    """The truth plant of a config: ``(plant.kind, plant.turbulence)``.
+
+    Parameters
+    ----------
+    cfg : dict
+        The config stored in a result's metadata.
+
+    Returns
+    -------
+    (str, str)
+        :data:`DEFAULT_PLANT` for results written before the ``plant`` section
+        existed (or a field missing from it).
+    """
+    plant = cfg.get("plant") or {}
+    return (str(plant.get("kind", DEFAULT_PLANT[0])),
+            str(plant.get("turbulence", DEFAULT_PLANT[1])))
+
+
+def _plant_text(cfg: dict) -> str:
+    """``truth plant `kind`, turbulence `level``` of a config."""
+    kind, turbulence = plant_condition(cfg)
+    return f"truth plant `{kind}`, turbulence `{turbulence}`"
+
+
 def _run_header(cfg: dict) -> str:
     c = cfg.get("campaign", {})
     return (f"{len(c.get('transitions', []))} transition(s), {c.get('trials', '?')} trials "
             f"each, seed {c.get('seed', '?')}, signature `{c.get('signature', '?')}`, "
-            f"controller `{cfg.get('controller', {}).get('kind', '?')}`.")
+            f"controller `{cfg.get('controller', {}).get('kind', '?')}`, "
+            f"{_plant_text(cfg)}.")
 
 
 def run_section(r: ResultDir, fig_dir: Path, slug: str, report: Path) -> list:
@@ -643,7 +685,8 @@ def scenario_section(r: ResultDir, report: Path) -> list:
              f"Signature `{sc.get('signature', '?')}`, controller "
              f"`{r.meta.get('config', {}).get('controller', {}).get('kind', '?')}`, seed "
              f"{sc.get('seed', '?')}, {sc.get('duration_s', '?')} s, "
-             f"{len(sc.get('schedule', []))} schedule entries.", "",
+             f"{len(sc.get('schedule', []))} schedule entries, "
+             f"{_plant_text(r.meta.get('config', {}))}.", "",
              "### Event timeline beside the paper", ""] + timeline_table(seg, ev)
             + ["### Controller switches and excitations", ""] + switches_and_excitations(ev)
             + ["<details><summary>All events</summary>", "", details, "", "</details>", "",
@@ -768,7 +811,8 @@ def sweep_section(r: ResultDir, fig_dir: Path, slug: str, report: Path) -> list:
     lines = [f"## Sweep `{r.path}`", "",
              f"{t[['t_q', 't_nx']].drop_duplicates().shape[0]} threshold points, "
              f"{t['transition'].nunique()} transition(s), variants "
-             f"{', '.join(sorted(t['variant'].unique()))}.", "",
+             f"{', '.join(sorted(t['variant'].unique()))}, "
+             f"{_plant_text(r.meta.get('config', {}))}.", "",
              f"![threshold trade-off]({_rel_link(fig, report)})", "",
              "### Recommended threshold", ""]
     for variant in sorted(t["variant"].unique()):
@@ -776,6 +820,327 @@ def sweep_section(r: ResultDir, fig_dir: Path, slug: str, report: Path) -> list:
         lines.append(f"- `{variant}`: **t_q = {tq:g}, t_nx = {tnx:g}**: {why}.")
     lines.append("")
     return lines
+
+
+# ------------------------------------------------------ truth plant and turbulence
+
+
+def _rank(seq: tuple, value: str) -> int:
+    """Position of ``value`` in ``seq``; unknown values after the known ones."""
+    return seq.index(value) if value in seq else len(seq)
+
+
+def condition_order(conditions: list) -> list:
+    """Indices of ``conditions`` in report order.
+
+    :data:`DEFAULT_PLANT` first, then by plant kind (:data:`PLANT_KINDS`), then
+    by turbulence (:data:`TURBULENCE_LEVELS`); ties keep the input order.
+
+    Parameters
+    ----------
+    conditions : list of (str, str)
+        ``(kind, turbulence)`` of each run.
+
+    Returns
+    -------
+    list of int
+    """
+    def key(i):
+        kind, turbulence = conditions[i]
+        return (conditions[i] != DEFAULT_PLANT, _rank(PLANT_KINDS, kind), kind,
+                _rank(TURBULENCE_LEVELS, turbulence), turbulence, i)
+    return sorted(range(len(conditions)), key=key)
+
+
+def condition_labels(conditions: list, slugs: list) -> list:
+    """``kind / turbulence`` of each run, with its slug when the condition repeats."""
+    out = []
+    for cond, slug in zip(conditions, slugs):
+        label = " / ".join(cond)
+        out.append(f"{label} ({slug})" if conditions.count(cond) > 1 else label)
+    return out
+
+
+def reference_index(conditions: list) -> int:
+    """The reference run: the first with :data:`DEFAULT_PLANT`, else the first."""
+    return conditions.index(DEFAULT_PLANT) if DEFAULT_PLANT in conditions else 0
+
+
+def _fault_time_s(cfg: dict) -> float:
+    """``timing.fault_time_s`` of a config (the default if absent)."""
+    return float(cfg.get("timing", {}).get(
+        "fault_time_s", TimingConfig.model_fields["fault_time_s"].default))
+
+
+def _median(values) -> float:
+    v = np.asarray(values, dtype=float)
+    v = v[np.isfinite(v)]
+    return float(np.median(v)) if len(v) else np.nan
+
+
+def condition_rates(trials: pd.DataFrame, fault_time_s: float) -> pd.DataFrame:
+    """Rates of one run per transition and signature variant, over judged trials.
+
+    Parameters
+    ----------
+    trials : DataFrame
+        ``trials.parquet`` of a run.
+    fault_time_s : float
+        Fault-free flight before the switch in every trial [s]: the exposure
+        of ``false_resets``.
+
+    Returns
+    -------
+    DataFrame
+        ``transition, variant, judged, excluded, inappropriate_pct,
+        no_reset_pct, false_resets, flight_hours, false_per_h, false_per_h_low,
+        false_per_h_high, delay_median_s, detection_median_s``; the
+        false-reset interval is the exact (Garwood) Poisson 95 % interval.
+    """
+    rows = []
+    for (name, variant), g in trials.groupby(["transition", "variant"], sort=False):
+        ok = g[g["judged"].astype(bool)]
+        n, k = len(ok), int(ok["false_resets"].sum())
+        hours = n * fault_time_s / 3600.0
+        lo, hi = poisson_ci(k, hours) if n else (np.nan, np.nan)
+        rows.append({
+            "transition": name, "variant": variant, "judged": n, "excluded": len(g) - n,
+            "inappropriate_pct": 100 * ok["inappropriate"].mean() if n else np.nan,
+            "no_reset_pct": 100 * ok["no_reset"].mean() if n else np.nan,
+            "false_resets": k, "flight_hours": hours,
+            "false_per_h": k / hours if n else np.nan,
+            "false_per_h_low": lo, "false_per_h_high": hi,
+            "delay_median_s": _median(ok["first_reset_s"]),
+            "detection_median_s": _median(ok["detection_s"])})
+    return pd.DataFrame(rows)
+
+
+def _with_deltas(rates: pd.DataFrame, ref: str) -> pd.DataFrame:
+    """``rates`` plus the rate changes [pp] against condition ``ref``."""
+    base = rates[rates["condition"] == ref][["transition", "variant", "inappropriate_pct",
+                                             "no_reset_pct"]]
+    out = rates.merge(base, on=["transition", "variant"], how="left", suffixes=("", "_ref"))
+    for col in ("inappropriate", "no_reset"):
+        out[f"d_{col}_pp"] = out[f"{col}_pct"] - out[f"{col}_pct_ref"]
+    out["reference"] = out["condition"] == ref
+    return out.drop(columns=["inappropriate_pct_ref", "no_reset_pct_ref"])
+
+
+def plant_rates(runs: list, slugs: list) -> pd.DataFrame:
+    """Rates of every run, one condition per run, in report order.
+
+    Parameters
+    ----------
+    runs : list of ResultDir
+        Run directories.
+    slugs : list of str
+        Their slugs (labels of repeated conditions).
+
+    Returns
+    -------
+    DataFrame
+        The :func:`condition_rates` columns plus ``condition`` (label),
+        ``reference`` (bool), ``d_inappropriate_pp``, ``d_no_reset_pp``
+        (change against the reference run, NaN where it lacks the row) and
+        ``_cond`` (rank of the condition, :func:`condition_order`); rows by
+        transition (paper order), variant, then condition.
+    """
+    configs = [r.meta.get("config", {}) for r in runs]
+    conds = [plant_condition(c) for c in configs]
+    labels = condition_labels(conds, slugs)
+    rank = {i: pos for pos, i in enumerate(condition_order(conds))}
+    parts = []
+    for i, (r, cfg) in enumerate(zip(runs, configs)):
+        part = condition_rates(r.tables["trials"], _fault_time_s(cfg))
+        parts.append(part.assign(condition=labels[i], _cond=rank[i]))
+    rates = _with_deltas(pd.concat(parts, ignore_index=True),
+                         labels[reference_index(conds)])
+    t_order = {n: i for i, n in enumerate(TRANSITIONS)}
+    v_order = {v: i for i, v in enumerate(dict.fromkeys(rates["variant"]))}
+    rates["_t"] = rates["transition"].map(t_order).fillna(len(t_order))
+    rates["_v"] = rates["variant"].map(v_order)
+    return (rates.sort_values(["_t", "_v", "_cond"], kind="stable")
+            .drop(columns=["_t", "_v"]).reset_index(drop=True))
+
+
+def _per_hour(x: float) -> str:
+    """A rate per flight hour: three significant digits, whole numbers from 1000."""
+    if x is None or not np.isfinite(x):
+        return "-"
+    return f"{x:,.0f}" if x >= 1000 else f"{x:.3g}"
+
+
+def _delta(r: pd.Series, col: str) -> str:
+    return "ref" if r["reference"] else _num(r[f"d_{col}_pp"], "{:+.1f}")
+
+
+def _plant_row(r: pd.Series) -> dict:
+    """One row of the plant-comparison table."""
+    return {
+        "transition": _label(r["transition"]), "signature": r["variant"],
+        "condition": r["condition"], "judged": int(r["judged"]),
+        "inappropriate [%]": _num(r["inappropriate_pct"]),
+        "no reset [%]": _num(r["no_reset_pct"]),
+        "false resets / flight h (95 % CI)":
+            f"{_per_hour(r['false_per_h'])} ({_per_hour(r['false_per_h_low'])}-"
+            f"{_per_hour(r['false_per_h_high'])})" if r["judged"] else "-",
+        "first reset median [s]": _num(r["delay_median_s"]),
+        "detection median [s]": _num(r["detection_median_s"]),
+        "Δ inappropriate [pp]": _delta(r, "inappropriate"),
+        "Δ no reset [pp]": _delta(r, "no_reset"),
+    }
+
+
+def _excluded_note(runs: list, labels: list, order: list) -> str:
+    """One sentence: how many trials of each condition were not judged, and why."""
+    parts = []
+    for i in order:
+        trials = runs[i].tables["trials"]
+        timing = runs[i].meta.get("config", {}).get("timing", {})
+        end = (timing["fault_time_s"] + timing["window_s"]
+               if {"fault_time_s", "window_s"} <= timing.keys() else None)
+        out = trials[~trials["judged"].astype(bool)]
+        why = f" ({_why(_exclusion_reason(out, end))})" if len(out) else ""
+        parts.append(f"`{labels[i]}` {len(out)} of {len(trials)}{why}")
+    return ("Trials excluded from the rates (not judged), by condition: "
+            + "; ".join(parts) + ". In turbulence many trials can leave the validity "
+            "envelope before the end of the judging window; they enter no column above, "
+            "so compare the judged counts too.")
+
+
+def _comparable(cfg: dict) -> dict:
+    """``cfg`` without the ``plant`` section and :data:`IGNORED_CAMPAIGN_KEYS`."""
+    out = {k: v for k, v in cfg.items() if k != "plant"}
+    if isinstance(out.get("campaign"), dict):
+        out["campaign"] = {k: v for k, v in out["campaign"].items()
+                           if k not in IGNORED_CAMPAIGN_KEYS}
+    return out
+
+
+def config_differences(configs: list) -> list:
+    """Top-level config sections in which the compared runs differ.
+
+    The ``plant`` section and ``campaign`` fields :data:`IGNORED_CAMPAIGN_KEYS`
+    are left out.
+
+    Parameters
+    ----------
+    configs : list of dict
+
+    Returns
+    -------
+    list of str
+        In the order of the first config.
+    """
+    first = _comparable(configs[0]) if configs else {}
+    found = {}
+    for cfg in configs[1:]:
+        other = _comparable(cfg)
+        for key in list(first) + list(other):
+            if first.get(key) != other.get(key):
+                found[key] = None
+    return list(found)
+
+
+def _difference_warning(configs: list) -> list:
+    """Markdown lines: a warning if the runs differ beyond the plant, else nothing."""
+    diff = config_differences(configs)
+    if not diff:
+        return []
+    return [f"> **Warning: the compared runs also differ in "
+            f"{', '.join(f'`{d}`' for d in diff)}** (besides `plant` and "
+            f"`campaign.{'`/`campaign.'.join(IGNORED_CAMPAIGN_KEYS)}`): the changes "
+            "below need not come from the plant alone.", ""]
+
+
+def _figure_variant(rates: pd.DataFrame) -> str:
+    variants = list(dict.fromkeys(rates["variant"]))
+    return "swapped" if "swapped" in variants else variants[0]
+
+
+def plant_figure(rates: pd.DataFrame, variant: str, path: Path) -> Path:
+    """Grouped bars: inappropriate and no-reset rates per transition and condition.
+
+    Parameters
+    ----------
+    rates : DataFrame
+        :func:`plant_rates`.
+    variant : str
+        The signature variant drawn.
+    path : Path
+        PNG file, written atomically.
+
+    Returns
+    -------
+    Path
+    """
+    from .plots import plt, save
+
+    g = rates[rates["variant"] == variant]
+    names = list(dict.fromkeys(g["transition"]))
+    conds = list(g.sort_values("_cond", kind="stable")["condition"].drop_duplicates())
+    width = 0.8 / len(conds)
+    fig, axs = plt.subplots(1, 2, figsize=(max(7.0, 1.6 * len(names) + 4), 3.8),
+                            sharey=True, layout="constrained")
+    for ax, (col, title) in zip(axs, (("inappropriate_pct", "inappropriate resets"),
+                                      ("no_reset_pct", "no reset in the window"))):
+        for j, cond in enumerate(conds):
+            c = g[g["condition"] == cond].set_index("transition")[col]
+            ax.bar(np.arange(len(names)) + (j - (len(conds) - 1) / 2) * width,
+                   [c.get(n, np.nan) for n in names], width, label=cond)
+        ax.set_xticks(range(len(names)),
+                      [_label(n).replace(" → ", "\n→ ") for n in names], fontsize=7)
+        ax.set_title(title, fontsize=9)
+        ax.grid(alpha=0.3, axis="y")
+    axs[0].set_ylabel("% of judged trials")
+    axs[1].legend(fontsize=7, title="plant / turbulence", title_fontsize=7)
+    fig.suptitle(f"Truth plant and turbulence (signature {variant})")
+    return save(fig, path)
+
+
+def plant_conditions_differ(runs: list) -> bool:
+    """True if at least two runs differ in (plant kind, turbulence)."""
+    return len({plant_condition(r.meta.get("config", {})) for r in runs}) >= 2
+
+
+def plant_section(runs: list, slugs: list, fig_dir: Path, report: Path) -> list:
+    """Markdown lines: the runs' rates side by side, one condition per run.
+
+    Parameters
+    ----------
+    runs : list of ResultDir
+        The run inputs (at least two conditions, :func:`plant_conditions_differ`).
+    slugs : list of str
+        Their slugs.
+    fig_dir : Path
+        Folder of the figure.
+    report : Path
+        The report file (for the relative link).
+
+    Returns
+    -------
+    list of str
+    """
+    configs = [r.meta.get("config", {}) for r in runs]
+    conds = [plant_condition(c) for c in configs]
+    labels = condition_labels(conds, slugs)
+    ref = reference_index(conds)
+    rates = plant_rates(runs, slugs)
+    variant = _figure_variant(rates)
+    fig = plant_figure(rates, variant, fig_dir / PLANT_FIGURE)
+    return (["## Truth plant and turbulence", "",
+             f"{len(runs)} runs, one condition each (plant / turbulence); reference "
+             f"`{labels[ref]}` (`{runs[ref].path}`).", ""]
+            + _difference_warning(configs)
+            + [pd.DataFrame([_plant_row(r) for _, r in rates.iterrows()])
+               .to_markdown(index=False, floatfmt=".1f"), "",
+               "Rates in % of judged trials. False resets: resets at or before the fault "
+               "switch, per hour of the fault-free flight before it (judged trials × "
+               "`timing.fault_time_s`), with the exact Poisson 95 % interval. First reset: "
+               "median delay after the switch, of trials with a reset in the window. "
+               "Δ: change in percentage points against the reference condition.", "",
+               _excluded_note(runs, labels, condition_order(conds)), "",
+               f"![truth plant and turbulence]({_rel_link(fig, report)})", ""])
 
 
 def build_report(dirs: list, out: Path, allow_mixed: bool = False) -> Path:
@@ -788,7 +1153,8 @@ def build_report(dirs: list, out: Path, allow_mixed: bool = False) -> Path:
         only their Parquet files are read.
     out : Path
         The Markdown file, written atomically.  Figures go to
-        ``<out stem>_figures/`` beside it.
+        ``<out stem>_figures/`` beside it.  When at least two runs differ in truth
+        plant or turbulence, a section compares them (:func:`plant_section`).
     allow_mixed : bool
         Build the report even if the inputs come from different package versions
         or git revisions (a warning is added to the report).
@@ -817,13 +1183,17 @@ def build_report(dirs: list, out: Path, allow_mixed: bool = False) -> Path:
              "`ftc-mc report`.", ""]
     if warning:
         lines += [f"> **Warning: mixed inputs.** {warning}.", ""]
-    for r, slug in zip(inputs, _slugs(inputs)):
+    slugs = _slugs(inputs)
+    for r, slug in zip(inputs, slugs):
         if r.kind == "run":
             lines += run_section(r, fig_dir, slug, out)
         elif r.kind == "sweep":
             lines += sweep_section(r, fig_dir, slug, out)
         else:
             lines += scenario_section(r, out)
+    runs = [(r, slug) for r, slug in zip(inputs, slugs) if r.kind == "run"]
+    if plant_conditions_differ([r for r, _ in runs]):
+        lines += plant_section([r for r, _ in runs], [s for _, s in runs], fig_dir, out)
     lines += provenance_section(inputs, warning)
     write_text(out, "\n".join(lines))
     return out

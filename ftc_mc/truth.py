@@ -23,7 +23,9 @@ from .model.linear import LinearPlant, jacobian
 from .model.turbulence import DrydenModel, dryden_model
 
 PLANT_KINDS = ("linear", "nonlinear")
+"""Truth plants (config ``plant.kind``), in the order reports list them."""
 TURBULENCE_LEVELS = ("none", "light", "moderate", "severe")
+"""Turbulence levels (config ``plant.turbulence``), weakest first."""
 
 
 def wind_matrices(plant: LinearPlant):

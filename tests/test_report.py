@@ -128,6 +128,8 @@ def test_report_has_scenario_timeline_and_provenance(inputs, report):
             assert cell == ("-" if np.isnan(value) else f"{value:.1f}")
     for detail in ev.loc[ev.kind == "controller_switch", "detail"]:
         assert detail in text
+    scenario = text.split(f"## Scenario `{inputs[1]}`", 1)[1].split("\n## ", 1)[0]
+    assert "truth plant `linear`, turbulence `none`." in scenario
     for d in inputs:
         meta = read_metadata(next(d.glob("*.parquet")))
         assert str(d) in text

@@ -93,10 +93,12 @@ def auto_jobs(cfg: Config, n_variants: int) -> int:
     """Worker count for ``jobs=-1``: every core, or 1 for a small run.
 
     A trial step of the reconfiguring loop costs about six of the nominal one
-    (the controller selection predicts three controllers over the horizon).
+    (the controller selection predicts three controllers over the horizon); one
+    on the nonlinear plant about four (``scripts/bench_truth.py``).
     """
     c = cfg.campaign
     weight = 6 if cfg.controller.kind == "reconfiguring" else 1
+    weight *= 4 if cfg.plant.kind == "nonlinear" else 1
     steps = c.trials * len(c.transitions) * n_variants * cfg.steps(cfg.timing.duration_s)
     if steps * weight < SMALL_RUN_STEPS:
         return 1
@@ -169,7 +171,8 @@ def run_campaign(config, *, trials=None, seed=None, signature=None, jobs: int = 
             n_jobs = os.cpu_count() if jobs == -1 else n_jobs
         with parallel_backend(backend, scheduler, n_jobs):
             gen = Parallel(n_jobs=n_jobs, return_as="generator")(
-                delayed(run_chunk)(setup, name, ids, c.seed, variants, c.max_resets, window)
+                delayed(run_chunk)(setup, name, ids, c.seed, variants, cfg.resets_stored(),
+                                   window)
                 for name, ids in todo)
             for (name, ids), out in zip(todo, gen):
                 part = [dict(trials=t, resets=r) for t, r in out]

@@ -257,7 +257,7 @@ class SweepResult:
         return 1.0 - self.simulated_steps / self.alone_steps
 
 
-def _poisson_ci(k: int, exposure: float):
+def poisson_ci(k: int, exposure: float):
     """Exact (Garwood) 95 % interval of a Poisson rate ``k / exposure``."""
     lo = 0.0 if k == 0 else scipy.stats.chi2.ppf(0.025, 2 * k) / 2
     hi = scipy.stats.chi2.ppf(0.975, 2 * k + 2) / 2
@@ -302,11 +302,12 @@ def run_sweep(cfg: Config, points, *, flights: int | None = None, jobs: int = 1,
         warm_up(setup, cfg)
     n_jobs = (os.cpu_count() or 1) if jobs == -1 else max(1, int(jobs))
 
+    stored = cfg.resets_stored()
+
     def task(name, ids):
         if name == FLIGHT:
-            return delayed(flight_chunk)(setup, cfg, ids, points, variants, c.max_resets)
-        return delayed(sweep_chunk)(setup, cfg, name, ids, points, variants, c.max_resets,
-                                    window)
+            return delayed(flight_chunk)(setup, cfg, ids, points, variants, stored)
+        return delayed(sweep_chunk)(setup, cfg, name, ids, points, variants, stored, window)
 
     done = {}
     with tqdm(total=sum(len(ids) for _, ids in units), unit="trial", disable=not progress,
@@ -349,7 +350,7 @@ def run_sweep(cfg: Config, points, *, flights: int | None = None, jobs: int = 1,
     rates = []
     for _, r in fsum.iterrows():
         exposure = r["judged"] * hours
-        lo, hi = _poisson_ci(int(r["resets"]), exposure) if exposure else (np.nan, np.nan)
+        lo, hi = poisson_ci(int(r["resets"]), exposure) if exposure else (np.nan, np.nan)
         rates.append({"t_q": r["t_q"], "t_nx": r["t_nx"], "variant": r["variant"],
                       "flight_hours": exposure, "flight_false_resets": int(r["resets"]),
                       "false_resets_per_hour": r["resets"] / exposure if exposure else np.nan,

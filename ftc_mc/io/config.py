@@ -218,8 +218,8 @@ class CampaignConfig(_Strict):
     """Table 1 variant(s) run on the same draws and noise."""
     chunk_size: Annotated[int, NoBool, Field(gt=0, le=4096)] = 128
     """Trials per chunk (one kernel call, lanes); results do not depend on it."""
-    max_resets: Annotated[int, NoBool, Field(gt=0, le=100_000)] = 256
-    """Resets stored per trial (more are counted, not stored)."""
+    max_resets: Annotated[int, NoBool, Field(gt=0, le=100_000)] | None = None
+    """Resets stored per trial (more are counted, not stored); null: one per step, all."""
 
     @model_validator(mode="after")
     def _unique(self):
@@ -279,6 +279,12 @@ class Config(_Strict):
     def steps(self, seconds: float) -> int:
         """Number of sampling periods in ``seconds``."""
         return int(round(seconds / self.model.dt_s))
+
+    def resets_stored(self) -> int:
+        """Resets stored per trial: ``campaign.max_resets``, or every step's when null
+        (a trial resets at most one block per step, so then none is lost)."""
+        m = self.campaign.max_resets
+        return self.steps(self.timing.duration_s) if m is None else m
 
 
 _REPR = reprlib.Repr()

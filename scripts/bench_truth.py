@@ -1,0 +1,98 @@
+"""Trials per second on each truth plant, same process (issue 7).
+
+For every (plant, turbulence) pair of ``--plants`` the script times
+``ftc_mc.campaign.chunk.run_chunk`` -- drawing the trials, running both
+signature variants and classifying them, exactly what one campaign worker
+does -- on one chunk of ``--lanes`` elevon-lock and engine-loss trials with the
+default 50 s timing, in one thread, after a warm-up call, median of
+``--repeat``.  The linear still-air plant (the paper's setting) is the
+reference every ratio is taken against.  ``--controller`` picks the nominal
+controller (the Tables 2-3 estimation campaign) or the reconfiguring loop.
+
+Usage::
+
+    .venv/bin/python scripts/bench_truth.py [--lanes 128] [--repeat 3]
+
+The last line is ``linear_trials_per_s=<a> nonlinear_trials_per_s=<b>
+nonlinear_moderate_trials_per_s=<c> ratio=<a/b>`` (nominal controller unless
+told otherwise).
+"""
+
+from __future__ import annotations
+
+import os
+
+for _var in ("NUMBA_NUM_THREADS", "OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS",
+             "MKL_NUM_THREADS"):
+    os.environ[_var] = "1"
+
+import argparse  # noqa: E402
+import statistics  # noqa: E402
+import sys  # noqa: E402
+import time  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+import numpy as np  # noqa: E402
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from ftc_mc.campaign.chunk import run_chunk  # noqa: E402
+from ftc_mc.campaign.setup import build_setup  # noqa: E402
+from ftc_mc.io.config import Config  # noqa: E402
+
+PLANTS = (("linear", "none"), ("nonlinear", "none"), ("linear", "moderate"),
+          ("nonlinear", "moderate"))
+TRANSITIONS = ("elevon_lock", "engine_loss")
+
+
+def trials_per_s(kind, turbulence, controller, lanes, repeat):
+    """Median trials/s of one chunk per transition (both variants count as trials)."""
+    cfg = Config.model_validate({
+        "campaign": {"transitions": list(TRANSITIONS), "signature": "both"},
+        "controller": {"kind": controller},
+        "plant": {"kind": kind, "turbulence": turbulence}})
+    setup = build_setup(cfg)
+    ids = np.arange(lanes)
+    window = cfg.steps(cfg.timing.window_s)
+
+    def once():
+        for name in TRANSITIONS:
+            run_chunk(setup, name, ids, cfg.campaign.seed, ("paper", "swapped"),
+                      cfg.resets_stored(), window)
+
+    once()  # compile or load from the cache
+    times = []
+    for _ in range(repeat):
+        t = time.perf_counter()
+        once()
+        times.append(time.perf_counter() - t)
+    n_trials = lanes * len(TRANSITIONS) * 2
+    return n_trials / statistics.median(times), cfg.steps(cfg.timing.duration_s)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--lanes", type=int, default=128)
+    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--controller", choices=("nominal", "reconfiguring"), default="nominal")
+    args = ap.parse_args()
+    rows = {}
+    for kind, turb in PLANTS:
+        rows[kind, turb], n_steps = trials_per_s(kind, turb, args.controller, args.lanes,
+                                                 args.repeat)
+    ref = rows["linear", "none"]
+    print(f"one thread, chunks of {args.lanes} trials, {n_steps} steps per trial, "
+          f"controller {args.controller}, transitions {', '.join(TRANSITIONS)}, "
+          f"both variants")
+    print(f"{'plant':>10} {'turbulence':>10} {'trials/s':>10} {'trial steps/s':>14} "
+          f"{'vs linear':>10}")
+    for (kind, turb), r in rows.items():
+        print(f"{kind:>10} {turb:>10} {r:10.1f} {r * n_steps:14.3g} {r / ref:10.3f}")
+    nl = rows["nonlinear", "none"]
+    print(f"linear_trials_per_s={ref:.1f} nonlinear_trials_per_s={nl:.1f} "
+          f"nonlinear_moderate_trials_per_s={rows['nonlinear', 'moderate']:.1f} "
+          f"ratio={ref / nl:.2f}")
+
+
+if __name__ == "__main__":
+    main()
