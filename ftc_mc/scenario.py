@@ -302,7 +302,8 @@ def summary_markdown(res: ScenarioResult) -> str:
     lines = ["# ftc-mc scenario", "",
              f"Signature: `{res.config.scenario.signature}`; controller: "
              f"`{res.config.controller.kind}`; seed {res.config.scenario.seed}; "
-             f"run status: `{res.status}`.", "",
+             f"truth plant `{res.config.plant.kind}`, turbulence "
+             f"`{res.config.plant.turbulence}`; run status: `{res.status}`.", "",
              "## Detection of each schedule entry", ""]
     tab = seg[["start_s", "truth_mode", "detection_s", "paper_detection_s",
                "max_cross_track_m", "max_along_track_m", "cross_track_recovery_s",
