@@ -98,3 +98,19 @@ def test_cli_sweep(tmp_path):
     assert "Recommended threshold" in text and "t_q = " in text
     png = rep.parent / "report_figures" / "out_sweep.png"
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and png.stat().st_size > 10_000
+
+
+def test_shared_trials_equal_separate_runs_on_a_turbulent_nonlinear_plant():
+    """The shared start carries the gust state (LaneState.gust) and the nonlinear
+    truth: continuing from it must equal running each point alone."""
+    cfg = CFG.model_copy(update={"plant": CFG.plant.model_copy(
+        update={"kind": "nonlinear", "turbulence": "light"})})
+    points = threshold_points("3000,20000")  # light gusts: r_q reaches ~3e3 per flight
+    res = run_sweep(cfg, points, flights=6, jobs=1, progress=False)
+    for t, _ in points:
+        est = cfg.estimator.model_copy(update={"t_q": t, "t_nx": t})
+        alone = ftc_mc.run_campaign(cfg.model_copy(update={"estimator": est}), jobs=1,
+                                    progress=False).trials
+        shared = res.trials[res.trials.t_q == t].drop(columns=["t_q", "t_nx"])
+        pd.testing.assert_frame_equal(alone, shared.reset_index(drop=True), check_exact=True)
+    assert res.simulated_steps < res.alone_steps
