@@ -40,11 +40,10 @@ from .campaign.transitions import TRANSITION_TABLE
 from .errors import UserError
 from .io.atomic import write_text
 from .io.chunks import FOLDER as CHUNKS_FOLDER
-from .io.config import TRANSITIONS, TimingConfig
+from .io.config import PLANT_KINDS, TRANSITIONS, TURBULENCE_LEVELS, TimingConfig
 from .io.lock import holder
 from .io.results import read_metadata
 from .scenario import PAPER_TIMELINE
-from .truth import PLANT_KINDS, TURBULENCE_LEVELS
 
 RUN_TABLES = ("trials.parquet", "summary.parquet")
 """Parquet files a run directory must hold (``resets.parquet`` is optional)."""
@@ -926,15 +925,17 @@ def _with_deltas(rates: pd.DataFrame, ref: str) -> pd.DataFrame:
     return out.drop(columns=["inappropriate_pct_ref", "no_reset_pct_ref"])
 
 
-def plant_rates(runs: list, slugs: list) -> pd.DataFrame:
+def plant_rates(runs: list, conds: list, labels: list) -> pd.DataFrame:
     """Rates of every run, one condition per run, in report order.
 
     Parameters
     ----------
     runs : list of ResultDir
         Run directories.
-    slugs : list of str
-        Their slugs (labels of repeated conditions).
+    conds : list of (str, str)
+        Their conditions (:func:`plant_condition`).
+    labels : list of str
+        Their labels (:func:`condition_labels`).
 
     Returns
     -------
@@ -945,13 +946,10 @@ def plant_rates(runs: list, slugs: list) -> pd.DataFrame:
         ``_cond`` (rank of the condition, :func:`condition_order`); rows by
         transition (paper order), variant, then condition.
     """
-    configs = [r.meta.get("config", {}) for r in runs]
-    conds = [plant_condition(c) for c in configs]
-    labels = condition_labels(conds, slugs)
     rank = {i: pos for pos, i in enumerate(condition_order(conds))}
     parts = []
-    for i, (r, cfg) in enumerate(zip(runs, configs)):
-        part = condition_rates(r.tables["trials"], _fault_time_s(cfg))
+    for i, r in enumerate(runs):
+        part = condition_rates(r.tables["trials"], _fault_time_s(r.meta.get("config", {})))
         parts.append(part.assign(condition=labels[i], _cond=rank[i]))
     rates = _with_deltas(pd.concat(parts, ignore_index=True),
                          labels[reference_index(conds)])
@@ -1125,7 +1123,7 @@ def plant_section(runs: list, slugs: list, fig_dir: Path, report: Path) -> list:
     conds = [plant_condition(c) for c in configs]
     labels = condition_labels(conds, slugs)
     ref = reference_index(conds)
-    rates = plant_rates(runs, slugs)
+    rates = plant_rates(runs, conds, labels)
     variant = _figure_variant(rates)
     fig = plant_figure(rates, variant, fig_dir / PLANT_FIGURE)
     return (["## Truth plant and turbulence", "",

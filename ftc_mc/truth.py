@@ -18,15 +18,10 @@ import scipy.signal
 
 from .core.nonlinear import derivatives_nb, outputs_nb
 from .core.settings import TruthPlant
+from .io.config import PLANT_KINDS, TURBULENCE_LEVELS
 from .model.dynamics import N_OUTPUT, N_STATE
 from .model.linear import LinearPlant, jacobian
 from .model.turbulence import DrydenModel, dryden_model
-
-PLANT_KINDS = ("linear", "nonlinear")
-"""Truth plants (config ``plant.kind``), in the order reports list them."""
-TURBULENCE_LEVELS = ("none", "light", "moderate", "severe")
-"""Turbulence levels (config ``plant.turbulence``), weakest first."""
-
 
 def wind_matrices(plant: LinearPlant):
     """Gust input matrices of the linear plant.

@@ -17,6 +17,32 @@ from .transitions import (BLOCK_NAMES, TRANSITION_TABLE, draw_trial, estimator_p
 MODE_NAMES = ("nominal", "engine", "left_elevon", "right_elevon")
 
 
+def draw_lanes(setup: CampaignSetup, tr, trial_ids, seed: int, lock_range=(0.0, 1.0)):
+    """Every trial's draws (:func:`~ftc_mc.campaign.transitions.draw_trial`) in lanes.
+
+    Returns
+    -------
+    draws : ndarray, shape (L,)
+        The fault draw of each trial (lock position or b1).
+    w, v : ndarray, shapes (n_steps, 9, L) and (n_steps, 12, L)
+    eta, g0 : ndarray
+        Gust draws and initial gust states (see
+        :func:`~ftc_mc.campaign.transitions.gust_lanes`).
+    """
+    n, L = setup.tim.n_steps, len(trial_ids)
+    w = np.empty((n, 9, L))
+    v = np.empty((n, 12, L))
+    draws = np.empty(L)
+    eta, g0 = gust_lanes(n, L, setup.gust_chol is not None)
+    for l, tid in enumerate(trial_ids):
+        draws[l], w[:, :, l], v[:, :, l], gust = draw_trial(
+            int(tid), seed, tr, lock_range, setup.loss_range, n, setup.q_std,
+            setup.r_std, setup.gust_chol)
+        if gust is not None:
+            eta[:, :, l], g0[:, l] = gust
+    return draws, w, v, eta, g0
+
+
 def build_inputs(setup: CampaignSetup, tr_name: str, trial_ids, seed: int):
     """Draw every trial of a chunk and lay the inputs out in lanes.
 
@@ -29,24 +55,13 @@ def build_inputs(setup: CampaignSetup, tr_name: str, trial_ids, seed: int):
     tr = TRANSITION_TABLE[tr_name]
     tim = setup.tim
     L = len(trial_ids)
-    n = tim.n_steps
-    w = np.empty((n, 9, L))
-    v = np.empty((n, 12, L))
     b0 = {True: np.zeros((3, L)), False: np.zeros((3, L))}   # keyed by 'faulty'
     b1 = {True: np.zeros((3, L)), False: np.zeros((3, L))}
     mode_f = np.zeros(L, dtype=np.int64)
     xa0 = np.zeros((14, L))
-    draws = np.empty(L)
-    eta, g0 = gust_lanes(n, L, setup.gust_chol is not None)
-    lock_range = setup.lock_range[tr.actuator]
-    for l, tid in enumerate(trial_ids):
-        value, wl, vl, gust = draw_trial(int(tid), seed, tr, lock_range, setup.loss_range,
-                                         n, setup.q_std, setup.r_std, setup.gust_chol)
-        draws[l] = value
-        w[:, :, l] = wl
-        v[:, :, l] = vl
-        if gust is not None:
-            eta[:, :, l], g0[:, l] = gust
+    draws, w, v, eta, g0 = draw_lanes(setup, tr, trial_ids, seed,
+                                      setup.lock_range[tr.actuator])
+    for l, value in enumerate(draws):
         fb0, fb1 = faulty_params(tr, value)
         b0[True][:, l] = fb0
         b1[True][:, l] = fb1

@@ -34,12 +34,11 @@ from ..core.trial import advance, init_state, new_state, run_trials
 from ..errors import UserError
 from ..estimator import detection
 from ..io.config import Config
-from .chunk import build_inputs, classify, new_record
+from .chunk import build_inputs, classify, draw_lanes, new_record
 from .parallel import backend as parallel_backend
 from .runner import _sorted, plan_chunks
 from .setup import CampaignSetup, build_setup, estimator_settings, variants_of
 from .summary import summarize
-from .transitions import draw_trial, gust_lanes
 
 FLIGHT = "fault_free"
 
@@ -180,18 +179,9 @@ def sweep_chunk(setup: CampaignSetup, cfg: Config, tr_name: str, trial_ids, poin
 
 def flight_inputs(setup: CampaignSetup, ids, seed: int) -> TrialInputs:
     """Fault-free flights: nominal throughout, trial streams as in a campaign."""
-    n, L = setup.tim.n_steps, len(ids)
-    w = np.empty((n, 9, L))
-    v = np.empty((n, 12, L))
-    eta, g0 = gust_lanes(n, L, setup.gust_chol is not None)
+    L = len(ids)
     tr = type("T", (), {"kind": "loss"})()
-    for l, tid in enumerate(ids):
-        _, wl, vl, gust = draw_trial(int(tid), seed, tr, (0.0, 1.0), setup.loss_range, n,
-                                     setup.q_std, setup.r_std, setup.gust_chol)
-        w[:, :, l] = wl
-        v[:, :, l] = vl
-        if gust is not None:
-            eta[:, :, l], g0[:, l] = gust
+    _, w, v, eta, g0 = draw_lanes(setup, tr, ids, seed)
     zeros = np.zeros((1, 3, L))
     modes = np.zeros(L, dtype=np.int64)
     return TrialInputs(k_switch=np.zeros(1, dtype=np.int64), b0=zeros, b1=zeros.copy(),

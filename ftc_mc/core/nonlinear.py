@@ -182,8 +182,10 @@ def propagate(x, cmd, p, wind, dt, n_sub, work):
         rk4_step(x, cmd, p, wind, h, work[0], work[1], work[2], work[3], work[4])
 
 
-def make_work() -> np.ndarray:
-    """A work array for :func:`propagate`, shape ``(N_WORK, N_STATE)``."""
+@kernel
+def make_work():
+    """A work array for :func:`propagate`, shape ``(N_WORK, N_STATE)`` (callable
+    from Python and from kernels)."""
     return np.zeros((N_WORK, N_STATE))
 
 

@@ -40,7 +40,7 @@ from .control import C_ELEVON, controller_command, select_controller
 from .dryden import gust_step
 from .excitation import doublet, saturate, signal_3211
 from .jit import kernel
-from .nonlinear import N_WORK, outputs_nb, propagate
+from .nonlinear import make_work, outputs_nb, propagate
 from .settings import LaneState
 
 STATUS_OK = 0
@@ -88,12 +88,6 @@ def is_psd(P, l, work):
             else:
                 work[i, j] = acc / work[j, j]
     return True
-
-
-@kernel
-def make_work_nb():
-    """Work array of :func:`ftc_mc.core.nonlinear.propagate` (inside a kernel)."""
-    return np.zeros((N_WORK, 9))
 
 
 @kernel
@@ -185,7 +179,7 @@ def advance(fm, det, bs, ctl, exc, tim, val, rc, eng, pl, inp, rec, st, k0, k1):
     xabs = np.zeros(nx)
     cmd = np.zeros(3)
     yl = np.zeros(12)
-    nl_work = make_work_nb()
+    nl_work = make_work()
     va_now = np.zeros(L)
     al_now = np.zeros(L)
     n_hist = rec.hist_x.shape[0]

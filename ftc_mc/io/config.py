@@ -25,6 +25,13 @@ TRANSITIONS = ("elevon_lock", "elevon_unlock", "elevon_loss", "elevon_loss_recov
                "engine_lock", "engine_unlock", "engine_loss", "engine_loss_recover")
 """The eight transitions of the paper's Tables 2-3 (DESIGN.md section 6)."""
 
+PLANT_KINDS = ("linear", "nonlinear")
+"""Truth plants a trial can fly (config ``plant.kind``), the paper's first."""
+
+TURBULENCE_LEVELS = ("none", "light", "moderate", "severe")
+"""MIL-F-8785C turbulence levels (config ``plant.turbulence``), weakest first."""
+
+
 def _no_bool(value):
     """YAML reads yes/no/on/off as booleans: never accept them as numbers."""
     if isinstance(value, bool):
@@ -57,11 +64,11 @@ class ModelConfig(_Strict):
 class PlantConfig(_Strict):
     """Truth plant the trials fly (the estimator and controllers keep the linear model)."""
 
-    kind: Literal["linear", "nonlinear"] = "linear"
+    kind: Literal[PLANT_KINDS] = "linear"
     """linear: the model of eq. (1), as in the paper; nonlinear: the X8 equations, RK4."""
     substeps: Annotated[int, NoBool, Field(ge=1, le=1000)] = 10
     """RK4 sub-steps per control period of the nonlinear plant (10: 6e-7 m/s error)."""
-    turbulence: Literal["none", "light", "moderate", "severe"] = "none"
+    turbulence: Literal[TURBULENCE_LEVELS] = "none"
     """MIL-F-8785C Dryden gusts: W20 = 0, 15, 30, 45 kt."""
     altitude_m: Annotated[float, NoBool, Field(ge=3.048, le=304.8, allow_inf_nan=False)] = 100.0
     """Altitude for the Dryden scale lengths [m] (low-altitude model: 10-1000 ft)."""
