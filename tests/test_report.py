@@ -15,7 +15,6 @@ paper scenario, both made once per module through the CLI:
 from __future__ import annotations
 
 import re
-import shutil
 from pathlib import Path
 from urllib.parse import unquote
 
@@ -31,6 +30,8 @@ from ftc_mc.errors import UserError
 from ftc_mc.io.lock import acquire
 from ftc_mc.io.results import read_metadata, write_parquet
 from ftc_mc.report import build_report, exclusion_table, variant_comparison
+
+from result_dirs import copy_dir, same_stamp
 
 ROOT = Path(__file__).resolve().parents[1]
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
@@ -54,22 +55,8 @@ def inputs(tmp_path_factory):
     res = CliRunner().invoke(cli, ["scenario", str(ROOT / "configs" / "paper_scenario.yaml"),
                                    "--out", str(scen)])
     assert res.exit_code == 0, res.output
-    _same_stamp(run, scen)
+    same_stamp(run, scen)
     return run, scen
-
-
-def _same_stamp(src: Path, dst: Path) -> None:
-    """Give ``dst``'s files the version and git revision of ``src``.
-
-    Other engineers commit and edit tracked files while the suite runs, so the
-    revision (and its ``+dirty`` suffix) can change between the two CLI calls.
-    """
-    ref = read_metadata(src / "summary.parquet")
-    for path in dst.glob("*.parquet"):
-        meta = read_metadata(path)
-        if (meta["version"], meta["git_revision"]) != (ref["version"], ref["git_revision"]):
-            meta.update(version=ref["version"], git_revision=ref["git_revision"])
-            write_parquet(pd.read_parquet(path), path, meta)
 
 
 @pytest.fixture(scope="module")
@@ -90,11 +77,6 @@ def _rows(text: str, heading: str) -> list:
             break
         table.append([c.strip() for c in line.strip("|").split("|")])
     return table[2:]
-
-
-def _copy(src: Path, dst: Path) -> Path:
-    shutil.copytree(src, dst)
-    return dst
 
 
 def test_report_has_paper_and_our_numbers(inputs, report):
@@ -152,8 +134,8 @@ def test_figures_exist_with_working_relative_links(inputs, report):
 
 
 def test_rebuild_from_parquet_files_only(inputs, tmp_path):
-    run = _copy(inputs[0], tmp_path / "run")
-    scen = _copy(inputs[1], tmp_path / "scen")
+    run = copy_dir(inputs[0], tmp_path / "run")
+    scen = copy_dir(inputs[1], tmp_path / "scen")
     out = tmp_path / "out" / "r.md"
     first = build_report([run, scen], out).read_text(encoding="utf-8")
     for p in list(tmp_path.rglob("*")):
@@ -182,7 +164,7 @@ def test_directory_without_results_is_refused(inputs, tmp_path):
 
 
 def test_directory_being_written_is_refused(inputs, tmp_path):
-    run = _copy(inputs[0], tmp_path / "run")
+    run = copy_dir(inputs[0], tmp_path / "run")
     out = tmp_path / "r.md"
     with acquire(run, command="ftc-mc run test"):
         with pytest.raises(UserError, match="being written by `ftc-mc run test`"):
@@ -196,7 +178,7 @@ def test_directory_being_written_is_refused(inputs, tmp_path):
 @pytest.mark.parametrize("field,value", [("version", "9.9.9"),
                                          ("git_revision", "0" * 40 + "+dirty")])
 def test_mixed_provenance_is_refused_unless_allowed(inputs, tmp_path, field, value):
-    run = _copy(inputs[0], tmp_path / "run")
+    run = copy_dir(inputs[0], tmp_path / "run")
     path = run / "summary.parquet"
     meta = read_metadata(path)
     meta[field] = value

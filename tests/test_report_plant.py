@@ -26,7 +26,6 @@ What is checked:
 from __future__ import annotations
 
 import re
-import shutil
 from pathlib import Path
 from urllib.parse import unquote
 
@@ -42,6 +41,8 @@ from ftc_mc.cli import cli
 from ftc_mc.io.results import read_metadata, write_parquet
 from ftc_mc.report import (build_report, condition_labels, condition_order,
                            config_differences, reference_index)
+
+from result_dirs import copy_dir, same_stamp
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 IMAGE = re.compile(r"!\[[^\]]*\]\(([^)]+)\)")
@@ -74,17 +75,6 @@ def _edit_config(run: Path, edit) -> None:
         write_parquet(pd.read_parquet(path), path, meta)
 
 
-def _same_stamp(src: Path, dst: Path) -> None:
-    """Give ``dst``'s files the version and git revision of ``src`` (others edit
-    tracked files while the suite runs, so the revision can change between runs)."""
-    ref = read_metadata(src / "summary.parquet")
-    for path in dst.glob("*.parquet"):
-        meta = read_metadata(path)
-        if (meta["version"], meta["git_revision"]) != (ref["version"], ref["git_revision"]):
-            meta.update(version=ref["version"], git_revision=ref["git_revision"])
-            write_parquet(pd.read_parquet(path), path, meta)
-
-
 @pytest.fixture(scope="module")
 def runs(tmp_path_factory):
     """The four run directories, by name."""
@@ -98,13 +88,8 @@ def runs(tmp_path_factory):
         assert res.exit_code == 0, res.output
         out[name] = base / name
     for d in out.values():
-        _same_stamp(out["lin"], d)
+        same_stamp(out["lin"], d)
     return out
-
-
-def _copy(src: Path, dst: Path) -> Path:
-    shutil.copytree(src, dst)
-    return dst
 
 
 def _report(dirs, tmp_path: Path) -> str:
@@ -232,7 +217,7 @@ def test_repeated_condition_is_labelled_with_slug(runs, tmp_path):
 
 
 def test_results_without_plant_section_read_as_linear(runs, tmp_path):
-    old = _copy(runs["lin"], tmp_path / "old")
+    old = copy_dir(runs["lin"], tmp_path / "old")
     _edit_config(old, lambda cfg: cfg.pop("plant"))
     assert "plant" not in read_metadata(old / "summary.parquet")["config"]
     text = _report([runs["nl"], old], tmp_path)
@@ -245,7 +230,7 @@ def test_results_without_plant_section_read_as_linear(runs, tmp_path):
 def test_config_difference_warning(runs, tmp_path):
     # seed and trial count differ (ignored): no warning
     assert "Warning" not in _section(_report([runs["lin"], runs["nlt"]], tmp_path / "a"))
-    changed = _copy(runs["nl"], tmp_path / "changed")
+    changed = copy_dir(runs["nl"], tmp_path / "changed")
     _edit_config(changed, lambda cfg: cfg["estimator"].update(t_q=30.0))
     section = _section(_report([runs["lin"], changed], tmp_path / "b"))
     warnings = [line for line in section.splitlines() if "Warning" in line]
@@ -283,7 +268,7 @@ def test_condition_order_reference_and_differences():
 
 
 def test_excluded_trials_do_not_enter_the_rates(runs, tmp_path):
-    edited = _copy(runs["nl"], tmp_path / "nl")
+    edited = copy_dir(runs["nl"], tmp_path / "nl")
     path = edited / "trials.parquet"
     t = pd.read_parquet(path)
     out = ~t["judged"]
@@ -317,7 +302,7 @@ def test_sweep_section_names_its_plant(runs, tmp_path):
                                    "--flights", "1", "--jobs", "1", "--quiet",
                                    "--out", str(sweep)])
     assert res.exit_code == 0, res.output
-    _same_stamp(runs["lin"], sweep)
+    same_stamp(runs["lin"], sweep)
     text = _report([runs["lin"], sweep], tmp_path)
     section = text.split(f"## Sweep `{sweep}`", 1)[1].split("\n## ", 1)[0]
     assert "truth plant `nonlinear`, turbulence `light`." in section

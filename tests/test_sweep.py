@@ -24,14 +24,19 @@ def sweep():
     return run_sweep(CFG, threshold_points("4,12,25"), flights=6, jobs=1, progress=False)
 
 
-def test_shared_trials_equal_separate_runs(sweep):
-    for t in (4.0, 12.0, 25.0):
-        est = CFG.estimator.model_copy(update={"t_q": t, "t_nx": t})
-        alone = ftc_mc.run_campaign(CFG.model_copy(update={"estimator": est}), jobs=1,
+def _assert_shared_equals_alone(cfg, res, thresholds):
+    """Each point's trials in the sweep ``res`` equal a campaign run at that point."""
+    for t in thresholds:
+        est = cfg.estimator.model_copy(update={"t_q": t, "t_nx": t})
+        alone = ftc_mc.run_campaign(cfg.model_copy(update={"estimator": est}), jobs=1,
                                     progress=False).trials
-        shared = sweep.trials[sweep.trials.t_q == t].drop(columns=["t_q", "t_nx"])
+        shared = res.trials[res.trials.t_q == t].drop(columns=["t_q", "t_nx"])
         pd.testing.assert_frame_equal(alone, shared.reset_index(drop=True), check_exact=True)
-    assert sweep.simulated_steps < sweep.alone_steps
+    assert res.simulated_steps < res.alone_steps
+
+
+def test_shared_trials_equal_separate_runs(sweep):
+    _assert_shared_equals_alone(CFG, sweep, (4.0, 12.0, 25.0))
 
 
 def test_table_rows_and_false_reset_rates(sweep):
@@ -107,10 +112,4 @@ def test_shared_trials_equal_separate_runs_on_a_turbulent_nonlinear_plant():
         update={"kind": "nonlinear", "turbulence": "light"})})
     points = threshold_points("3000,20000")  # light gusts: r_q reaches ~3e3 per flight
     res = run_sweep(cfg, points, flights=6, jobs=1, progress=False)
-    for t, _ in points:
-        est = cfg.estimator.model_copy(update={"t_q": t, "t_nx": t})
-        alone = ftc_mc.run_campaign(cfg.model_copy(update={"estimator": est}), jobs=1,
-                                    progress=False).trials
-        shared = res.trials[res.trials.t_q == t].drop(columns=["t_q", "t_nx"])
-        pd.testing.assert_frame_equal(alone, shared.reset_index(drop=True), check_exact=True)
-    assert res.simulated_steps < res.alone_steps
+    _assert_shared_equals_alone(cfg, res, [t for t, _ in points])
