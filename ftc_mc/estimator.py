@@ -32,7 +32,7 @@ PAPER_TM = (
 )
 """Mode transition matrix T_M (paper section 5.1), column j = from mode j."""
 
-MODE_NAMES = ("nominal", "engine", "left_elevon", "right_elevon")
+from .conventions import MODE_NAMES  # noqa: E402,F401
 
 
 @dataclasses.dataclass(frozen=True)

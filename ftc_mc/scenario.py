@@ -24,7 +24,7 @@ from .core.trial import STATUS_NAMES, run_trials
 from .estimator import MODE_NAMES
 from .io.config import ACTUATOR_NAMES, ScenarioConfig
 
-CONTROLLER_NAMES = ("c0 nominal", "c1 engine fault", "c2 elevon fault")
+from .conventions import CONTROLLER_NAMES  # noqa: E402
 
 PAPER_TIMELINE = {
     # paper section 5.2: what happened after each switch of Table 4

@@ -14,7 +14,7 @@ from .setup import CampaignSetup
 from .transitions import (BLOCK_NAMES, TRANSITION_TABLE, draw_trial, estimator_params,
                           faulty_params, gust_lanes, mode_of)
 
-MODE_NAMES = ("nominal", "engine", "left_elevon", "right_elevon")
+from ..conventions import MODE_NAMES
 
 
 def draw_lanes(setup: CampaignSetup, tr, trial_ids, seed: int, lock_range=(0.0, 1.0)):

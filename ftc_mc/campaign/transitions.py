@@ -18,9 +18,11 @@ import dataclasses
 
 import numpy as np
 
+from ..conventions import BLOCK_NAMES, MODE_ENGINE, MODE_NOMINAL  # noqa: F401
+from ..conventions import MODE_LEFT_ELEVON as MODE_LEFT
+from ..conventions import MODE_RIGHT_ELEVON as MODE_RIGHT
+
 ENGINE, LEFT, RIGHT = 0, 1, 2
-MODE_NOMINAL, MODE_ENGINE, MODE_LEFT, MODE_RIGHT = 0, 1, 2, 3
-BLOCK_NAMES = {0: "none", 1: "thrust", 2: "elevons"}
 
 
 @dataclasses.dataclass(frozen=True)

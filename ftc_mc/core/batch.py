@@ -44,14 +44,8 @@ from __future__ import annotations
 
 from .jit import kernel
 
-N_X = 9
-N_F = 5
-N_AUG = 14
-N_Z = 12
-
-OUT_Q = 2
-OUT_NX = 6
-OUT_NZ = 7
+from ..conventions import N_AUG, N_X, N_Z, OUT_NX, OUT_NZ, OUT_Q  # noqa: F401
+from ..conventions import N_FAULT as N_F
 
 GROUP = 6
 """Unit rows of ``C`` updated per pass (longer runs are split, shorter padded)."""

@@ -30,9 +30,7 @@ from .interp import engine_controller
 from .jit import kernel
 from .kalman import predict, project, update
 
-C_NOMINAL = 0
-C_ENGINE = 1
-C_ELEVON = 2
+from ..conventions import C_ELEVON, C_ENGINE, C_NOMINAL  # noqa: E402,F401
 
 
 @kernel

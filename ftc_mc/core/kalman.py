@@ -17,18 +17,9 @@ All arrays are float64; work arrays come from the caller so no kernel allocates.
 
 from __future__ import annotations
 
+from ..conventions import N_AUG, N_B0, N_X, N_Z, OUT_NX, OUT_NZ, OUT_Q  # noqa: F401
+from ..conventions import N_FAULT as N_F
 from .jit import kernel
-
-N_X = 9
-N_B0 = 2
-N_F = 5
-N_AUG = 14
-N_Z = 12
-
-# measured outputs used by the residuals (eqs. 9-11)
-OUT_Q = 2
-OUT_NX = 6
-OUT_NZ = 7
 
 
 @kernel

@@ -12,11 +12,8 @@ the printed rule sends to the thrust block).
 
 from __future__ import annotations
 
+from ..conventions import NO_RESET, RESET_ELEVONS, RESET_THRUST  # noqa: F401
 from .jit import kernel
-
-NO_RESET = 0
-RESET_THRUST = 1
-RESET_ELEVONS = 2
 
 
 

@@ -43,16 +43,10 @@ from .jit import kernel
 from .nonlinear import make_work, outputs_nb, propagate
 from .settings import LaneState
 
-STATUS_OK = 0
-STATUS_NONFINITE = 1      # estimate or covariance not finite
-STATUS_NOT_PSD = 2        # covariance lost positive semi-definiteness
-STATUS_AIRSPEED = 3       # true airspeed outside the validity bounds
-STATUS_ALPHA = 4          # true angle of attack outside the validity bounds
-STATUS_NAMES = ("ok", "nonfinite", "covariance_not_psd", "airspeed_out_of_bounds",
-                "alpha_out_of_bounds")
+from ..conventions import (OUT_ALPHA, OUT_VA, STATUS_AIRSPEED, STATUS_ALPHA,  # noqa: E402
+                           STATUS_NAMES, STATUS_NONFINITE, STATUS_NOT_PSD, STATUS_OK)
+
 NO_SIGNAL = -(1 << 40)
-OUT_ALPHA = 8
-OUT_VA = 11
 
 
 @kernel

@@ -21,15 +21,8 @@ from pydantic import (BaseModel, BeforeValidator, ConfigDict, Field, ValidationE
 from ..errors import UserError
 from ..model.airframe import X8
 
-TRANSITIONS = ("elevon_lock", "elevon_unlock", "elevon_loss", "elevon_loss_recover",
-               "engine_lock", "engine_unlock", "engine_loss", "engine_loss_recover")
-"""The eight transitions of the paper's Tables 2-3 (DESIGN.md section 6)."""
-
-PLANT_KINDS = ("linear", "nonlinear")
-"""Truth plants a trial can fly (config ``plant.kind``), the paper's first."""
-
-TURBULENCE_LEVELS = ("none", "light", "moderate", "severe")
-"""MIL-F-8785C turbulence levels (config ``plant.turbulence``), weakest first."""
+from ..conventions import (ACTUATOR_NAMES, PLANT_KINDS, TRANSITIONS,  # noqa: F401
+                           TURBULENCE_LEVELS)
 
 
 def _no_bool(value):
@@ -464,7 +457,6 @@ def render_yaml(cfg: BaseModel, title: str) -> str:
     return "\n".join(lines)
 
 
-ACTUATOR_NAMES = ("engine", "left_elevon", "right_elevon")
 
 
 class FaultEvent(_Strict):

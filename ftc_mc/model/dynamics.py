@@ -37,15 +37,10 @@ import numpy as np
 
 from .airframe import Airframe
 
-N_STATE = 9
-N_INPUT = 3
-N_OUTPUT = 12
-
-STATE_NAMES = ("u", "w", "q", "x", "z", "theta", "thrust", "elevon_left",
-               "elevon_right")
-INPUT_NAMES = ("throttle", "elevon_left", "elevon_right")
-OUTPUT_NAMES = ("u", "w", "q", "x", "z", "theta", "n_x", "n_z", "alpha", "gamma",
-                "CAS", "Va")
+from ..conventions import INPUT_NAMES, OUTPUT_NAMES, STATE_NAMES  # noqa: F401
+from ..conventions import N_U as N_INPUT
+from ..conventions import N_X as N_STATE
+from ..conventions import N_Z as N_OUTPUT
 
 # Index of each entry of the packed parameter vector used by the kernels.
 (P_MASS, P_JY, P_S, P_C, P_RHO, P_G, P_CL0, P_CLA, P_CLQ, P_CLDE, P_CD0, P_CDA,

@@ -26,19 +26,9 @@ from __future__ import annotations
 
 import numpy as np
 
-N_B0 = 2
-N_B1 = 3
-N_FAULT = N_B0 + N_B1
-N_AUG = 9 + N_FAULT
-
-# indices in the augmented state
-I_B0_THRUST = 9
-I_B0_ELEVONS = 10
-I_B1_THRUST = 11
-I_B1_LEFT = 12
-I_B1_RIGHT = 13
-
-ACTUATORS = ("engine", "left_elevon", "right_elevon")
+from ..conventions import (I_B0_ELEVONS, I_B0_THRUST, I_B1_LEFT,  # noqa: F401
+                           I_B1_RIGHT, I_B1_THRUST, N_AUG, N_B0, N_B1, N_FAULT)
+from ..conventions import ACTUATOR_NAMES as ACTUATORS
 
 
 def effect(u, u0, b0, b1):

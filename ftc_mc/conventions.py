@@ -1,0 +1,110 @@
+"""Names and indices of states, outputs, parameters, modes, blocks and statuses.
+
+The one home of every name list and index the rest of the package shares, so a
+kernel, a table and a report agree on what "index 11" or "mode 2" means.  Pure
+Python constants (Numba reads module-level ints and tuples as compile-time
+constants).  See ``docs/paper-map.md`` for the paper's symbols.
+
+Plant and filter (DESIGN.md section 2, paper eqs. 1-5)
+------------------------------------------------------
+The linear plant's state has ``N_X = 9`` entries (:data:`STATE_NAMES`), its
+outputs ``N_Z = 12`` (:data:`OUTPUT_NAMES`, the paper's order), its commands
+``N_U = 3`` (:data:`INPUT_NAMES`).  The paper's augmented filter state is
+``[x (9), b0 (2), b1 (3)]`` (eq. 5, :data:`PARAM_NAMES` for the last five); a
+filter design with more states (gusts, sensor biases) appends them after the
+fault parameters, so kernels take the augmented dimension from their arrays'
+shapes, never from a literal.
+"""
+
+from __future__ import annotations
+
+# ------------------------------------------------------------------ plant
+STATE_NAMES = ("u", "w", "q", "x", "z", "theta", "thrust", "elevon_left", "elevon_right")
+"""States of the linear plant (body velocities [m/s], pitch rate [rad/s],
+position deviations [m], pitch [rad], then the three first-order actuators)."""
+
+INPUT_NAMES = ("throttle", "elevon_left", "elevon_right")
+"""Commands: throttle [-] and elevon deflections [rad]."""
+
+OUTPUT_NAMES = ("u", "w", "q", "x", "z", "theta", "n_x", "n_z", "alpha", "gamma", "CAS",
+                "Va")
+"""The 12 outputs in the paper's order (section 5.1)."""
+
+ACTUATOR_NAMES = ("engine", "left_elevon", "right_elevon")
+"""Actuators in command order."""
+
+N_X = len(STATE_NAMES)
+N_U = len(INPUT_NAMES)
+N_Z = len(OUTPUT_NAMES)
+
+OUT_Q = OUTPUT_NAMES.index("q")
+OUT_NX = OUTPUT_NAMES.index("n_x")
+OUT_NZ = OUTPUT_NAMES.index("n_z")
+OUT_ALPHA = OUTPUT_NAMES.index("alpha")
+OUT_VA = OUTPUT_NAMES.index("Va")
+
+# ------------------------------------------------------------------ fault parameters
+PARAM_NAMES = ("b0_thrust", "b0_elevons", "b1_thrust", "b1_left", "b1_right")
+"""The estimator's fault parameters (paper section 2.4): the thrust's bias, the
+elevons' bias *sum*, and the three effectiveness losses."""
+
+N_B0 = 2
+N_B1 = 3
+N_FAULT = N_B0 + N_B1
+N_AUG = N_X + N_FAULT
+"""Augmented dimension of the paper's filter (eq. 5)."""
+
+I_B0_THRUST = N_X + PARAM_NAMES.index("b0_thrust")
+I_B0_ELEVONS = N_X + PARAM_NAMES.index("b0_elevons")
+I_B1_THRUST = N_X + PARAM_NAMES.index("b1_thrust")
+I_B1_LEFT = N_X + PARAM_NAMES.index("b1_left")
+I_B1_RIGHT = N_X + PARAM_NAMES.index("b1_right")
+
+# ------------------------------------------------------------------ residuals, blocks
+RESIDUAL_NAMES = ("r_q", "r_nx", "r_nz")
+"""Normalised residuals of eqs. 9-11, on the outputs :data:`RESIDUAL_OUTPUTS`."""
+RESIDUAL_OUTPUTS = (OUT_Q, OUT_NX, OUT_NZ)
+
+NO_RESET = 0
+RESET_THRUST = 1
+RESET_ELEVONS = 2
+BLOCK_NAMES = ("none", "thrust", "elevons")
+"""Covariance blocks of Table 1, indexed by the block code."""
+
+THRUST_BLOCK = (PARAM_NAMES.index("b0_thrust"), PARAM_NAMES.index("b1_thrust"))
+ELEVON_BLOCK = (PARAM_NAMES.index("b0_elevons"), PARAM_NAMES.index("b1_left"),
+                PARAM_NAMES.index("b1_right"))
+"""Fault parameters (indices into :data:`PARAM_NAMES`) reset with each block."""
+
+VARIANTS = ("paper", "swapped")
+"""Table 1 as printed, and with its third clause's r_nz comparison swapped."""
+
+# ------------------------------------------------------------------ modes, controllers
+MODE_NAMES = ("nominal", "engine", "left_elevon", "right_elevon")
+"""The belief's four modes (section 3.3)."""
+N_MODES = len(MODE_NAMES)
+MODE_NOMINAL, MODE_ENGINE, MODE_LEFT_ELEVON, MODE_RIGHT_ELEVON = range(N_MODES)
+
+CONTROLLER_NAMES = ("c0 nominal", "c1 engine fault", "c2 elevon fault")
+"""Controllers of section 4, indexed by their code."""
+N_CONTROLLERS = len(CONTROLLER_NAMES)
+C_NOMINAL, C_ENGINE, C_ELEVON = range(N_CONTROLLERS)
+
+# ------------------------------------------------------------------ trial status
+STATUS_OK = 0
+STATUS_NONFINITE = 1
+STATUS_NOT_PSD = 2
+STATUS_AIRSPEED = 3
+STATUS_ALPHA = 4
+STATUS_NAMES = ("ok", "nonfinite", "covariance_not_psd", "airspeed_out_of_bounds",
+                "alpha_out_of_bounds")
+"""Why a trial stopped being trusted (``ok``: it ran to its end)."""
+
+# ------------------------------------------------------------------ campaigns, plants
+TRANSITIONS = ("elevon_lock", "elevon_unlock", "elevon_loss", "elevon_loss_recover",
+               "engine_lock", "engine_unlock", "engine_loss", "engine_loss_recover")
+"""The eight transitions of Tables 2-3 (DESIGN.md section 6)."""
+
+PLANT_KINDS = ("linear", "nonlinear")
+TURBULENCE_LEVELS = ("none", "light", "moderate", "severe")
+"""Truth plants and MIL-F-8785C turbulence levels (W20 = 0, 15, 30, 45 kt)."""
