@@ -151,8 +151,7 @@ def run_scenario(sc: ScenarioConfig, seed: int | None = None,
                                  f"[{plant.u_lower[a]:g}, {plant.u_upper[a]:g}]")
     inp, k_sw, b0, b1, modes = scenario_inputs(sc, setup)
     rec = new_record(setup, 1, 100_000, history=True)
-    run_trials(setup.fm, setup.det[sc.scenario.signature], setup.bs, setup.ctl, setup.exc,
-               setup.tim, setup.val, setup.rc, setup.eng, setup.truth, inp, rec)
+    run_trials(setup.scheme(sc.scenario.signature), setup.flight, inp, rec)
     ts = _timeseries(setup, sc, rec, k_sw, b0, b1)
     events = _events(ts, sc, rec, setup)
     segments = _segments(ts, sc, modes, setup)

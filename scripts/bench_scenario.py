@@ -130,8 +130,7 @@ def main():
     it = iter(recs)
 
     def kernel():
-        run_trials(setup.fm, det, setup.bs, setup.ctl, setup.exc, setup.tim, setup.val,
-                   setup.rc, setup.eng, setup.truth, inp, next(it))
+        run_trials(setup.scheme("paper", det), setup.flight, inp, next(it))
 
     kernel_s, kernel_min, kernel_max = median_time(kernel, args.repeat)
     # the timed kernel is the one run_scenario runs

@@ -28,8 +28,7 @@ def _run(setup, inp=None, ids=np.arange(4)):
     else:
         draws = np.zeros(len(ids))
     rec = new_record(setup, len(ids), 256)
-    run_trials(setup.fm, setup.det["paper"], setup.bs, setup.ctl, setup.exc, setup.tim,
-               setup.val, setup.rc, setup.eng, setup.truth, inp, rec)
+    run_trials(setup.scheme("paper"), setup.flight, inp, rec)
     trials, _ = classify(setup, "elevon_lock", "paper", ids, draws, inp, rec, 20)
     return rec, trials
 

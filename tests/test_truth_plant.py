@@ -47,8 +47,7 @@ def _cfg(kind="nonlinear", turbulence="none", **extra):
 
 def _run(setup, inp, L, det=None):
     rec = new_record(setup, L, 256, history=True)
-    run_trials(setup.fm, det or setup.det["swapped"], setup.bs, setup.ctl, setup.exc,
-               setup.tim, setup.val, setup.rc, setup.eng, setup.truth, inp, rec)
+    run_trials(setup.scheme("swapped", det), setup.flight, inp, rec)
     return rec
 
 

@@ -228,8 +228,7 @@ def run_chunk(setup: CampaignSetup, tr_name: str, trial_ids, seed: int, variants
     out = []
     for variant in variants:
         rec = new_record(setup, len(trial_ids), max_resets)
-        run_trials(setup.fm, setup.det[variant], setup.bs, setup.ctl, setup.exc,
-                   setup.tim, setup.val, setup.rc, setup.eng, setup.truth, inp, rec)
+        run_trials(setup.scheme(variant), setup.flight, inp, rec)
         out.append(classify(setup, tr_name, variant, trial_ids, draws, inp, rec,
                             window_steps))
     return out

@@ -12,8 +12,8 @@ import math
 import numpy as np
 
 from ..core.interp import EngineTables
-from ..core.settings import (Belief, Controller, Excitation, FilterModel,
-                             Reconfig, Timing, TruthPlant, Validity)
+from ..core.settings import (Belief, Controller, Excitation, FilterModel, Flight,
+                             Reconfig, Scheme, Timing, TruthPlant, Validity)
 from ..design.terminal import terminal_costs
 from ..design.theorem41 import cached_engine_tables
 from ..design.lqr import discounted_lqr, paper_q_lqr
@@ -85,6 +85,17 @@ class CampaignSetup:
     truth: TruthPlant
     gust: DrydenModel | None
     gust_chol: np.ndarray | None
+
+    def scheme(self, variant: str, detection=None) -> Scheme:
+        """The kernels' :class:`Scheme` for one signature variant (or ``detection``)."""
+        return Scheme(filter=self.fm, detection=self.det[variant] if detection is None
+                      else detection, belief=self.bs, controller=self.ctl,
+                      excitation=self.exc, reconfig=self.rc, engine=self.eng)
+
+    @property
+    def flight(self) -> Flight:
+        """The kernels' :class:`Flight`: timing, validity and truth plant."""
+        return Flight(timing=self.tim, validity=self.val, plant=self.truth)
 
 
 def variants_of(signature: str) -> tuple:

@@ -108,15 +108,8 @@ def _point_det(setup: CampaignSetup, cfg: Config, variant: str, tq: float, tnx: 
     return detection(setup.plant, s)
 
 
-def _args(setup):
-    return (setup.fm, None, setup.bs, setup.ctl, setup.exc, setup.tim, setup.val,
-            setup.rc, setup.eng, setup.truth)
-
-
 def _run(setup, det, inp, rec, st, k0, k1):
-    a = list(_args(setup))
-    a[1] = det
-    advance(*a, inp, rec, st, k0, k1)
+    advance(setup.scheme("paper", det), setup.flight, inp, rec, st, k0, k1)
 
 
 def _rerun(setup, det, inp, rec, lanes, max_resets):
@@ -125,9 +118,7 @@ def _rerun(setup, det, inp, rec, lanes, max_resets):
         return 0
     sub_inp = _take(inp, lanes)
     sub = new_record(setup, len(lanes), max_resets)
-    a = list(_args(setup))
-    a[1] = det
-    run_trials(*a, sub_inp, sub)
+    run_trials(setup.scheme("paper", det), setup.flight, sub_inp, sub)
     for f, v in sub._asdict().items():
         getattr(rec, f)[..., lanes] = v
     return len(lanes) * setup.tim.n_steps

@@ -127,6 +127,25 @@ Reconfig = namedtuple("Reconfig", [
 ])
 """Controller selection settings (paper section 4.2)."""
 
+Scheme = namedtuple("Scheme", [
+    "filter",      # FilterModel: the augmented Kalman filter (eqs. 4-6)
+    "detection",   # Detection: Table 1 thresholds, variant and reset variances
+    "belief",      # Belief: mode boxes and T_M (eqs. 12-14)
+    "controller",  # Controller: nominal gain and command limits (eqs. 15-19)
+    "excitation",  # Excitation: doublet and 3211 on resets (section 4.1.1)
+    "reconfig",    # Reconfig: controller selection (eqs. 45-47)
+    "engine",      # EngineTables: Theorem 4.1 tables of c1 (core/interp.py)
+])
+"""The fault-tolerant control scheme under test: estimator, detector, belief,
+controllers and their selection.  A threshold sweep varies only ``detection``."""
+
+Flight = namedtuple("Flight", [
+    "timing",    # Timing: steps, fault step, reconfiguration period
+    "validity",  # Validity: where a trial stops being trusted
+    "plant",     # TruthPlant: the simulated aircraft and air
+])
+"""What the scheme flies: the truth plant, how long, and its validity envelope."""
+
 LaneState = namedtuple("LaneState", [
     "x",        # (9, L) true plant state (deviation from trim)
     "xa",       # (14, L) augmented estimate

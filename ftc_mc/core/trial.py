@@ -85,16 +85,18 @@ def is_psd(P, l, work):
 
 
 @kernel
-def advance(fm, det, bs, ctl, exc, tim, val, rc, eng, pl, inp, rec, st, k0, k1):
+def advance(scheme, flight, inp, rec, st, k0, k1):
     """Advance ``L`` trials from step ``k0`` to ``k1``, writing their records.
 
     Parameters
     ----------
-    fm : FilterModel
-    det : Detection
-    bs : Belief
-    ctl : Controller
-    exc : Excitation
+    scheme : Scheme
+        The FTC scheme: ``filter`` (FilterModel), ``detection`` (Detection),
+        ``belief`` (Belief), ``controller`` (Controller), ``excitation``
+        (Excitation), ``reconfig`` (Reconfig) and ``engine`` (EngineTables).
+    flight : Flight
+        ``timing`` (Timing), ``validity`` (Validity) and ``plant`` (TruthPlant).
+    (fields, by the names used below)
     tim : Timing
     val : Validity
         A lane stops being recorded (its ``status`` and ``stop_k`` are set, later
@@ -128,6 +130,16 @@ def advance(fm, det, bs, ctl, exc, tim, val, rc, eng, pl, inp, rec, st, k0, k1):
     k0, k1 : int
         First step and end step (``0 <= k0 <= k1 <= tim.n_steps``).
     """
+    fm = scheme.filter
+    det = scheme.detection
+    bs = scheme.belief
+    ctl = scheme.controller
+    exc = scheme.excitation
+    rc = scheme.reconfig
+    eng = scheme.engine
+    tim = flight.timing
+    val = flight.validity
+    pl = flight.plant
     L = inp.w.shape[2]
     nx = 9
     n_res_max = rec.reset_k.shape[0]
@@ -453,7 +465,7 @@ def new_state(L):
 
 
 @kernel
-def run_trials(fm, det, bs, ctl, exc, tim, val, rc, eng, pl, inp, rec):
+def run_trials(scheme, flight, inp, rec):
     """Simulate ``L`` trials from the start to the end (see :func:`advance`).
 
     Parameters are those of :func:`advance` without the state and step range;
@@ -461,4 +473,4 @@ def run_trials(fm, det, bs, ctl, exc, tim, val, rc, eng, pl, inp, rec):
     """
     st = new_state(inp.w.shape[2])
     init_state(inp, st, rec)
-    advance(fm, det, bs, ctl, exc, tim, val, rc, eng, pl, inp, rec, st, 0, tim.n_steps)
+    advance(scheme, flight, inp, rec, st, 0, flight.timing.n_steps)
