@@ -34,8 +34,6 @@ import pandas as pd
 import scipy.stats
 import yaml
 
-from .campaign.summary import wilson
-from .campaign.sweep import poisson_ci
 from .campaign.transitions import TRANSITION_TABLE
 from .errors import UserError
 from .io.atomic import write_text
@@ -44,6 +42,7 @@ from .io.config import PLANT_KINDS, TRANSITIONS, TURBULENCE_LEVELS, TimingConfig
 from .io.lock import holder
 from .io.results import read_metadata
 from .scenario import PAPER_TIMELINE
+from .stats import poisson_ci, wilson
 
 RUN_TABLES = ("trials.parquet", "summary.parquet")
 """Parquet files a run directory must hold (``resets.parquet`` is optional)."""
