@@ -25,17 +25,7 @@ from .estimator import MODE_NAMES
 from .io.config import ACTUATOR_NAMES, ScenarioConfig
 
 from .conventions import CONTROLLER_NAMES  # noqa: E402
-
-PAPER_TIMELINE = {
-    # paper section 5.2: what happened after each switch of Table 4
-    "detection_s": {10.0: 3.0, 30.0: 8.0, 50.0: 3.0, 70.0: 6.0, 90.0: 3.0},
-    "controller_switches_s": (11.0, 12.0, 91.0),
-    "tracking_recovery_s": 15.0,
-}
-"""The paper's own timeline (section 5.2): detections 'less than 3 s' for the
-faults (given here as that bound), 8 s and 6 s for the recoveries of the engine,
-controller switches at 11 s, 12 s and 91 s, tracking recovered 15 s after the
-engine recovers."""
+from .paper import PAPER_TIMELINE
 
 
 @dataclasses.dataclass

@@ -11,10 +11,11 @@ from click.testing import CliRunner
 import ftc_mc
 from ftc_mc.campaign.chunk import build_inputs, classify, new_record
 from ftc_mc.campaign.setup import build_setup
-from ftc_mc.campaign.summary import summarize, wilson
+from ftc_mc.campaign.summary import summarize
 from ftc_mc.cli import cli
 from ftc_mc.io.config import Config, TRANSITIONS
 from ftc_mc.io.results import read_metadata
+from ftc_mc.stats import wilson
 
 SMALL = {"timing": {"fault_time_s": 5.0, "window_s": 5.0, "duration_s": 15.0}}
 

@@ -23,13 +23,13 @@ import pandas as pd
 import pytest
 from click.testing import CliRunner
 
-from ftc_mc.campaign.summary import wilson
 from ftc_mc.campaign.transitions import PAPER_TABLES, TRANSITION_TABLE
 from ftc_mc.cli import cli
 from ftc_mc.errors import UserError
 from ftc_mc.io.lock import acquire
 from ftc_mc.io.results import read_metadata, write_parquet
 from ftc_mc.report import build_report, exclusion_table, variant_comparison
+from ftc_mc.stats import wilson
 
 from result_dirs import copy_dir, same_stamp
 

@@ -1,35 +1,17 @@
 """The Tables 2-3 summary: one row per transition and signature variant.
 
-Rates carry 95 % Wilson score intervals (:meth:`scipy.stats.binomtest`'s
-``proportion_ci(method="wilson")``).  The paper's own counts stand beside ours.
+Rates carry 95 % Wilson score intervals (:func:`ftc_mc.stats.wilson`).  The
+paper's own counts stand beside ours.
 """
 
 from __future__ import annotations
 
 import numpy as np
 import pandas as pd
-import scipy.stats
 
 from ..core.trial import STATUS_NAMES
+from ..stats import median_p95, wilson
 from .transitions import PAPER_TABLES, TRANSITION_TABLE
-
-
-def wilson(k: int, n: int, confidence: float = 0.95):
-    """Wilson score interval of a binomial proportion.
-
-    Parameters
-    ----------
-    k, n : int
-        Successes and trials (``n >= 1``).
-    confidence : float
-
-    Returns
-    -------
-    (float, float)
-    """
-    ci = scipy.stats.binomtest(int(k), int(n)).proportion_ci(confidence_level=confidence,
-                                                             method="wilson")
-    return float(ci.low), float(ci.high)
 
 
 def _rate(prefix: str, k: int, n: int) -> dict:
@@ -39,11 +21,8 @@ def _rate(prefix: str, k: int, n: int) -> dict:
 
 
 def _quantiles(prefix: str, values: np.ndarray) -> dict:
-    v = values[np.isfinite(values)]
-    if len(v) == 0:
-        return {f"{prefix}_median_s": np.nan, f"{prefix}_p95_s": np.nan}
-    return {f"{prefix}_median_s": float(np.median(v)),
-            f"{prefix}_p95_s": float(np.quantile(v, 0.95))}
+    median, p95 = median_p95(values)
+    return {f"{prefix}_median_s": median, f"{prefix}_p95_s": p95}
 
 
 def summarize(trials: pd.DataFrame) -> pd.DataFrame:

@@ -25,7 +25,6 @@ import os
 
 import numpy as np
 import pandas as pd
-import scipy.stats
 from joblib import Parallel, delayed
 from tqdm.auto import tqdm
 
@@ -34,6 +33,7 @@ from ..core.trial import advance, init_state, new_state, run_trials
 from ..errors import UserError
 from ..estimator import detection
 from ..io.config import Config
+from ..stats import poisson_rate
 from .chunk import build_inputs, classify, draw_lanes, new_record
 from .parallel import backend as parallel_backend
 from .runner import _sorted, plan_chunks
@@ -238,13 +238,6 @@ class SweepResult:
         return 1.0 - self.simulated_steps / self.alone_steps
 
 
-def poisson_ci(k: int, exposure: float):
-    """Exact (Garwood) 95 % interval of a Poisson rate ``k / exposure``."""
-    lo = 0.0 if k == 0 else scipy.stats.chi2.ppf(0.025, 2 * k) / 2
-    hi = scipy.stats.chi2.ppf(0.975, 2 * k + 2) / 2
-    return lo / exposure, hi / exposure
-
-
 def run_sweep(cfg: Config, points, *, flights: int | None = None, jobs: int = 1,
               progress: bool = True, backend: str = "loky",
               scheduler: str | None = None, chunks=None) -> SweepResult:
@@ -331,10 +324,10 @@ def run_sweep(cfg: Config, points, *, flights: int | None = None, jobs: int = 1,
     rates = []
     for _, r in fsum.iterrows():
         exposure = r["judged"] * hours
-        lo, hi = poisson_ci(int(r["resets"]), exposure) if exposure else (np.nan, np.nan)
+        rate, lo, hi = poisson_rate(int(r["resets"]), exposure)
         rates.append({"t_q": r["t_q"], "t_nx": r["t_nx"], "variant": r["variant"],
                       "flight_hours": exposure, "flight_false_resets": int(r["resets"]),
-                      "false_resets_per_hour": r["resets"] / exposure if exposure else np.nan,
+                      "false_resets_per_hour": rate,
                       "false_resets_per_hour_ci_low": lo,
                       "false_resets_per_hour_ci_high": hi})
     table = table.merge(pd.DataFrame(rates), on=["t_q", "t_nx", "variant"], how="left")

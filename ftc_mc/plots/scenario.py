@@ -1,23 +1,10 @@
-"""Figures (matplotlib, Agg backend), written atomically as PNG."""
+"""The paper's Figs. 6-12 for one scenario (``ftc-mc scenario``)."""
 
 from __future__ import annotations
 
 from pathlib import Path
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-
-from .io.atomic import atomic_path  # noqa: E402
-
-
-def save(fig, path: Path) -> Path:
-    """Save ``fig`` to ``path`` (PNG) atomically and close it."""
-    with atomic_path(path, suffix=".png") as tmp:
-        fig.savefig(tmp, format="png", dpi=110, bbox_inches="tight")
-    plt.close(fig)
-    return path
+from .figure import plt, save
 
 
 def _switch_lines(ax, res):
@@ -27,6 +14,14 @@ def _switch_lines(ax, res):
 
 def scenario_figures(res, out: Path) -> list:
     """Figures like the paper's Figs. 6-12 for a :class:`ScenarioResult`.
+
+    Parameters
+    ----------
+    res : ftc_mc.scenario.ScenarioResult
+        One flight: its time series (time [s], errors [m], fault parameters,
+        residuals, beliefs, controller, commands) and its config (schedule).
+    out : Path
+        Folder of the PNG files (``fig06_trajectory.png`` ... ``fig12_commands.png``).
 
     Returns
     -------

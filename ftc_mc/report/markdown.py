@@ -1,0 +1,100 @@
+"""Formatting helpers shared by the report's sections.
+
+Numbers and counts as the report prints them, relative links to figures,
+file-name stems per input, transition labels, and the truth plant of a
+result's config.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from urllib.parse import quote
+
+import numpy as np
+
+from ..campaign.transitions import TRANSITION_TABLE
+from ..stats import wilson
+
+DEFAULT_PLANT = ("linear", "none")
+"""Truth plant of results written before the ``plant`` section existed; the
+reference condition of the plant comparison."""
+
+LABELS = {name: t.label for name, t in TRANSITION_TABLE.items()}
+"""Display label of each transition name (e.g. ``Engine nominal → Engine locked``)."""
+
+
+def label(name: str) -> str:
+    """The display label of a transition (the name itself if unknown)."""
+    return LABELS.get(name, name)
+
+
+def rel_link(target: Path, report: Path) -> str:
+    """URL-quoted POSIX path of ``target`` relative to the report's folder."""
+    rel = os.path.relpath(Path(target).resolve(), Path(report).resolve().parent)
+    return quote(Path(rel).as_posix())
+
+
+def num(x, fmt="{:.1f}") -> str:
+    """``x`` formatted with ``fmt``, ``-`` if it is None or not finite."""
+    return "-" if x is None or not np.isfinite(x) else fmt.format(x)
+
+
+def count(k: int, n: int, ci: bool = True) -> str:
+    """``k/n (rate %, CI low-high)``, with the 95 % Wilson interval if ``ci``."""
+    if not n:
+        return f"{k}/0"
+    text = f"{k}/{n} ({100 * k / n:.1f} %"
+    if ci:
+        lo, hi = wilson(k, n)
+        text += f", {100 * lo:.1f}-{100 * hi:.1f}"
+    return text + ")"
+
+
+def slugs(inputs: list) -> list:
+    """A distinct file-name stem per input (its directory name, made unique).
+
+    Parameters
+    ----------
+    inputs : list of ResultDir
+
+    Returns
+    -------
+    list of str
+    """
+    out, used = [], set()
+    for r in inputs:
+        base = "".join(c if c.isalnum() or c in "-_." else "_"
+                       for c in r.path.resolve().name) or "input"
+        slug, n = base, 1
+        while slug in used:
+            n += 1
+            slug = f"{base}-{n}"
+        used.add(slug)
+        out.append(slug)
+    return out
+
+
+def plant_condition(cfg: dict) -> tuple:
+    """The truth plant of a config: ``(plant.kind, plant.turbulence)``.
+
+    Parameters
+    ----------
+    cfg : dict
+        The config stored in a result's metadata.
+
+    Returns
+    -------
+    (str, str)
+        :data:`DEFAULT_PLANT` for results written before the ``plant`` section
+        existed (or a field missing from it).
+    """
+    plant = cfg.get("plant") or {}
+    return (str(plant.get("kind", DEFAULT_PLANT[0])),
+            str(plant.get("turbulence", DEFAULT_PLANT[1])))
+
+
+def plant_text(cfg: dict) -> str:
+    """``truth plant `kind`, turbulence `level``` of a config."""
+    kind, turbulence = plant_condition(cfg)
+    return f"truth plant `{kind}`, turbulence `{turbulence}`"

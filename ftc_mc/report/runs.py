@@ -1,0 +1,321 @@
+"""The report section of one run (``ftc-mc run``).
+
+Tables 2-3 beside the paper's counts, per signature variant, with 95 % Wilson
+intervals (:func:`paper_tables`); the excluded trials and why
+(:func:`exclusion_table`); a paired comparison of the signature variants with
+an exact McNemar test (:func:`variant_comparison`); a link to the delay figure
+(``ftc_mc/plots/campaign.py``).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pandas as pd
+
+from ..stats import mcnemar_exact, wilson
+from .load import ResultDir
+from .markdown import LABELS, count, label, num, plant_text, rel_link
+
+SIGNIFICANCE = 0.05
+"""Level of the paired (McNemar) test between signature variants."""
+
+
+# ------------------------------------------------------------------ Tables 2-3
+
+
+def _vs_paper(r: pd.Series) -> str:
+    """Where our 95 % interval lies wholly above or below the paper's."""
+    notes = []
+    for col in ("inappropriate", "no_reset"):
+        lo, hi = wilson(r[f"paper_{col}"], r["paper_trials"])
+        if r["trials"] and r[f"{col}_ci_low"] > hi:
+            notes.append(f"{col.replace('_', ' ')} higher")
+        elif r["trials"] and r[f"{col}_ci_high"] < lo:
+            notes.append(f"{col.replace('_', ' ')} lower")
+    return ", ".join(notes) or "consistent"
+
+
+def _paper_row(r: pd.Series) -> dict:
+    """One row of the ours-beside-the-paper table."""
+    n = int(r["trials"])
+    return {
+        "transition": r["label"], "judged": n,
+        "inappropriate: ours": count(int(r["inappropriate"]), n),
+        "inappropriate: paper": count(int(r["paper_inappropriate"]),
+                                      int(r["paper_trials"])),
+        "no reset: ours": count(int(r["no_reset"]), n),
+        "no reset: paper": count(int(r["paper_no_reset"]), int(r["paper_trials"])),
+        "no reset explained": num(100 * r["no_reset_explained_share"], "{:.0f} %"),
+        "correct block": count(int(r["correct"]), n, ci=False),
+        "reset delay median / p95 [s]":
+            f"{num(r['delay_median_s'])} / {num(r['delay_p95_s'])}",
+        "detection median / p95 [s]":
+            f"{num(r['detection_median_s'])} / {num(r['detection_p95_s'])}",
+        "false-alarm trials": int(r["false_alarm_trials"]),
+        "95 % CIs vs paper": _vs_paper(r),
+    }
+
+
+def paper_tables(summary: pd.DataFrame) -> list:
+    """Markdown lines: Tables 2-3 beside the paper's, one table per variant.
+
+    Parameters
+    ----------
+    summary : DataFrame
+        ``summary.parquet`` of a run.
+
+    Returns
+    -------
+    list of str
+    """
+    lines = []
+    for variant, g in summary.groupby("variant", sort=False):
+        lines += [f"#### Signature `{variant}`", "",
+                  pd.DataFrame([_paper_row(r) for _, r in g.iterrows()])
+                  .to_markdown(index=False), ""]
+    lines += ["Counts are `k/n (rate %, 95 % Wilson CI)`, over judged trials only; the "
+              "paper's counts are from its Tables 2-3 (one set for both variants). "
+              "*95 % CIs vs paper* says where our interval lies wholly above or below "
+              "the paper's.", ""]
+    return lines
+
+
+# ------------------------------------------------------------------ exclusions
+
+
+def window_end_s(cfg: dict) -> float | None:
+    """End of the judging window, ``timing.fault_time_s + timing.window_s`` [s].
+
+    Parameters
+    ----------
+    cfg : dict
+        The config stored in a run's metadata.
+
+    Returns
+    -------
+    float or None
+        None if the config lacks either field.
+    """
+    timing = cfg.get("timing", {})
+    return (timing["fault_time_s"] + timing["window_s"]
+            if {"fault_time_s", "window_s"} <= timing.keys() else None)
+
+
+def exclusion_reason(t: pd.DataFrame, window_end: float | None) -> pd.Series:
+    """Why each trial of ``t`` (not judged) was excluded.
+
+    Parameters
+    ----------
+    t : DataFrame
+        Trials that were not judged (rows of ``trials.parquet``).
+    window_end : float or None
+        :func:`window_end_s` [s]; None: every early stop counts.
+
+    Returns
+    -------
+    Series of str
+        The stop status, ``resets_truncated`` or ``unknown``.
+    """
+    numeric = t["status"].isin(["nonfinite", "covariance_not_psd"])
+    early = t["status"].ne("ok") & (t["stop_s"] <= window_end + 1e-9
+                                    if window_end is not None else True)
+    stopped = t["status"].where(numeric | early)
+    reason = stopped.fillna(pd.Series("resets_truncated", index=t.index)
+                            .where(t["resets_truncated"]))
+    return reason.fillna("unknown")
+
+
+def why(reasons: pd.Series) -> str:
+    """``reason count, ...`` of :func:`exclusion_reason`, ``-`` if empty."""
+    counts = reasons.value_counts()
+    return ", ".join(f"{k} {v}" for k, v in counts.items()) or "-"
+
+
+def _stopped(r: pd.Series) -> str:
+    cols = [c for c in r.index if c.startswith("stopped_")]
+    parts = [f"{c[len('stopped_'):]} {int(r[c])}" for c in cols if r[c]]
+    return ", ".join(parts) or "-"
+
+
+def exclusion_table(summary: pd.DataFrame, trials: pd.DataFrame, config: dict) -> list:
+    """Markdown lines: excluded trials per transition and variant, and why.
+
+    Parameters
+    ----------
+    summary, trials : DataFrame
+        ``summary.parquet`` and ``trials.parquet`` of a run.
+    config : dict
+        The config stored in the run's metadata.
+
+    Returns
+    -------
+    list of str
+    """
+    end = window_end_s(config)
+    out = trials[~trials["judged"]]
+    reasons = exclusion_reason(out, end) if len(out) else pd.Series(dtype=object)
+    rows = []
+    for _, r in summary.iterrows():
+        sel = (out["transition"] == r["transition"]) & (out["variant"] == r["variant"])
+        if not r["excluded"] and _stopped(r) == "-":
+            continue
+        rows.append({"transition": r["label"], "signature": r["variant"],
+                     "run": int(r["trials"] + r["excluded"]), "excluded": int(r["excluded"]),
+                     "why excluded": why(reasons[sel]),
+                     "stopped at any time (stopped_*)": _stopped(r)})
+    if not rows:
+        return ["No trial was excluded or stopped early.", ""]
+    return [pd.DataFrame(rows).to_markdown(index=False), "",
+            "A trial is excluded from the rates when it failed numerically, left the "
+            "validity envelope before the end of the judging window"
+            + (f" ({end:g} s)" if end is not None else "")
+            + ", or had more resets than it could store (`resets_truncated`); a trial stopped "
+            "after the window still counts.", ""]
+
+
+# ------------------------------------------------------------------ variant choice
+
+
+def paired_counts(trials: pd.DataFrame, a: str, b: str, col: str) -> pd.DataFrame:
+    """Per transition, ``col`` of variants ``a`` and ``b`` on the same trials.
+
+    Only trials judged in both variants enter.  The p-value is the exact
+    McNemar test (:func:`ftc_mc.stats.mcnemar_exact`).
+
+    Parameters
+    ----------
+    trials : DataFrame
+        ``trials.parquet`` of a run with both variants.
+    a, b : str
+        The two signature variants.
+    col : str
+        A boolean outcome column, e.g. ``inappropriate``.
+
+    Returns
+    -------
+    DataFrame
+        ``transition, n, a, b, only_a, only_b, p``.
+    """
+    rows = []
+    for name, g in trials.groupby("transition", sort=False):
+        wide = g.pivot_table(index="trial_id", columns="variant",
+                             values=[col, "judged"], aggfunc="first")
+        both = wide["judged"].reindex(columns=[a, b]).fillna(False).astype(bool).all(axis=1)
+        x = wide[col].reindex(columns=[a, b])[both].astype(bool)
+        only_a = int((x[a] & ~x[b]).sum())
+        only_b = int((x[b] & ~x[a]).sum())
+        rows.append({"transition": name, "n": int(both.sum()), "a": int(x[a].sum()),
+                     "b": int(x[b].sum()), "only_a": only_a, "only_b": only_b,
+                     "p": mcnemar_exact(only_a, only_b)})
+    return pd.DataFrame(rows)
+
+
+def _verdict(inap: pd.DataFrame, a: str, b: str) -> str:
+    """The sentence naming the better variant, with its numbers."""
+    sig = inap[inap["p"] < SIGNIFICANCE]
+    a_better = sig[sig["a"] < sig["b"]]
+    b_better = sig[sig["b"] < sig["a"]]
+
+    def cite(df):
+        return "; ".join(f"{label(r.transition)}: {r.a}/{r.n} vs {r.b}/{r.n}, "
+                         f"p = {r.p:.2g}" for r in df.itertuples()) or "none"
+
+    n_tr = len(inap)
+    if len(a_better) and len(b_better):
+        head = (f"**Neither variant is better everywhere**: `{a}` has fewer inappropriate "
+                f"resets in {len(a_better)} transition(s) ({cite(a_better)}), `{b}` in "
+                f"{len(b_better)} ({cite(b_better)}).")
+    elif len(a_better) or len(b_better):
+        win, lose, df = (a, b, a_better) if len(a_better) else (b, a, b_better)
+        head = (f"**`{win}` is better**: fewer inappropriate resets than `{lose}` in "
+                f"{len(df)} of {n_tr} transitions ({cite(df)}) and more in none.")
+    else:
+        head = (f"**Neither variant is better on this data**: no transition shows a "
+                f"significant difference in inappropriate resets (of {n_tr}).")
+    tot = (f" Over all transitions: `{a}` {inap['a'].sum()}/{inap['n'].sum()}, "
+           f"`{b}` {inap['b'].sum()}/{inap['n'].sum()} inappropriate.")
+    return head + tot
+
+
+def _no_reset_note(nr: pd.DataFrame, a: str, b: str) -> str:
+    diff = nr[nr["a"] != nr["b"]]
+    if not len(diff):
+        return "The no-reset counts are identical for both variants in every transition."
+    return ("No-reset counts differ in " + "; ".join(
+        f"{label(r.transition)} ({a} {r.a}/{r.n}, {b} {r.b}/{r.n}, p = {r.p:.2g})"
+        for r in diff.itertuples()) + "; weigh these against the inappropriate resets.")
+
+
+def variant_comparison(trials: pd.DataFrame) -> list:
+    """Markdown lines: which signature variant is better, from paired trials.
+
+    Parameters
+    ----------
+    trials : DataFrame
+        ``trials.parquet`` of a run.
+
+    Returns
+    -------
+    list of str
+    """
+    variants = list(dict.fromkeys(trials["variant"]))
+    if len(variants) != 2:
+        return [f"Only the `{'`, `'.join(variants)}` variant was run; nothing to compare.",
+                ""]
+    a, b = variants
+    inap = paired_counts(trials, a, b, "inappropriate")
+    nr = paired_counts(trials, a, b, "no_reset")
+    table = pd.DataFrame({
+        "transition": inap["transition"].map(label), "paired trials": inap["n"],
+        f"inappropriate `{a}`": inap["a"], f"inappropriate `{b}`": inap["b"],
+        f"only `{a}`": inap["only_a"], f"only `{b}`": inap["only_b"],
+        "McNemar p": inap["p"].map(lambda p: f"{p:.2g}"),
+        f"no reset `{a}`": nr["a"], f"no reset `{b}`": nr["b"]})
+    return [_verdict(inap, a, b) + " " + _no_reset_note(nr, a, b), "",
+            table.to_markdown(index=False), "",
+            "Both variants run on the same draws and noise, so the comparison is "
+            "paired: trial by trial on the trials judged in both variants, with an exact "
+            f"McNemar test (difference called significant at p < {SIGNIFICANCE}).", ""]
+
+
+# ------------------------------------------------------------------ section
+
+
+def _run_header(cfg: dict) -> str:
+    c = cfg.get("campaign", {})
+    return (f"{len(c.get('transitions', []))} transition(s), {c.get('trials', '?')} trials "
+            f"each, seed {c.get('seed', '?')}, signature `{c.get('signature', '?')}`, "
+            f"controller `{cfg.get('controller', {}).get('kind', '?')}`, "
+            f"{plant_text(cfg)}.")
+
+
+def run_section(r: ResultDir, fig_dir: Path, slug: str, report: Path) -> list:
+    """Markdown lines of one run.
+
+    Parameters
+    ----------
+    r : ResultDir
+        A run directory.
+    fig_dir : Path
+        Folder of the report's figures (``<slug>_delays.png`` is written there).
+    slug : str
+        The run's file-name stem (:func:`ftc_mc.report.markdown.slugs`).
+    report : Path
+        The report file (for the relative link).
+
+    Returns
+    -------
+    list of str
+    """
+    from ..plots.campaign import delay_figure  # matplotlib only when drawing
+
+    summary, trials = r.tables["summary"], r.tables["trials"]
+    cfg = r.meta.get("config", {})
+    fig = delay_figure(trials, fig_dir / f"{slug}_delays.png", LABELS)
+    return ([f"## Run `{r.path}`", "", _run_header(cfg), "",
+             "### Tables 2-3: ours beside the paper", ""] + paper_tables(summary)
+            + ["### Excluded trials", ""] + exclusion_table(summary, trials, cfg)
+            + ["### Which signature variant is better", ""] + variant_comparison(trials)
+            + ["### Delay distributions", "", f"![delays of {slug}]({rel_link(fig, report)})",
+               ""])

@@ -1,0 +1,100 @@
+"""The report section of one threshold sweep (``ftc-mc sweep``).
+
+The trade-off figure (``ftc_mc/plots/campaign.py``) and the threshold point
+recommended for each signature variant (:func:`recommend_threshold`).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pandas as pd
+
+from .load import ResultDir
+from .markdown import LABELS, plant_text, rel_link
+
+FALSE_RESET_TARGET_PER_H = 0.01
+"""Largest acceptable false-reset rate when recommending a threshold: one per
+100 flight hours [1/h]."""
+
+
+def recommend_threshold(table: pd.DataFrame, variant: str,
+                        target: float = FALSE_RESET_TARGET_PER_H):
+    """The threshold point a sweep recommends for one signature variant.
+
+    Among the points whose false-reset rate per flight hour is at most
+    ``target``, the one with the smallest mean over transitions of the
+    inappropriate-reset rate plus the *unexplained* no-reset rate (no-reset
+    trials not explained by a small ``b1`` or a lock near trim).  If no point
+    meets the target, the point with the fewest false resets.
+
+    Parameters
+    ----------
+    table : DataFrame
+        ``sweep.parquet``.
+    variant : str
+        Signature variant.
+    target : float
+        Largest acceptable false-reset rate [1/h].
+
+    Returns
+    -------
+    (float, float, str)
+        ``t_q``, ``t_nx`` and the reasoning in one sentence.
+    """
+    g = table[table["variant"] == variant].copy()
+    explained = g["no_reset_explained_share"].fillna(0.0)
+    g["cost"] = g["inappropriate_rate"] + g["no_reset_rate"] * (1.0 - explained)
+    per = g.groupby(["t_q", "t_nx"]).agg(cost=("cost", "mean"),
+                                         false=("false_resets_per_hour", "first"),
+                                         upper=("false_resets_per_hour_ci_high", "first"))
+    ok = per[per["false"] <= target]
+    if len(ok):
+        (tq, tnx), row = ok["cost"].idxmin(), ok.loc[ok["cost"].idxmin()]
+        why = (f"lowest mean inappropriate + unexplained no-reset rate "
+               f"({100 * row['cost']:.2f} %) among the {len(ok)} points with at most "
+               f"{target:g} false resets per flight hour (here {row['false']:.3g}; "
+               f"95 % upper bound {row['upper']:.3g} from the flights flown)")
+    else:
+        (tq, tnx) = per["false"].idxmin()
+        row = per.loc[(tq, tnx)]
+        why = (f"no point reaches {target:g} false resets per flight hour; this one has "
+               f"the fewest ({row['false']:.3g}); more fault-free flights or higher "
+               "thresholds are needed")
+    return float(tq), float(tnx), why
+
+
+def sweep_section(r: ResultDir, fig_dir: Path, slug: str, report: Path) -> list:
+    """Report section of one sweep: trade-off plots and the recommended threshold.
+
+    Parameters
+    ----------
+    r : ResultDir
+        A sweep directory.
+    fig_dir : Path
+        Folder of the report's figures (``<slug>_sweep.png`` is written there).
+    slug : str
+        The sweep's file-name stem.
+    report : Path
+        The report file (for the relative link).
+
+    Returns
+    -------
+    list of str
+    """
+    from ..plots.campaign import sweep_figure  # matplotlib only when drawing
+
+    t = r.tables["sweep"]
+    fig = sweep_figure(t, fig_dir / f"{slug}_sweep.png", FALSE_RESET_TARGET_PER_H, LABELS)
+    lines = [f"## Sweep `{r.path}`", "",
+             f"{t[['t_q', 't_nx']].drop_duplicates().shape[0]} threshold points, "
+             f"{t['transition'].nunique()} transition(s), variants "
+             f"{', '.join(sorted(t['variant'].unique()))}, "
+             f"{plant_text(r.meta.get('config', {}))}.", "",
+             f"![threshold trade-off]({rel_link(fig, report)})", "",
+             "### Recommended threshold", ""]
+    for variant in sorted(t["variant"].unique()):
+        tq, tnx, why = recommend_threshold(t, variant)
+        lines.append(f"- `{variant}`: **t_q = {tq:g}, t_nx = {tnx:g}**: {why}.")
+    lines.append("")
+    return lines
