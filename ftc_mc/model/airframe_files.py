@@ -286,6 +286,8 @@ LINEAR_MODEL_VARIABLES: dict[str, tuple[tuple[int, ...], str]] = {
 
 
 def _load_npz(path: Path) -> dict:
+    if not zipfile.is_zipfile(path):  # np.load would try it as .npy or a pickle
+        raise ValueError("not a zip archive")
     with np.load(path, allow_pickle=False) as data:
         return {k: data[k] for k in data.files}
 
@@ -340,6 +342,8 @@ def load_linear_model(path) -> LinearPlant:
     except (OSError, ValueError, EOFError, TypeError, KeyError, NotImplementedError,
             zipfile.BadZipFile, zlib.error, scipy.io.matlab.MatReadError) as exc:
         first = (str(exc).splitlines() or [type(exc).__name__])[0]
+        if isinstance(exc, NotImplementedError):  # scipy's words for v7.3 files
+            first = "MATLAB v7.3 (HDF5) files are not read; save with -v7"
         kind = "NumPy .npz" if suffix == ".npz" else "MATLAB .mat"
         raise UserError(f"linear model: not a readable {kind} file "
                         f"({_REPR.repr(first)[1:-1]}){tail}") from None
@@ -365,10 +369,9 @@ def load_linear_model(path) -> LinearPlant:
                             f"{a.shape}{tail}")
         a = np.array(a, dtype=np.float64, order="C")  # a copy; keeps 0-d scalars
         if not np.all(np.isfinite(a)):
+            at = np.argwhere(~np.isfinite(a))[0]
             raise UserError(f"linear model: {name}: must be finite, got "
-                            f"{a.flat[np.flatnonzero(~np.isfinite(a))[0]]!r} "
-                            f"at index {np.argwhere(~np.isfinite(a))[0].tolist()}"
-                            f"{tail}")
+                            f"{float(a[tuple(at)])!r} at index {at.tolist()}{tail}")
         v[name] = a
     for name in ("dt", "V0"):
         if not v[name] > 0:
