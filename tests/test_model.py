@@ -148,6 +148,10 @@ def test_cli_model_json(tmp_path):
     saved = np.load(out)
     assert saved["A"].shape == (9, 9) and saved["C"].shape == (12, 9)
     assert float(saved["dt"]) == 0.1
+    # everything a linear trial uses (ftc_mc/model/summary.py: save_npz)
+    assert saved.files == ["A", "B", "C", "u0", "u_lower", "u_upper", "dt", "x0",
+                           "y0", "alpha", "V0", "gamma0", "Bw", "Dw"]
+    assert saved["Bw"].shape == (9, 3) and saved["Dw"].shape == (12, 3)
 
 
 def test_cli_model_bad_input_is_one_line(tmp_path):

@@ -1,22 +1,27 @@
-"""Skywalker X8 longitudinal airframe parameters.
+"""Longitudinal airframe parameters, and today's rounded Skywalker X8 (``X8``).
 
-Source of every aerodynamic number below: K. Gryte, R. Hann, M. Alam, J. Rohac,
-T. A. Johansen, T. I. Fossen, "Aerodynamic modeling of the Skywalker X8 Fixed-Wing
-Unmanned Aerial Vehicle", ICUAS 2018, as transcribed in DESIGN.md section 2.
-Second sources checked: the authors' own simulator README (github krisgry/x8)
-states Cm_alpha = -0.4629, Cm_0 = 0.0227, Cm_delta_e = -0.2292 and that the thrust
-model is the Aerosonde one of Beard & McLain, "Small Unmanned Aircraft" (2012);
-a public Python transcription of ``x8_param.mat`` gives mass 3.364 kg and
-Jy 0.1702 kg m^2.  The drag polar is the quadratic fit
-``CD = 0.0197 + 0.0791 a + 1.0555 a**2 + 0.0633 de**2`` of DESIGN.md.
+:class:`Airframe` holds the coefficient set of the longitudinal model of
+``ftc_mc/model/dynamics.py``.  The cited, full-precision copies of the two public
+X8 parameter files are the presets of ``ftc_mc/model/presets.py``
+(``x8-gryte2018``, ``x8-pyfly``; ``docs/airframes.md`` compares them); a user's
+own aircraft comes from a YAML file (``ftc_mc/model/airframe_files.py``).
 
-Choices that are ours, not Gryte's (see ``docs/model.md``):
+:data:`X8` (the defaults of :class:`Airframe`) is the airframe the tool has flown
+so far: the values of ``x8-gryte2018`` rounded to about 4 digits (c 0.3571 for
+0.35714285714285715, CL0 0.0867, CLde 0.2781, CDa 0.0791, CDa2 1.0555, CDde2
+0.0633, Cmq -1.3012, S_prop 0.1018, ...).  It stays unchanged because the golden
+results of ``tests/test_golden.py`` pin it; its trim at 20 m/s, -3 deg differs
+from the preset's in the fourth digit of alpha (1.0737 against 1.0731 deg).
+
+Choices that are ours, not the parameter files' (the same in ``X8`` and both
+presets; ``docs/airframes.md``):
 
 * actuator time constants: engine 0.3 s (same order as the short-period mode,
   paper section 2.4), elevons 0.05 s;
 * command limits: throttle [0, 1] (absolute), each elevon [-30 deg, +30 deg]
   (absolute, symmetric range in rad);
-* sea-level air, so calibrated airspeed equals true airspeed.
+* sea-level air (rho 1.225 kg/m^3, g 9.81 m/s^2), so calibrated airspeed equals
+  true airspeed.
 """
 
 from __future__ import annotations
@@ -30,7 +35,9 @@ G0 = 9.81
 
 @dataclasses.dataclass(frozen=True)
 class Airframe:
-    """Longitudinal Skywalker X8 parameters (SI units, angles in rad).
+    """Longitudinal airframe parameters (SI units, angles in rad).
+
+    The defaults are today's rounded X8 (:data:`X8`, module docstring).
 
     Parameters
     ----------
@@ -136,4 +143,7 @@ class Airframe:
 
 
 X8 = Airframe()
-"""The default Skywalker X8 airframe."""
+"""Today's Skywalker X8: the ``x8-gryte2018`` values rounded to about 4 digits.
+
+Kept unchanged (golden results pin it); the cited full-precision copies are in
+``ftc_mc/model/presets.py``."""

@@ -16,6 +16,7 @@ import scipy.differentiate
 import scipy.optimize
 import scipy.signal
 
+from ..errors import UserError
 from .airframe import X8, Airframe
 from .dynamics import (N_INPUT, N_OUTPUT, N_STATE, derivatives, outputs,
                        pack_parameters)
@@ -37,8 +38,9 @@ class TrimPoint:
         Trim angle of attack [rad].
     V0, gamma0 : float
         Airspeed [m/s] and flight-path angle [rad] of the trim.
-    params : ndarray, shape (25,)
-        Packed parameters used (airframe and glide path).
+    params : ndarray, shape (25,) or None
+        Packed parameters used (airframe and glide path); ``None`` for the trim
+        of a linear model read from a file.
     """
 
     x0: np.ndarray
@@ -50,12 +52,19 @@ class TrimPoint:
     params: np.ndarray
 
 
-def trim(airframe: Airframe = X8, V0: float = 20.0, gamma0_deg: float = -3.0
-         ) -> TrimPoint:
-    """Trim the X8 in a steady straight glide.
+def _fmt(value: float) -> str:
+    """Short decimal text of a number for error lines (4 significant digits)."""
+    return f"{value:.4g}"
+
+
+def trim(airframe: Airframe = X8, V0: float = 20.0, gamma0_deg: float = -3.0,
+         alpha_range: tuple | None = None) -> TrimPoint:
+    """Trim the airframe in a steady straight glide (or climb).
 
     Solves ``du/dt = dw/dt = dq/dt = 0`` for angle of attack, throttle and
-    (symmetric) elevon deflection with ``theta = alpha + gamma0`` and ``q = 0``.
+    (symmetric) elevon deflection with ``theta = alpha + gamma0`` and ``q = 0``,
+    then refuses a condition the airframe cannot fly: throttle or elevon outside
+    its range, angle of attack outside ``alpha_range``, or no equilibrium found.
 
     Parameters
     ----------
@@ -64,7 +73,10 @@ def trim(airframe: Airframe = X8, V0: float = 20.0, gamma0_deg: float = -3.0
     V0 : float
         Airspeed [m/s], > 0.
     gamma0_deg : float
-        Flight-path angle [deg], negative when descending.
+        Flight-path angle [deg], within (-30, 30), negative when descending.
+    alpha_range : tuple of float, optional
+        ``(alpha_min, alpha_max)`` [rad]: the angles of attack where the
+        aerodynamic model is trusted.  ``None`` (default): no check.
 
     Returns
     -------
@@ -72,14 +84,25 @@ def trim(airframe: Airframe = X8, V0: float = 20.0, gamma0_deg: float = -3.0
 
     Raises
     ------
+    UserError
+        One line naming ``model.airspeed_mps`` and/or ``model.gamma_deg`` and
+        what is wrong: a non-finite or non-positive airspeed, a flight-path angle
+        outside (-30, 30) deg, no equilibrium found, or a trim throttle, elevon or
+        angle of attack outside its range.
     ValueError
-        If ``V0`` is not positive or no trim exists within the command limits.
+        If ``alpha_range`` is not two finite numbers with ``lo < hi``.
     """
-    if not (math.isfinite(V0) and V0 > 0):
-        raise ValueError(f"trim parameter 'V0' must be a finite number > 0, got {V0!r}")
-    if not (math.isfinite(gamma0_deg) and abs(gamma0_deg) < 30):
-        raise ValueError("trim parameter 'gamma0_deg' must be finite and within "
-                         f"(-30, 30) deg, got {gamma0_deg!r}")
+    if not (isinstance(V0, (int, float)) and math.isfinite(V0) and V0 > 0):
+        raise UserError(f"model.airspeed_mps: must be a finite number > 0, got {V0!r}")
+    if not (isinstance(gamma0_deg, (int, float)) and math.isfinite(gamma0_deg)
+            and abs(gamma0_deg) < 30):
+        raise UserError("model.gamma_deg: must be finite and within (-30, 30) deg, "
+                        f"got {gamma0_deg!r}")
+    if alpha_range is not None:
+        a_lo, a_hi = (float(v) for v in alpha_range)
+        if not (math.isfinite(a_lo) and math.isfinite(a_hi) and a_lo < a_hi):
+            raise ValueError("trim parameter 'alpha_range' must be two finite numbers "
+                             f"lo < hi [rad], got {alpha_range!r}")
     gamma0 = math.radians(gamma0_deg)
     p = pack_parameters(airframe, V0, gamma0)
 
@@ -96,12 +119,31 @@ def trim(airframe: Airframe = X8, V0: float = 20.0, gamma0_deg: float = -3.0
 
     sol = scipy.optimize.root(residual, np.array([0.02, 0.1, 0.05]), tol=1e-14)
     alpha, thr, de = sol.x
+    # Converged means an equilibrium to 1e-9 (m/s^2, rad/s^2): the solver's own
+    # flag is not used, since with tol=1e-14 it reports "not making good
+    # progress" at residuals of 1e-15 for some airframes.
+    res = np.max(np.abs(residual(sol.x))) if np.all(np.isfinite(sol.x)) else math.inf
+    where = (f"model.airspeed_mps={V0:g}, model.gamma_deg={gamma0_deg:g}: "
+             "the airframe cannot fly this condition:")
+    if not (math.isfinite(res) and res <= 1e-9):
+        raise UserError(f"{where} no equilibrium found (residual {res:.2g}; "
+                        f"solver: {' '.join(sol.message.split())})")
+    problems = []
     lo_t, hi_t = airframe.throttle_limits
+    if thr > hi_t:
+        problems.append(f"trim throttle {_fmt(thr)} above its maximum {_fmt(hi_t)}")
+    elif thr < lo_t:
+        problems.append(f"trim throttle {_fmt(thr)} below its minimum {_fmt(lo_t)}")
     lo_e, hi_e = airframe.elevon_limits
-    if (not sol.success or np.max(np.abs(residual(sol.x))) > 1e-9
-            or not lo_t <= thr <= hi_t or not lo_e <= de <= hi_e):
-        raise ValueError(f"no trim within the command limits at V0={V0} m/s, "
-                         f"gamma0={gamma0_deg} deg (solver: {sol.message})")
+    if not lo_e <= de <= hi_e:
+        problems.append(f"trim elevon {_fmt(de)} rad outside its range "
+                        f"[{_fmt(lo_e)}, {_fmt(hi_e)}] rad")
+    if alpha_range is not None and not a_lo <= alpha <= a_hi:
+        problems.append(f"trim angle of attack {_fmt(math.degrees(alpha))} deg outside "
+                        f"the validity range [{_fmt(math.degrees(a_lo))}, "
+                        f"{_fmt(math.degrees(a_hi))}] deg")
+    if problems:
+        raise UserError(f"{where} {'; '.join(problems)}")
     x0 = state(sol.x)
     y0 = np.empty(N_OUTPUT)
     outputs(x0, p, y0)
@@ -125,38 +167,56 @@ def jacobian(fun, at):
 class LinearPlant:
     """Discrete linear longitudinal model about a trim point (paper eq. 1).
 
+    Built from an airframe by :func:`build_plant`, or read from a file by
+    :func:`ftc_mc.model.airframe_files.load_linear_model`; a model read from a
+    file has no airframe (``airframe is None``), so it has no nonlinear model
+    and flies only the linear truth plant.
+
     Attributes
     ----------
     A, B, C : ndarray
         Discrete matrices, shapes (9, 9), (9, 3), (12, 9).
-    Ac, Bc, Cc : ndarray
-        Continuous-time matrices before discretisation.
+    Ac, Bc, Cc : ndarray or None
+        Continuous-time matrices before discretisation; ``None`` for a model
+        read from a file.
     dt : float
         Sampling period [s].
     trim : TrimPoint
-        The trim point; deviations are taken from it.
+        The trim point; deviations are taken from it (``trim.params`` is ``None``
+        for a model read from a file).
     u_lower, u_upper : ndarray, shape (3,)
         Absolute command limits (throttle [-], elevons [rad]).
-    airframe : Airframe
-        The airframe it was built from.
+    airframe : Airframe or None
+        The airframe it was built from; ``None``: no nonlinear model.
+    Bw, Dw : ndarray or None
+        Gust input matrices, shapes (9, 3) and (12, 3), of a model read from a
+        file; ``None`` for a model built from an airframe, whose gust matrices
+        :func:`ftc_mc.truth.wind_matrices` computes.
     """
 
     A: np.ndarray
     B: np.ndarray
     C: np.ndarray
-    Ac: np.ndarray
-    Bc: np.ndarray
-    Cc: np.ndarray
+    Ac: np.ndarray | None
+    Bc: np.ndarray | None
+    Cc: np.ndarray | None
     dt: float
     trim: TrimPoint
     u_lower: np.ndarray
     u_upper: np.ndarray
-    airframe: Airframe
+    airframe: Airframe | None = None
+    Bw: np.ndarray | None = None
+    Dw: np.ndarray | None = None
 
     @property
     def u0(self) -> np.ndarray:
         """Trim commands (absolute)."""
         return self.trim.u0
+
+    @property
+    def has_nonlinear_model(self) -> bool:
+        """True when built from an airframe (the nonlinear truth plant can fly it)."""
+        return self.airframe is not None
 
 
 def linearise(tp: TrimPoint):
@@ -196,7 +256,7 @@ def linearise(tp: TrimPoint):
 
 
 def build_plant(airframe: Airframe = X8, V0: float = 20.0, gamma0_deg: float = -3.0,
-                dt: float = 0.1) -> LinearPlant:
+                dt: float = 0.1, alpha_range: tuple | None = None) -> LinearPlant:
     """Trim, linearise and discretise (zero-order hold) the X8.
 
     Parameters
@@ -209,6 +269,9 @@ def build_plant(airframe: Airframe = X8, V0: float = 20.0, gamma0_deg: float = -
         Trim flight-path angle [deg].
     dt : float
         Sampling period [s], > 0 (paper: 0.1 s).
+    alpha_range : tuple of float, optional
+        Validity range of the angle of attack [rad] the trim must lie in
+        (:func:`trim`); ``None``: no check.
 
     Returns
     -------
@@ -217,11 +280,13 @@ def build_plant(airframe: Airframe = X8, V0: float = 20.0, gamma0_deg: float = -
     Raises
     ------
     ValueError
-        If ``dt`` is not a positive finite number, or trim fails.
+        If ``dt`` is not a positive finite number.
+    UserError
+        If the airframe cannot fly the condition (:func:`trim`).
     """
     if not (isinstance(dt, (int, float)) and math.isfinite(dt) and dt > 0):
         raise ValueError(f"model parameter 'dt' must be a finite number > 0, got {dt!r}")
-    tp = trim(airframe, V0, gamma0_deg)
+    tp = trim(airframe, V0, gamma0_deg, alpha_range)
     Ac, Bc, Cc = linearise(tp)
     A, B, C, _, _ = scipy.signal.cont2discrete(
         (Ac, Bc, Cc, np.zeros((N_OUTPUT, N_INPUT))), dt, method="zoh")

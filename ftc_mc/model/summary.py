@@ -72,7 +72,49 @@ def format_summary(s: dict) -> str:
 
 
 def save_npz(plant: LinearPlant, f) -> None:
-    """Write A, B, C, u0, command limits and dt to an open binary file (.npz)."""
+    """Write everything a trial of the linear plant uses to a ``.npz`` file.
+
+    :func:`ftc_mc.model.airframe_files.load_linear_model` reads it back to a
+    :class:`LinearPlant` whose arrays equal these to the bit.  Variables (all
+    float64; ``docs/airframes.md`` has the same table):
+
+    ======== ======== ===========================================================
+    name     shape    meaning [unit]
+    ======== ======== ===========================================================
+    A        (9, 9)   discrete state matrix, ``x[k+1] = A x[k] + B u[k]``
+    B        (9, 3)   discrete input matrix (throttle [-], left, right elevon [rad])
+    C        (12, 9)  output matrix, ``z[k] = C x[k]`` (deviations from trim)
+    u0       (3,)     trim commands, absolute: throttle [-], elevons [rad]
+    u_lower  (3,)     absolute lower command limits
+    u_upper  (3,)     absolute upper command limits
+    dt       ()       sampling period [s]
+    x0       (9,)     trim state, absolute: u, w [m/s], q [rad/s], x, z [m],
+                      theta [rad], throttle [-], left, right elevon [rad]
+    y0       (12,)    trim outputs, absolute: u, w [m/s], q [rad/s], x, z [m],
+                      theta [rad], n_x, n_z [g], alpha, gamma [rad], CAS, Va [m/s]
+    alpha    ()       trim angle of attack [rad]
+    V0       ()       trim airspeed [m/s]
+    gamma0   ()       trim flight-path angle [rad]
+    Bw       (9, 3)   discrete gust input matrix, gust ``[u_g, w_g, q_g]``
+                      ([m/s], [m/s], [rad/s]) held over ``dt``
+    Dw       (12, 3)  gust feed-through into the 12 outputs
+    ======== ======== ===========================================================
+
+    Parameters
+    ----------
+    plant : LinearPlant
+        A plant built from an airframe (its ``Bw``, ``Dw`` are computed by
+        :func:`ftc_mc.truth.wind_matrices`) or read from a file (its own).
+    f : str, Path or binary file
+        Destination, as for :func:`numpy.savez`.
+    """
+    if plant.Bw is not None and plant.Dw is not None:
+        Bw, Dw = plant.Bw, plant.Dw
+    else:
+        from ..truth import wind_matrices  # compiles the Numba dynamics: only here
+        Bw, Dw, _ = wind_matrices(plant)
+    tp = plant.trim
     np.savez(f, A=plant.A, B=plant.B, C=plant.C, u0=plant.u0, u_lower=plant.u_lower,
-             u_upper=plant.u_upper, dt=np.float64(plant.dt), x0=plant.trim.x0,
-             y0=plant.trim.y0)
+             u_upper=plant.u_upper, dt=np.float64(plant.dt), x0=tp.x0, y0=tp.y0,
+             alpha=np.float64(tp.alpha), V0=np.float64(tp.V0),
+             gamma0=np.float64(tp.gamma0), Bw=Bw, Dw=Dw)
