@@ -16,6 +16,7 @@ import scipy.differentiate
 import scipy.optimize
 import scipy.signal
 
+from ..errors import UserError
 from .airframe import X8, Airframe
 from .dynamics import (N_INPUT, N_OUTPUT, N_STATE, derivatives, outputs,
                        pack_parameters)
@@ -76,10 +77,10 @@ def trim(airframe: Airframe = X8, V0: float = 20.0, gamma0_deg: float = -3.0
         If ``V0`` is not positive or no trim exists within the command limits.
     """
     if not (math.isfinite(V0) and V0 > 0):
-        raise ValueError(f"trim parameter 'V0' must be a finite number > 0, got {V0!r}")
+        raise UserError(f"trim parameter 'V0' must be a finite number > 0, got {V0!r}")
     if not (math.isfinite(gamma0_deg) and abs(gamma0_deg) < 30):
-        raise ValueError("trim parameter 'gamma0_deg' must be finite and within "
-                         f"(-30, 30) deg, got {gamma0_deg!r}")
+        raise UserError("trim parameter 'gamma0_deg' must be finite and within "
+                        f"(-30, 30) deg, got {gamma0_deg!r}")
     gamma0 = math.radians(gamma0_deg)
     p = pack_parameters(airframe, V0, gamma0)
 
@@ -100,8 +101,8 @@ def trim(airframe: Airframe = X8, V0: float = 20.0, gamma0_deg: float = -3.0
     lo_e, hi_e = airframe.elevon_limits
     if (not sol.success or np.max(np.abs(residual(sol.x))) > 1e-9
             or not lo_t <= thr <= hi_t or not lo_e <= de <= hi_e):
-        raise ValueError(f"no trim within the command limits at V0={V0} m/s, "
-                         f"gamma0={gamma0_deg} deg (solver: {sol.message})")
+        raise UserError(f"no trim within the command limits at V0={V0} m/s, "
+                        f"gamma0={gamma0_deg} deg (solver: {sol.message})")
     x0 = state(sol.x)
     y0 = np.empty(N_OUTPUT)
     outputs(x0, p, y0)
@@ -220,7 +221,7 @@ def build_plant(airframe: Airframe = X8, V0: float = 20.0, gamma0_deg: float = -
         If ``dt`` is not a positive finite number, or trim fails.
     """
     if not (isinstance(dt, (int, float)) and math.isfinite(dt) and dt > 0):
-        raise ValueError(f"model parameter 'dt' must be a finite number > 0, got {dt!r}")
+        raise UserError(f"model parameter 'dt' must be a finite number > 0, got {dt!r}")
     tp = trim(airframe, V0, gamma0_deg)
     Ac, Bc, Cc = linearise(tp)
     A, B, C, _, _ = scipy.signal.cont2discrete(
