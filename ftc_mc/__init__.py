@@ -1,14 +1,14 @@
 """ftc-mc: Monte Carlo fault injection for indirect active fault-tolerant control.
 
 Implements "Reconfiguration control method for non-redundant actuator faults on
-UAV" on a Skywalker X8 model; see ``docs/paper-map.md``.
+UAV" on a Skywalker X8 model; see ``docs/paper-map.md``.  The Python API, one
+function per command (see :mod:`ftc_mc.api`)::
+
+    import ftc_mc
+    res = ftc_mc.run_campaign("configs/elevon_lock.yaml", trials=200, jobs=2)
+    res.summary
 """
 
-__all__ = ["run_campaign"]
+from .api import build_report, load_config, run_campaign, run_scenario, run_sweep
 
-
-def run_campaign(config, **kwargs):
-    """Run a Monte Carlo campaign; see :func:`ftc_mc.campaign.runner.run_campaign`."""
-    from .campaign.runner import run_campaign as _run
-
-    return _run(config, **kwargs)
+__all__ = ["run_campaign", "run_sweep", "run_scenario", "build_report", "load_config"]

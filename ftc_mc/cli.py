@@ -1,27 +1,33 @@
-"""The ``ftc-mc`` command line: parse, call, print.
+"""The ``ftc-mc`` command line: parse, call the API (:mod:`ftc_mc.api`), print.
 
-Every command turns a bad input into one line on stderr naming the problem and
-exit code 2, without a traceback and without writing anything.
+Every command turns a bad input (a :class:`~ftc_mc.errors.UserError`) into one
+line on stderr naming the problem and exit code 2, without a traceback and
+without writing anything.  Any other error is a bug and shows its traceback.
 """
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import json
+import shlex
 import sys
 
 import click
 
 from .errors import UserError
 
+TERMINAL_WIDTH = 120
+"""Widest line of the table ``ftc-mc run`` prints (the full one is in summary.md)."""
+
 
 def user_errors(func):
-    """Turn :class:`UserError` and ``ValueError`` into one line and exit code 2."""
+    """Turn :class:`UserError` into one line and exit code 2."""
     @functools.wraps(func)
     def wrapper(*args, **kwargs):
         try:
             return func(*args, **kwargs)
-        except (UserError, ValueError) as exc:
+        except UserError as exc:
             msg = str(exc).strip().splitlines()
             click.echo(f"ftc-mc: error: {msg[0] if msg else type(exc).__name__}",
                        err=True)
@@ -97,15 +103,6 @@ def plant_options(func):
                         "X8 (overrides plant.kind; the estimator stays linear).")(func)
 
 
-def _with_plant(cfg, plant, turbulence):
-    """``cfg`` with the ``--plant`` and ``--turbulence`` overrides."""
-    from .io.config import with_overrides
-
-    if plant is None and turbulence is None:
-        return cfg
-    return with_overrides(cfg, plant={"kind": plant, "turbulence": turbulence})
-
-
 def parallel_options(func):
     """``--backend``, ``--scheduler`` and ``--quiet`` of ``run`` and ``sweep``."""
     func = click.option("--quiet", is_flag=True, help="No progress bar.")(func)
@@ -116,24 +113,53 @@ def parallel_options(func):
                         help="Worker processes here (loky) or a Dask cluster.")(func)
 
 
-def _open_chunks(out_dir, identity_json: str, overwrite: bool, resume: bool):
-    """The chunk store of a run or sweep directory, new or resumed."""
-    from .io.chunks import ChunkStore
+@contextlib.contextmanager
+def _interruptible(out_dir):
+    """Ctrl-C with finished chunks on disk: say where they are and how to continue."""
+    from .io.chunks import FOLDER
 
-    store = ChunkStore(out_dir, identity_json)
-    if overwrite:
-        store.remove()
-    elif resume and not store.exists():
-        raise UserError(f"--resume: {out_dir} holds no interrupted run")
-    store.open(resume)
-    return store
+    try:
+        yield
+    except KeyboardInterrupt:
+        folder = out_dir / FOLDER
+        if not (folder / "manifest.json").exists():
+            raise
+        click.echo(f"\ninterrupted: finished chunks are kept in {folder}; "
+                   f"continue with --resume --out {out_dir}", err=True)
+        sys.exit(130)
 
 
-def _interrupted(store, out_dir):
-    """Ctrl-C: say where the finished chunks are and how to continue."""
-    click.echo(f"\ninterrupted: finished chunks are kept in {store.folder}; "
-               f"continue with --resume --out {out_dir}", err=True)
-    sys.exit(130)
+def terminal_table(summary) -> str:
+    """The run summary as a Markdown table of at most :data:`TERMINAL_WIDTH` columns.
+
+    Per transition and variant: trials judged, inappropriate and no-reset
+    rates, the share of no-reset trials explained by a small ``b1`` or a lock
+    near trim, the median reset delay, and the paper's counts (of 1000).  The
+    full table, with 95 % intervals, is in ``summary.md``.
+    """
+    import math
+
+    def num(x, fmt):
+        return "-" if not math.isfinite(x) else fmt.format(x)
+
+    head = ("transition", "variant", "judged", "inappr. %", "no reset %", "explained",
+            "delay med [s]", "paper inappr/no reset")
+    rows = [(r["transition"], r["variant"], str(r["trials"]),
+             num(100 * r["inappropriate_rate"], "{:.1f}"),
+             num(100 * r["no_reset_rate"], "{:.1f}"),
+             num(100 * r["no_reset_explained_share"], "{:.0f} %"),
+             num(r["delay_median_s"], "{:.1f}"),
+             f"{r['paper_inappropriate']} / {r['paper_no_reset']}")
+            for _, r in summary.iterrows()]
+    widths = [max(len(c) for c in col) for col in zip(head, *rows)]
+
+    def line(cells):
+        return "| " + " | ".join(c.ljust(w) if i < 2 else c.rjust(w)
+                                 for i, (c, w) in enumerate(zip(cells, widths))) + " |"
+
+    rule = "|" + "|".join(":" + "-" * (w + 1) if i < 2 else "-" * (w + 1) + ":"
+                          for i, w in enumerate(widths)) + "|"
+    return "\n".join([line(head), rule, *map(line, rows)])
 
 
 @cli.command()
@@ -160,36 +186,24 @@ def run(config, trials, seed, jobs, out, signature, controller, overwrite, resum
     """Run a Monte Carlo campaign (the paper's Tables 2-3) from CONFIG."""
     from pathlib import Path
 
-    from .campaign.runner import resolve_config, run_campaign
-    from .io.config import with_overrides
-    from .io.lock import acquire
-    from .io.results import prepare_output_dir, provenance, write_run
+    from . import api
 
-    if jobs == 0 or jobs < -1:
-        raise UserError(f"--jobs: must be a positive count or -1, got {jobs}")
-    cfg = resolve_config(config, trials, seed, signature)
-    if controller is not None:
-        cfg = with_overrides(cfg, controller={"kind": controller})
-    cfg = _with_plant(cfg, plant, turbulence)
+    cfg = api.campaign_config(config, trials=trials, seed=seed, signature=signature,
+                              controller=controller, plant=plant, turbulence=turbulence)
     if resume and not out:
         raise UserError("--resume: name the run's directory with --out")
     out_dir = Path(out) if out else _default_out(config, cfg)
-    config_json = json.dumps(cfg.model_dump(mode="json"), sort_keys=True)
-    with acquire(out_dir, command="ftc-mc run"):
-        prepare_output_dir(out_dir, overwrite)
-        store = _open_chunks(out_dir, config_json, overwrite, resume)
-        try:
-            result = run_campaign(cfg, jobs=jobs, progress=not quiet, chunks=store,
-                                  backend=backend, scheduler=scheduler)
-        except KeyboardInterrupt:
-            _interrupted(store, out_dir)
-        meta = provenance(cfg.model_dump(mode="json"), cfg.campaign.seed, "run")
-        md = "# ftc-mc run summary\n\n" + result.markdown() + "\n"
-        write_run(out_dir, result.trials, result.resets, result.summary, md, meta)
-        store.remove()
-    click.echo(result.markdown())
+    with _interruptible(out_dir):
+        result = api.run_campaign(cfg, jobs=jobs, progress=not quiet, backend=backend,
+                                  scheduler=scheduler, out=out_dir, overwrite=overwrite,
+                                  resume=resume,
+                                  command=shlex.join(["ftc-mc", "run", config]))
+    if result is None:
+        click.echo(f"{out_dir}: the run is already complete; nothing to resume")
+        return
+    click.echo(terminal_table(result.summary))
     click.echo(f"\nwrote {out_dir}/: trials.parquet, resets.parquet, summary.parquet, "
-               "summary.md")
+               "summary.md (the full table)")
 
 
 @cli.command()
@@ -204,23 +218,16 @@ def scenario(config, out, seed, overwrite, plant, turbulence):
     """Run the closed-loop scenario of CONFIG (the paper's Table 4 by default)."""
     from pathlib import Path
 
-    from .io.config import load_scenario
-    from .io.lock import acquire
-    from .io.results import prepare_output_dir, provenance
-    from .scenario import run_scenario, summary_markdown, write_scenario
+    from . import api
+    from .scenario import summary_markdown
 
-    sc = _with_plant(load_scenario(config), plant, turbulence)
-    if seed is not None and seed < 0:
-        raise UserError(f"--seed: must be >= 0, got {seed}")
+    sc = api.scenario_config(config, plant=plant, turbulence=turbulence)
     out_dir = Path(out) if out else _default_out(config, sc)
-    with acquire(out_dir, command="ftc-mc scenario"):
-        prepare_output_dir(out_dir, overwrite)
-        res = run_scenario(sc, seed=seed)
-        meta = provenance(res.config.model_dump(mode="json"), res.config.scenario.seed,
-                          "scenario")
-        files = write_scenario(res, out_dir, meta)
+    res = api.run_scenario(sc, seed=seed, out=out_dir, overwrite=overwrite,
+                           command=shlex.join(["ftc-mc", "scenario", config]))
+    files = [*api.SCENARIO_OUTPUTS, *sorted(p.name for p in out_dir.glob("fig*.png"))]
     click.echo(summary_markdown(res))
-    click.echo(f"wrote {out_dir}/: " + ", ".join(p.name for p in files))
+    click.echo(f"wrote {out_dir}/: " + ", ".join(files))
 
 
 @cli.command()
@@ -248,45 +255,23 @@ def sweep(config, thresholds, tq, tnx, transitions, signature, trials, flights, 
     """Sweep the Table 1 thresholds: Tables 2-3 and false resets per flight hour."""
     from pathlib import Path
 
-    from .campaign.runner import resolve_config
-    from .campaign.sweep import run_sweep, sweep_markdown, threshold_points
-    from .io.atomic import write_text
-    from .io.config import with_overrides
-    from .io.lock import acquire
-    from .io.results import prepare_output_dir, provenance, write_parquet
+    from . import api
+    from .campaign.sweep import sweep_markdown
 
-    cfg = resolve_config(config, trials, None, signature)
-    if transitions is not None:
-        names = [t.strip() for t in transitions.split(",") if t.strip()]
-        cfg = with_overrides(cfg, campaign={"transitions": names})
-    cfg = _with_plant(cfg, plant, turbulence)
-    points = threshold_points(thresholds, tq, tnx)
-    if flights is not None and flights < 1:
-        raise UserError(f"--flights: must be >= 1, got {flights}")
-    if jobs == 0 or jobs < -1:
-        raise UserError(f"--jobs: must be a positive count or -1, got {jobs}")
+    cfg = api.campaign_config(config, trials=trials, signature=signature,
+                              transitions=transitions, plant=plant, turbulence=turbulence)
     if resume and not out:
         raise UserError("--resume: name the sweep's directory with --out")
     out_dir = Path(out) if out else _default_out(config, cfg)
-    identity = {"config": cfg.model_dump(mode="json"), "points": [list(p) for p in points],
-                "flights": flights}
-    with acquire(out_dir, command="ftc-mc sweep"):
-        prepare_output_dir(out_dir, overwrite)
-        store = _open_chunks(out_dir, json.dumps(identity, sort_keys=True), overwrite,
-                             resume)
-        try:
-            res = run_sweep(cfg, points, flights=flights, jobs=jobs, progress=not quiet,
-                            backend=backend, scheduler=scheduler, chunks=store)
-        except KeyboardInterrupt:
-            _interrupted(store, out_dir)
-        meta = provenance(cfg.model_dump(mode="json"), cfg.campaign.seed, "sweep")
-        meta["points"] = [list(p) for p in points]
-        meta["trial_steps"] = {"simulated": res.simulated_steps, "alone": res.alone_steps}
-        write_parquet(res.table, out_dir / "sweep.parquet", meta)
-        md = sweep_markdown(res)
-        write_text(out_dir / "sweep.md", md)
-        store.remove()
-    click.echo(md)
+    with _interruptible(out_dir):
+        res = api.run_sweep(cfg, thresholds, tq=tq, tnx=tnx, flights=flights, jobs=jobs,
+                            progress=not quiet, backend=backend, scheduler=scheduler,
+                            out=out_dir, overwrite=overwrite, resume=resume,
+                            command=shlex.join(["ftc-mc", "sweep", config]))
+    if res is None:
+        click.echo(f"{out_dir}: the sweep is already complete; nothing to resume")
+        return
+    click.echo(sweep_markdown(res))
     click.echo(f"wrote {out_dir}/: sweep.parquet, sweep.md")
 
 
@@ -305,11 +290,9 @@ def report(dirs, output, allow_mixed):
     Reads only their Parquet files, so a report can be rebuilt at any time
     without rerunning anything.
     """
-    from pathlib import Path
+    from . import api
 
-    from .report import build_report
-
-    out = build_report([Path(d) for d in dirs], Path(output), allow_mixed=allow_mixed)
+    out = api.build_report(list(dirs), output, allow_mixed=allow_mixed)
     click.echo(f"wrote {out}")
 
 

@@ -21,6 +21,7 @@ from .campaign.setup import CampaignSetup, build_setup
 from .campaign.transitions import draw_gusts, gust_lanes, mode_of
 from .core.settings import TrialInputs
 from .core.trial import STATUS_NAMES, run_trials
+from .errors import UserError
 from .estimator import MODE_NAMES
 from .io.config import ACTUATOR_NAMES, ScenarioConfig
 
@@ -136,9 +137,9 @@ def run_scenario(sc: ScenarioConfig, seed: int | None = None,
         if e.fault == "lock" and e.position != "trim":
             a = ACTUATOR_NAMES.index(e.actuator)
             if not plant.u_lower[a] <= e.position <= plant.u_upper[a]:
-                raise ValueError(f"scenario.schedule.{i}.position: {e.position:g} is outside "
-                                 f"the {e.actuator} command range "
-                                 f"[{plant.u_lower[a]:g}, {plant.u_upper[a]:g}]")
+                raise UserError(f"scenario.schedule.{i}.position: {e.position:g} is outside "
+                                f"the {e.actuator} command range "
+                                f"[{plant.u_lower[a]:g}, {plant.u_upper[a]:g}]")
     inp, k_sw, b0, b1, modes = scenario_inputs(sc, setup)
     rec = new_record(setup, 1, 100_000, history=True)
     run_trials(setup.scheme(sc.scenario.signature), setup.flight, inp, rec)

@@ -17,6 +17,7 @@ from ..core.settings import (Belief, Controller, Excitation, FilterModel, Flight
 from ..design.terminal import terminal_costs
 from ..design.theorem41 import cached_engine_tables
 from ..design.lqr import discounted_lqr, paper_q_lqr
+from ..errors import UserError
 from ..estimator import (EstimatorSettings, belief_settings, detection, filter_model,
                          initial_covariance)
 from ..io.config import Config
@@ -170,9 +171,9 @@ def build_setup(cfg: Config) -> CampaignSetup:
     for a, (lo, hi) in lock_range.items():
         if lo < plant.u_lower[a] or hi > plant.u_upper[a]:
             name = "draws.engine_lock_range" if a == 0 else "draws.elevon_lock_range_rad"
-            raise ValueError(f"{name}: must lie within the command range "
-                             f"[{plant.u_lower[a]:g}, {plant.u_upper[a]:g}], "
-                             f"got {[lo, hi]}")
+            raise UserError(f"{name}: must lie within the command range "
+                            f"[{plant.u_lower[a]:g}, {plant.u_upper[a]:g}], "
+                            f"got {[lo, hi]}")
     pc = cfg.plant
     truth, gust = truth_plant(plant, pc.kind, pc.substeps, pc.turbulence, pc.altitude_m)
     return CampaignSetup(

@@ -68,6 +68,8 @@ def parse_spec(text: str, option: str) -> list:
             values = [start + i * step for i in range(n)]
         else:
             values = [float(p) for p in text.split(",")]
+    except UserError:
+        raise
     except ValueError:
         raise UserError(f"{option}: expected start:stop:step or a comma list of "
                         f"numbers, got {text!r}") from None

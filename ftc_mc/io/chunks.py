@@ -91,6 +91,12 @@ class ChunkStore:
         """DataFrames of a finished chunk, one per name in ``tables``."""
         return tuple(pq.read_table(self._path(name, start, t)).to_pandas() for t in tables)
 
+    def discard_if_empty(self) -> None:
+        """Delete the chunk folder if no chunk in it was finished (a run refused
+        before its first chunk leaves nothing behind)."""
+        if not any(self.folder.glob("*.trials.parquet")):
+            self.remove()
+
     def remove(self) -> None:
         """Delete the chunk folder (after the final files are written)."""
         shutil.rmtree(self.folder, ignore_errors=True)

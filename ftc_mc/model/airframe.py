@@ -29,6 +29,8 @@ from __future__ import annotations
 import dataclasses
 import math
 
+from ..errors import UserError
+
 G0 = 9.81
 """Gravitational acceleration [m/s^2]."""
 
@@ -114,22 +116,22 @@ class Airframe:
             value = getattr(self, name)
             if not (isinstance(value, (int, float)) and math.isfinite(value)
                     and value > 0):
-                raise ValueError(f"airframe parameter {name!r} must be a finite "
-                                 f"number > 0, got {value!r}")
+                raise UserError(f"airframe parameter {name!r} must be a finite "
+                                f"number > 0, got {value!r}")
         for name in ("CL0", "CLa", "CLq", "CLde", "CD0", "CDa", "CDa2", "CDde2",
                      "Cm0", "Cma", "Cmq", "Cmde"):
             value = getattr(self, name)
             if not (isinstance(value, (int, float)) and math.isfinite(value)):
-                raise ValueError(f"airframe parameter {name!r} must be finite, "
-                                 f"got {value!r}")
+                raise UserError(f"airframe parameter {name!r} must be finite, "
+                                f"got {value!r}")
         for name in ("throttle_limits", "elevon_limits"):
             lo, hi = getattr(self, name)
             if not (math.isfinite(lo) and math.isfinite(hi) and lo < hi):
-                raise ValueError(f"airframe parameter {name!r} must be a finite "
-                                 f"range (lo < hi), got {(lo, hi)!r}")
+                raise UserError(f"airframe parameter {name!r} must be a finite "
+                                f"range (lo < hi), got {(lo, hi)!r}")
         if self.elevon_limits[0] != -self.elevon_limits[1]:
-            raise ValueError("airframe parameter 'elevon_limits' must be "
-                             f"symmetric, got {self.elevon_limits!r}")
+            raise UserError("airframe parameter 'elevon_limits' must be "
+                            f"symmetric, got {self.elevon_limits!r}")
 
     @property
     def command_lower(self):

@@ -279,13 +279,12 @@ def build_plant(airframe: Airframe = X8, V0: float = 20.0, gamma0_deg: float = -
 
     Raises
     ------
-    ValueError
-        If ``dt`` is not a positive finite number.
     UserError
-        If the airframe cannot fly the condition (:func:`trim`).
+        If ``dt`` is not a positive finite number, or the airframe cannot fly
+        the condition (:func:`trim`).
     """
     if not (isinstance(dt, (int, float)) and math.isfinite(dt) and dt > 0):
-        raise ValueError(f"model parameter 'dt' must be a finite number > 0, got {dt!r}")
+        raise UserError(f"model.dt_s: must be a finite number > 0, got {dt!r}")
     tp = trim(airframe, V0, gamma0_deg, alpha_range)
     Ac, Bc, Cc = linearise(tp)
     A, B, C, _, _ = scipy.signal.cont2discrete(

@@ -1,0 +1,443 @@
+"""The Python API: one function per command, each returning DataFrames.
+
+::
+
+    import ftc_mc
+    cfg = ftc_mc.load_config("configs/paper_tables.yaml")      # validated Config
+    res = ftc_mc.run_campaign(cfg, trials=200, jobs=2)         # res.summary, res.trials
+    sw = ftc_mc.run_sweep(cfg, "10,25,50", trials=100)         # sw.table
+    sc = ftc_mc.run_scenario("configs/paper_scenario.yaml")    # sc.timeseries, sc.events
+    ftc_mc.build_report(["results/paper_tables"], "report.md")
+
+Every function takes a config object, a mapping or a YAML path.  Without
+``out`` nothing is written; with ``out`` the results go to that directory
+exactly as the command line writes them: under the directory's lock, in chunks
+that ``resume=True`` continues after a crash, each file atomic and carrying its
+provenance.  The command line (:mod:`ftc_mc.cli`) is a thin layer over these.
+
+Bad input raises :class:`~ftc_mc.errors.UserError` (a ``ValueError``) with a
+one-line message; nothing is written then.
+"""
+
+from __future__ import annotations
+
+import json
+import shlex
+import sys
+from pathlib import Path
+
+from .errors import UserError
+
+RUN_OUTPUTS = ("summary.parquet", "trials.parquet", "resets.parquet", "summary.md")
+"""Files of a finished ``run`` directory (the first holds the metadata checked)."""
+SWEEP_OUTPUTS = ("sweep.parquet", "sweep.md")
+"""Files of a finished ``sweep`` directory."""
+SCENARIO_OUTPUTS = ("timeseries.parquet", "events.parquet", "segments.parquet",
+                    "summary.md")
+"""Files of a ``scenario`` directory besides its figures."""
+
+
+# -- configs ----------------------------------------------------------------------
+
+def _parse_scenario(data, source: str):
+    from pydantic import ValidationError
+
+    from .io.config import ScenarioConfig, _format_error
+
+    if data is None:
+        raise UserError(f"{source}: the file is empty; expected a mapping of sections")
+    if not isinstance(data, dict):
+        raise UserError(f"{source}: expected a mapping of sections at the top level, "
+                        f"got {type(data).__name__}")
+    try:
+        return ScenarioConfig.model_validate(data)
+    except ValidationError as exc:
+        raise UserError(_format_error(exc, source)) from None
+
+
+def load_config(path):
+    """Read and validate a config file: a campaign (or sweep) or a scenario.
+
+    Parameters
+    ----------
+    path : str, Path, dict, Config or ScenarioConfig
+        A YAML file, or its parsed mapping; a file with a top-level
+        ``scenario`` section is a scenario.  A config object is returned as is.
+
+    Returns
+    -------
+    Config or ScenarioConfig
+
+    Raises
+    ------
+    UserError
+        Missing or unreadable file, malformed YAML, or an invalid field (the
+        message names it).
+    """
+    from .io.config import Config, ScenarioConfig, _read_yaml, parse_config
+
+    if isinstance(path, (Config, ScenarioConfig)):
+        return path
+    data, source = (path, "config") if isinstance(path, dict) else (_read_yaml(path),
+                                                                    str(path))
+    if isinstance(data, dict) and "scenario" in data:
+        return _parse_scenario(data, source)
+    return parse_config(data, source)
+
+
+def _listed(names):
+    if isinstance(names, str):
+        return [t.strip() for t in names.split(",") if t.strip()]
+    return None if names is None else list(names)
+
+
+def campaign_config(config, *, trials=None, seed=None, signature=None, transitions=None,
+                    controller=None, plant=None, turbulence=None):
+    """A validated campaign :class:`~ftc_mc.io.config.Config` with overrides.
+
+    Parameters
+    ----------
+    config : str, Path, dict or Config
+    trials, seed : int, optional
+        ``campaign.trials``, ``campaign.seed``.
+    signature : {"paper", "swapped", "both"}, optional
+    transitions : list of str or str, optional
+        Transition names (a string is a comma list).
+    controller : {"nominal", "reconfiguring"}, optional
+    plant : {"linear", "nonlinear"}, optional
+    turbulence : {"none", "light", "moderate", "severe"}, optional
+    """
+    from .io.config import Config, ScenarioConfig, load_config as load_campaign
+    from .io.config import parse_config, with_overrides
+
+    if isinstance(config, ScenarioConfig):
+        raise UserError("config: a scenario config; run it with run_scenario "
+                        "(ftc-mc scenario)")
+    if isinstance(config, Config):
+        cfg = config
+    elif isinstance(config, dict):
+        cfg = parse_config(config)
+    else:
+        cfg = load_campaign(config)
+    over = {"campaign": {"trials": trials, "seed": seed, "signature": signature,
+                         "transitions": _listed(transitions)},
+            "controller": {"kind": controller},
+            "plant": {"kind": plant, "turbulence": turbulence}}
+    over = {k: v for k, v in over.items() if any(x is not None for x in v.values())}
+    return with_overrides(cfg, **over) if over else cfg
+
+
+def scenario_config(config, *, plant=None, turbulence=None):
+    """A validated :class:`~ftc_mc.io.config.ScenarioConfig` with plant overrides.
+
+    Parameters
+    ----------
+    config : str, Path, dict or ScenarioConfig
+    plant, turbulence : str, optional
+        As in :func:`campaign_config`.
+    """
+    from .io.config import Config, ScenarioConfig, load_scenario, with_overrides
+
+    if isinstance(config, Config):
+        raise UserError("config: a campaign config; a scenario needs a scenario config "
+                        "(see configs/paper_scenario.yaml)")
+    if isinstance(config, ScenarioConfig):
+        sc = config
+    elif isinstance(config, dict):
+        sc = _parse_scenario(config, "config")
+    else:
+        sc = load_scenario(config)
+    if plant is None and turbulence is None:
+        return sc
+    return with_overrides(sc, plant={"kind": plant, "turbulence": turbulence})
+
+
+# -- output directories -----------------------------------------------------------
+
+def _who(name: str) -> str:
+    """The command written to the lock file of an API call."""
+    return f"ftc_mc.{name}() in {shlex.join(sys.argv) or 'python'}"
+
+
+def _check_jobs(jobs) -> None:
+    if jobs == 0 or jobs < -1:
+        raise UserError(f"--jobs: must be a positive count or -1, got {jobs}")
+
+
+def _check_out(out, resume: bool) -> Path | None:
+    if out is None:
+        if resume:
+            raise UserError("--resume: name the directory to continue with --out")
+        return None
+    return Path(out)
+
+
+def _open_chunks(out_dir: Path, identity_json: str, overwrite: bool, resume: bool):
+    """The chunk store of a run or sweep directory, new or resumed."""
+    from .io.chunks import ChunkStore
+
+    store = ChunkStore(out_dir, identity_json)
+    if overwrite:
+        store.remove()
+    elif resume and not store.exists():
+        raise UserError(f"--resume: {out_dir} holds no interrupted run")
+    store.open(resume)
+    return store
+
+
+def _finished(out_dir: Path, kind: str, files, identity: dict) -> bool:
+    """Whether ``out_dir`` holds a finished ``kind`` with this identity.
+
+    Raises
+    ------
+    UserError
+        It holds a finished ``kind`` of another configuration.
+    """
+    from .io.chunks import ChunkStore
+    from .io.results import read_metadata
+
+    if not all((out_dir / f).is_file() for f in files):
+        return False
+    try:
+        meta = read_metadata(out_dir / files[0])
+    except Exception:  # noqa: BLE001 -- unreadable: not ours to judge here
+        return False
+    if meta.get("kind") != kind:
+        return False
+    if any(meta.get(k) != v for k, v in identity.items()):
+        raise UserError(f"--resume: {out_dir} holds a finished {kind} of another "
+                        "configuration (or other options)")
+    ChunkStore(out_dir, "").remove()  # left if the process died just after the last file
+    return True
+
+
+# -- the commands -----------------------------------------------------------------
+
+def run_campaign(config, *, trials=None, seed=None, signature=None, controller=None,
+                 plant=None, turbulence=None, jobs: int = 1, progress: bool = True,
+                 backend: str = "loky", scheduler: str | None = None, out=None,
+                 overwrite: bool = False, resume: bool = False,
+                 command: str | None = None):
+    """Run a Monte Carlo campaign: the paper's Tables 2-3 (``ftc-mc run``).
+
+    Parameters
+    ----------
+    config : str, Path, dict or Config
+        YAML path, parsed mapping or validated configuration.
+    trials, seed, signature, controller, plant, turbulence : optional
+        Overrides of the config (:func:`campaign_config`).
+    jobs : int
+        Worker processes; 1 runs here, -1 uses every core (or this process
+        alone for a small run).  The results do not depend on it.
+    progress : bool
+        Show a progress bar.
+    backend : {"loky", "dask"}
+    scheduler : str, optional
+        Dask scheduler address (``backend="dask"``); a local cluster if None.
+    out : str or Path, optional
+        Write ``trials.parquet``, ``resets.parquet``, ``summary.parquet`` and
+        ``summary.md`` there (as ``ftc-mc run --out``).  Nothing is written
+        without it.
+    overwrite : bool
+        Replace results already in ``out``.
+    resume : bool
+        Continue the interrupted run in ``out``, skipping its finished chunks.
+    command : str, optional
+        Named to another process that finds ``out`` locked.
+
+    Returns
+    -------
+    CampaignResult or None
+        ``.summary`` (one row per transition and variant), ``.trials`` (one
+        row per trial and variant), ``.resets`` (one row per reset) and
+        ``.config``.  None if ``resume`` found the run already finished in
+        ``out`` (nothing was run).
+
+    Raises
+    ------
+    UserError
+        A bad config or option, or an ``out`` that is busy, holds other results
+        or (with ``resume``) no interrupted run; nothing is written then.
+    KeyboardInterrupt
+        The finished chunks stay in ``out``; ``resume=True`` continues.
+    """
+    from .campaign.runner import run_campaign as run
+    from .io.lock import acquire
+    from .io.results import prepare_output_dir, provenance, write_run
+
+    _check_jobs(jobs)
+    cfg = campaign_config(config, trials=trials, seed=seed, signature=signature,
+                          controller=controller, plant=plant, turbulence=turbulence)
+    kw = dict(jobs=jobs, progress=progress, backend=backend, scheduler=scheduler)
+    out_dir = _check_out(out, resume)
+    if out_dir is None:
+        return run(cfg, **kw)
+    config_json = cfg.model_dump(mode="json")
+    with acquire(out_dir, command=command or _who("run_campaign")):
+        if resume and not overwrite and _finished(out_dir, "run", RUN_OUTPUTS,
+                                                  {"config": config_json}):
+            return None
+        prepare_output_dir(out_dir, overwrite)
+        store = _open_chunks(out_dir, json.dumps(config_json, sort_keys=True), overwrite,
+                             resume)
+        try:
+            result = run(cfg, chunks=store, **kw)
+        except Exception:  # e.g. draws outside the command range, no Dask scheduler
+            store.discard_if_empty()
+            raise
+        meta = provenance(config_json, cfg.campaign.seed, "run")
+        md = "# ftc-mc run summary\n\n" + result.markdown() + "\n"
+        write_run(out_dir, result.trials, result.resets, result.summary, md, meta)
+        store.remove()
+    return result
+
+
+def _spec(values, option: str):
+    """A threshold spec for :func:`~ftc_mc.campaign.sweep.parse_spec` from a string,
+    a number or a sequence of numbers."""
+    if values is None or isinstance(values, str):
+        return values
+    if isinstance(values, (int, float)):
+        values = [values]
+    try:
+        return ",".join(repr(float(v)) for v in values)
+    except (TypeError, ValueError):
+        raise UserError(f"{option}: expected numbers, got {values!r}") from None
+
+
+def run_sweep(config, thresholds=None, *, tq=None, tnx=None, transitions=None,
+              signature=None, trials=None, seed=None, flights: int | None = None,
+              plant=None, turbulence=None, jobs: int = 1, progress: bool = True,
+              backend: str = "loky", scheduler: str | None = None, out=None,
+              overwrite: bool = False, resume: bool = False, command: str | None = None):
+    """Sweep the Table 1 thresholds (``ftc-mc sweep``).
+
+    Parameters
+    ----------
+    config : str, Path, dict or Config
+    thresholds : str or sequence of float, optional
+        ``t_q = t_nx`` values: ``"start:stop:step"``, ``"a,b,c"`` or numbers.
+    tq, tnx : str or sequence of float, optional
+        A grid of ``t_q`` by ``t_nx`` values instead of ``thresholds``.
+    transitions, signature, trials, seed, plant, turbulence : optional
+        Overrides of the config (:func:`campaign_config`).
+    flights : int, optional
+        Fault-free flights per point for the false-reset rate (default: trials).
+    jobs, progress, backend, scheduler, out, overwrite, resume, command
+        As in :func:`run_campaign`; ``out`` receives ``sweep.parquet`` and
+        ``sweep.md``.
+
+    Returns
+    -------
+    SweepResult or None
+        ``.table`` (one row per threshold point, transition and variant, with
+        the false resets per flight hour), ``.trials``, ``.points``,
+        ``.saving``.  None if ``resume`` found the sweep already finished.
+    """
+    from .campaign.sweep import run_sweep as sweep, sweep_markdown, threshold_points
+    from .io.atomic import write_text
+    from .io.lock import acquire
+    from .io.results import prepare_output_dir, provenance, write_parquet
+
+    cfg = campaign_config(config, trials=trials, seed=seed, signature=signature,
+                          transitions=transitions, plant=plant, turbulence=turbulence)
+    points = threshold_points(_spec(thresholds, "--thresholds"), _spec(tq, "--tq"),
+                              _spec(tnx, "--tnx"))
+    if flights is not None and flights < 1:
+        raise UserError(f"--flights: must be >= 1, got {flights}")
+    _check_jobs(jobs)
+    kw = dict(flights=flights, jobs=jobs, progress=progress, backend=backend,
+              scheduler=scheduler)
+    out_dir = _check_out(out, resume)
+    if out_dir is None:
+        return sweep(cfg, points, **kw)
+    config_json = cfg.model_dump(mode="json")
+    point_list = [list(p) for p in points]
+    identity = {"config": config_json, "points": point_list, "flights": flights}
+    with acquire(out_dir, command=command or _who("run_sweep")):
+        if resume and not overwrite and _finished(
+                out_dir, "sweep", SWEEP_OUTPUTS, {"config": config_json,
+                                                   "points": point_list}):
+            return None
+        prepare_output_dir(out_dir, overwrite)
+        store = _open_chunks(out_dir, json.dumps(identity, sort_keys=True), overwrite,
+                             resume)
+        try:
+            res = sweep(cfg, points, chunks=store, **kw)
+        except Exception:
+            store.discard_if_empty()
+            raise
+        meta = provenance(config_json, cfg.campaign.seed, "sweep")
+        meta["points"] = point_list
+        meta["trial_steps"] = {"simulated": res.simulated_steps, "alone": res.alone_steps}
+        write_parquet(res.table, out_dir / "sweep.parquet", meta)
+        write_text(out_dir / "sweep.md", sweep_markdown(res))
+        store.remove()
+    return res
+
+
+def run_scenario(config, *, seed: int | None = None, plant=None, turbulence=None,
+                 out=None, overwrite: bool = False, command: str | None = None):
+    """Fly one closed-loop scenario: the paper's Table 4 by default (``ftc-mc scenario``).
+
+    Parameters
+    ----------
+    config : str, Path, dict or ScenarioConfig
+    seed : int, optional
+        Noise seed (overrides ``scenario.seed``).
+    plant, turbulence : str, optional
+        Truth plant overrides, as in :func:`campaign_config`.
+    out : str or Path, optional
+        Write ``timeseries.parquet``, ``events.parquet``, ``segments.parquet``,
+        Figs. 6-12 and ``summary.md`` there.
+    overwrite, command
+        As in :func:`run_campaign`.
+
+    Returns
+    -------
+    ScenarioResult
+        ``.timeseries`` (one row per 0.1 s step), ``.events``, ``.segments``
+        (one row per schedule entry), ``.status`` and ``.config``.
+    """
+    from .io.lock import acquire
+    from .io.results import prepare_output_dir, provenance
+    from .scenario import run_scenario as run, write_scenario
+
+    sc = scenario_config(config, plant=plant, turbulence=turbulence)
+    if seed is not None and seed < 0:
+        raise UserError(f"--seed: must be >= 0, got {seed}")
+    out_dir = _check_out(out, False)
+    if out_dir is None:
+        return run(sc, seed=seed)
+    with acquire(out_dir, command=command or _who("run_scenario")):
+        prepare_output_dir(out_dir, overwrite)
+        res = run(sc, seed=seed)
+        meta = provenance(res.config.model_dump(mode="json"), res.config.scenario.seed,
+                          "scenario")
+        write_scenario(res, out_dir, meta)
+    return res
+
+
+def build_report(dirs, out="report.md", *, allow_mixed: bool = False) -> Path:
+    """Write one Markdown report of finished result directories (``ftc-mc report``).
+
+    Parameters
+    ----------
+    dirs : str, Path or list of them
+        Run, sweep and scenario directories, in any mix; only their Parquet
+        files are read.
+    out : str or Path
+        The Markdown file; figures go to ``<out stem>_figures/`` beside it.
+    allow_mixed : bool
+        Accept inputs of different package versions or git revisions.
+
+    Returns
+    -------
+    Path
+        ``out``.
+    """
+    from .report import build_report as build
+
+    if isinstance(dirs, (str, Path)):
+        dirs = [dirs]
+    return build([Path(d) for d in dirs], Path(out), allow_mixed=allow_mixed)
