@@ -159,8 +159,8 @@ def test_api_scenario(tmp_path):
 
 def test_bad_parameters_below_the_config_are_one_line(tmp_path):
     # values the schema lets through but the model or the draws refuse
-    for args, needle in ((["model", "--airspeed", "300"], "no trim"),
-                         (["model", "--gamma", "45"], "gamma0_deg"),
+    for args, needle in ((["model", "--airspeed", "300"], "cannot fly this condition"),
+                         (["model", "--gamma", "45"], "model.gamma_deg"),
                          (["run", str(_yaml(tmp_path, {**SMALL, "draws": {
                              "engine_lock_range": [0.0, 2.0]}})), "--out",
                            str(tmp_path / "o")], "draws.engine_lock_range")):
