@@ -99,7 +99,7 @@ def plant_options(func):
 
 def _with_plant(cfg, plant, turbulence):
     """``cfg`` with the ``--plant`` and ``--turbulence`` overrides."""
-    from .io.config import with_overrides
+    from .config import with_overrides
 
     if plant is None and turbulence is None:
         return cfg
@@ -161,7 +161,7 @@ def run(config, trials, seed, jobs, out, signature, controller, overwrite, resum
     from pathlib import Path
 
     from .campaign.runner import resolve_config, run_campaign
-    from .io.config import with_overrides
+    from .config import with_overrides
     from .io.lock import acquire
     from .io.results import prepare_output_dir, provenance, write_run
 
@@ -204,7 +204,7 @@ def scenario(config, out, seed, overwrite, plant, turbulence):
     """Run the closed-loop scenario of CONFIG (the paper's Table 4 by default)."""
     from pathlib import Path
 
-    from .io.config import load_scenario
+    from .config import load_scenario
     from .io.lock import acquire
     from .io.results import prepare_output_dir, provenance
     from .scenario import run_scenario, summary_markdown, write_scenario
@@ -251,7 +251,7 @@ def sweep(config, thresholds, tq, tnx, transitions, signature, trials, flights, 
     from .campaign.runner import resolve_config
     from .campaign.sweep import run_sweep, sweep_markdown, threshold_points
     from .io.atomic import write_text
-    from .io.config import with_overrides
+    from .config import with_overrides
     from .io.lock import acquire
     from .io.results import prepare_output_dir, provenance, write_parquet
 

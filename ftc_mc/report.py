@@ -40,7 +40,8 @@ from .campaign.transitions import TRANSITION_TABLE
 from .errors import UserError
 from .io.atomic import write_text
 from .io.chunks import FOLDER as CHUNKS_FOLDER
-from .io.config import PLANT_KINDS, TRANSITIONS, TURBULENCE_LEVELS, TimingConfig
+from .config.schema import TimingConfig
+from .conventions import PLANT_KINDS, TRANSITIONS, TURBULENCE_LEVELS
 from .io.lock import holder
 from .io.results import read_metadata
 from .scenario import PAPER_TIMELINE

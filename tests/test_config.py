@@ -6,8 +6,8 @@ from pathlib import Path
 import pytest
 import yaml
 
+from ftc_mc.config import Config, load_config, load_scenario, parse_config
 from ftc_mc.errors import UserError
-from ftc_mc.io.config import Config, load_config, load_scenario, parse_config
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "scripts"))
