@@ -39,22 +39,6 @@ SCENARIO_OUTPUTS = ("timeseries.parquet", "events.parquet", "segments.parquet",
 
 # -- configs ----------------------------------------------------------------------
 
-def _parse_scenario(data, source: str):
-    from pydantic import ValidationError
-
-    from .io.config import ScenarioConfig, _format_error
-
-    if data is None:
-        raise UserError(f"{source}: the file is empty; expected a mapping of sections")
-    if not isinstance(data, dict):
-        raise UserError(f"{source}: expected a mapping of sections at the top level, "
-                        f"got {type(data).__name__}")
-    try:
-        return ScenarioConfig.model_validate(data)
-    except ValidationError as exc:
-        raise UserError(_format_error(exc, source)) from None
-
-
 def load_config(path):
     """Read and validate a config file: a campaign (or sweep) or a scenario.
 
@@ -74,15 +58,16 @@ def load_config(path):
         Missing or unreadable file, malformed YAML, or an invalid field (the
         message names it).
     """
-    from .io.config import Config, ScenarioConfig, _read_yaml, parse_config
+    from .config import Config, ScenarioConfig
+    from .config.load import read_yaml, validate_model
 
     if isinstance(path, (Config, ScenarioConfig)):
         return path
-    data, source = (path, "config") if isinstance(path, dict) else (_read_yaml(path),
+    data, source = (path, "config") if isinstance(path, dict) else (read_yaml(path),
                                                                     str(path))
     if isinstance(data, dict) and "scenario" in data:
-        return _parse_scenario(data, source)
-    return parse_config(data, source)
+        return validate_model(ScenarioConfig, data, source)
+    return validate_model(Config, data, source)
 
 
 def _listed(names):
@@ -93,7 +78,7 @@ def _listed(names):
 
 def campaign_config(config, *, trials=None, seed=None, signature=None, transitions=None,
                     controller=None, plant=None, turbulence=None):
-    """A validated campaign :class:`~ftc_mc.io.config.Config` with overrides.
+    """A validated campaign :class:`~ftc_mc.config.Config` with overrides.
 
     Parameters
     ----------
@@ -107,8 +92,8 @@ def campaign_config(config, *, trials=None, seed=None, signature=None, transitio
     plant : {"linear", "nonlinear"}, optional
     turbulence : {"none", "light", "moderate", "severe"}, optional
     """
-    from .io.config import Config, ScenarioConfig, load_config as load_campaign
-    from .io.config import parse_config, with_overrides
+    from .config import Config, ScenarioConfig, load_config as load_campaign
+    from .config import parse_config, with_overrides
 
     if isinstance(config, ScenarioConfig):
         raise UserError("config: a scenario config; run it with run_scenario "
@@ -128,7 +113,7 @@ def campaign_config(config, *, trials=None, seed=None, signature=None, transitio
 
 
 def scenario_config(config, *, plant=None, turbulence=None):
-    """A validated :class:`~ftc_mc.io.config.ScenarioConfig` with plant overrides.
+    """A validated :class:`~ftc_mc.config.ScenarioConfig` with plant overrides.
 
     Parameters
     ----------
@@ -136,7 +121,8 @@ def scenario_config(config, *, plant=None, turbulence=None):
     plant, turbulence : str, optional
         As in :func:`campaign_config`.
     """
-    from .io.config import Config, ScenarioConfig, load_scenario, with_overrides
+    from .config import Config, ScenarioConfig, load_scenario, with_overrides
+    from .config.load import validate_model
 
     if isinstance(config, Config):
         raise UserError("config: a campaign config; a scenario needs a scenario config "
@@ -144,7 +130,7 @@ def scenario_config(config, *, plant=None, turbulence=None):
     if isinstance(config, ScenarioConfig):
         sc = config
     elif isinstance(config, dict):
-        sc = _parse_scenario(config, "config")
+        sc = validate_model(ScenarioConfig, config, "config")
     else:
         sc = load_scenario(config)
     if plant is None and turbulence is None:

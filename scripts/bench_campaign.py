@@ -28,10 +28,10 @@ import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-WARM = ("import numpy as np; from ftc_mc.io.config import load_config; "
-        "from ftc_mc.campaign.setup import build_setup; "
-        "from ftc_mc.campaign.runner import warm_up; "
-        "c = load_config('configs/paper_tables.yaml'); warm_up(build_setup(c), c)")
+WARM = ("from ftc_mc.config import load_config; "
+        "from ftc_mc.campaign.chunk import chunk_spec, warm_up; "
+        "c = load_config('configs/paper_tables.yaml'); "
+        "warm_up(chunk_spec(c), c.campaign.transitions[0])")
 
 
 def timed(cmd, env=None):
@@ -59,7 +59,7 @@ def main():
                                         "--controller", "nominal"])
 
     import ftc_mc
-    from ftc_mc.io.config import load_config, with_overrides
+    from ftc_mc.config import load_config, with_overrides
 
     cfg = load_config(ROOT / "configs" / "paper_tables.yaml")
     n_steps = cfg.steps(cfg.timing.duration_s)

@@ -49,8 +49,8 @@ from filterpy.kalman import KalmanFilter  # noqa: E402
 from ftc_mc.batch_workspace import lane_zeros, new_lane_workspace  # noqa: E402
 from ftc_mc.core.batch import filter_step_lanes  # noqa: E402
 from ftc_mc.core.step import filter_step  # noqa: E402
-from ftc_mc.estimator import (EstimatorSettings, Workspace, detection,  # noqa: E402
-                              filter_model, initial_covariance)
+from ftc_mc.sim.estimator import (EstimatorSettings, Workspace, detection,  # noqa: E402
+                                  filter_model, initial_covariance)
 from ftc_mc.model.faults import augmented  # noqa: E402
 from ftc_mc.model.linear import build_plant  # noqa: E402
 

@@ -2,7 +2,7 @@
 
 Prints:
 
-* offline design (``build_setup`` of the scenario's campaign config: trim,
+* offline design (``build_setup`` of the scenario config: trim,
   linearisation, LQR, the Theorem 4.1 engine tables and the terminal costs
   J^N), cold and cached.  Cold runs in a fresh interpreter whose design cache
   (``FTC_MC_CACHE_DIR``) is an empty temporary folder, so the engine tables are
@@ -43,13 +43,13 @@ DESIGN = """
 import json, sys, time
 t0 = time.perf_counter()
 import numpy as np
-from ftc_mc.io.config import load_scenario
-from ftc_mc.campaign.setup import build_setup
+from ftc_mc.config import load_scenario
 from ftc_mc.design.lqr import paper_q_lqr
 from ftc_mc.design.terminal import terminal_costs
 from ftc_mc.design.theorem41 import cached_engine_tables
+from ftc_mc.sim.setup import build_setup
 import_s = time.perf_counter() - t0
-cfg = load_scenario(sys.argv[1]).campaign_config()
+cfg = load_scenario(sys.argv[1])
 out = {"import_s": import_s}
 for name in ("cold", "cached"):
     t = time.perf_counter()
@@ -85,9 +85,9 @@ def design_times(config: Path) -> dict:
 
 def kernel_inputs(sc, setup):
     """The kernel inputs of ``run_scenario`` (same code path, built once)."""
-    from ftc_mc.scenario import scenario_inputs
+    from ftc_mc.sim.inputs import scenario_inputs
 
-    return scenario_inputs(sc, setup)[0]
+    return scenario_inputs(setup, sc.scenario)
 
 
 def median_time(fn, repeat):
@@ -107,16 +107,16 @@ def main():
 
     import numpy as np
 
-    from ftc_mc.campaign.chunk import new_record
-    from ftc_mc.campaign.setup import build_setup
+    from ftc_mc.config import load_scenario
     from ftc_mc.core.trial import run_trials
-    from ftc_mc.io.config import load_scenario
     from ftc_mc.io.results import provenance
     from ftc_mc.scenario import run_scenario, write_scenario
+    from ftc_mc.sim.lanes import HISTORY_RESETS, new_record
+    from ftc_mc.sim.setup import build_setup
 
     sc = load_scenario(args.config)
     t = time.perf_counter()
-    setup = build_setup(sc.campaign_config())  # warms the Numba cache of the design
+    setup = build_setup(sc)  # warms the Numba cache of the design
     first_setup_s = time.perf_counter() - t
     t = time.perf_counter()
     ref = run_scenario(sc, setup=setup)  # compiles (or loads) the kernel
@@ -126,11 +126,11 @@ def main():
 
     inp = kernel_inputs(sc, setup)
     det = setup.det[sc.scenario.signature]
-    recs = [new_record(setup, 1, 100_000, history=True) for _ in range(args.repeat)]
+    recs = [new_record(setup, 1, HISTORY_RESETS, history=True) for _ in range(args.repeat)]
     it = iter(recs)
 
     def kernel():
-        run_trials(setup.scheme("paper", det), setup.flight, inp, next(it))
+        run_trials(setup.scheme(sc.scenario.signature, det), setup.flight, inp, next(it))
 
     kernel_s, kernel_min, kernel_max = median_time(kernel, args.repeat)
     # the timed kernel is the one run_scenario runs

@@ -29,7 +29,7 @@ def main():
 
     import ftc_mc
     from ftc_mc.campaign.sweep import run_sweep, threshold_points
-    from ftc_mc.io.config import load_config, with_overrides
+    from ftc_mc.config import load_config, with_overrides
 
     cfg = load_config(ROOT / "configs" / "paper_tables.yaml")
     cfg = with_overrides(cfg, campaign={"trials": args.trials},

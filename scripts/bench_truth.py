@@ -36,9 +36,8 @@ import numpy as np  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from ftc_mc.campaign.chunk import run_chunk  # noqa: E402
-from ftc_mc.campaign.setup import build_setup  # noqa: E402
-from ftc_mc.io.config import Config  # noqa: E402
+from ftc_mc.campaign.chunk import chunk_spec, run_chunk  # noqa: E402
+from ftc_mc.config import Config  # noqa: E402
 
 PLANTS = (("linear", "none"), ("nonlinear", "none"), ("linear", "moderate"),
           ("nonlinear", "moderate"))
@@ -51,14 +50,12 @@ def trials_per_s(kind, turbulence, controller, lanes, repeat):
         "campaign": {"transitions": list(TRANSITIONS), "signature": "both"},
         "controller": {"kind": controller},
         "plant": {"kind": kind, "turbulence": turbulence}})
-    setup = build_setup(cfg)
+    spec = chunk_spec(cfg)
     ids = np.arange(lanes)
-    window = cfg.steps(cfg.timing.window_s)
 
     def once():
         for name in TRANSITIONS:
-            run_chunk(setup, name, ids, cfg.campaign.seed, ("paper", "swapped"),
-                      cfg.resets_stored(), window)
+            run_chunk(spec, name, ids)
 
     once()  # compile or load from the cache
     times = []

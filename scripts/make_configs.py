@@ -13,7 +13,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from ftc_mc.campaign.transitions import TRANSITION_TABLE  # noqa: E402
-from ftc_mc.io.config import Config, ScenarioConfig, render_yaml  # noqa: E402
+from ftc_mc.config import Config, ScenarioConfig, render_yaml  # noqa: E402
 
 
 def campaign_configs() -> dict:

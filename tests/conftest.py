@@ -2,8 +2,8 @@
 
 import pytest
 
-from ftc_mc.estimator import EstimatorSettings
 from ftc_mc.model.linear import build_plant
+from ftc_mc.sim.estimator import EstimatorSettings
 
 
 @pytest.fixture(scope="session")

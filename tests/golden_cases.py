@@ -51,7 +51,7 @@ def campaign_frames(name: str) -> dict:
 
 def scenario_frames(name: str) -> dict:
     """``{"timeseries": DataFrame}`` of the paper's scenario under ``name``."""
-    from ftc_mc.io.config import load_scenario, with_overrides
+    from ftc_mc.config import load_scenario, with_overrides
     from ftc_mc.scenario import run_scenario
 
     root = Path(__file__).resolve().parents[1]

@@ -14,7 +14,7 @@ from click.testing import CliRunner
 import ftc_mc
 from ftc_mc.cli import TERMINAL_WIDTH, cli, terminal_table
 from ftc_mc.errors import UserError
-from ftc_mc.io.config import Config, ScenarioConfig
+from ftc_mc.config import Config, ScenarioConfig
 from ftc_mc.io.results import read_metadata
 
 ROOT = Path(__file__).resolve().parents[1]

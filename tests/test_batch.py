@@ -19,8 +19,8 @@ from ftc_mc.core import batch as kb
 from ftc_mc.core import kalman as kk
 from ftc_mc.core import signature as ks
 from ftc_mc.core.step import filter_step
-from ftc_mc.estimator import (EstimatorSettings, Workspace, detection, filter_model,
-                              initial_covariance, unit_rows)
+from ftc_mc.sim.estimator import (EstimatorSettings, Workspace, detection, filter_model,
+                                  initial_covariance, unit_rows)
 from ftc_mc.model.linear import build_plant
 
 TOL = 1e-10

@@ -9,12 +9,13 @@ import pytest
 from click.testing import CliRunner
 
 import ftc_mc
-from ftc_mc.campaign.chunk import build_inputs, classify, new_record
-from ftc_mc.campaign.setup import build_setup
+from ftc_mc.campaign.chunk import chunk_spec, classify, trial_inputs
 from ftc_mc.campaign.summary import summarize
 from ftc_mc.cli import cli
-from ftc_mc.io.config import Config, TRANSITIONS
+from ftc_mc.config import Config
+from ftc_mc.conventions import TRANSITIONS
 from ftc_mc.io.results import read_metadata
+from ftc_mc.sim.lanes import new_record
 from ftc_mc.stats import wilson
 
 SMALL = {"timing": {"fault_time_s": 5.0, "window_s": 5.0, "duration_s": 15.0}}
@@ -27,8 +28,8 @@ def small_config(transitions, trials=8, **campaign):
 
 
 @pytest.fixture(scope="module")
-def setup():
-    return build_setup(small_config(["elevon_lock"]))
+def spec():
+    return chunk_spec(small_config(["elevon_lock"]))
 
 
 def _fake_record(setup, resets_per_lane, detect_k):
@@ -45,7 +46,8 @@ def _fake_record(setup, resets_per_lane, detect_k):
     return rec
 
 
-def test_classification_of_hand_made_resets(setup):
+def test_classification_of_hand_made_resets(spec):
+    setup = spec.setup
     kf = setup.tim.k_fault  # 50
     lanes = [
         [],                                   # no reset at all
@@ -57,9 +59,10 @@ def test_classification_of_hand_made_resets(setup):
         [(kf + 1, 2)] * 6,                    # more resets than stored
     ]
     ids = np.arange(len(lanes))
-    inp, draws = build_inputs(setup, "elevon_lock", ids, 7)
+    inp, values = trial_inputs(spec, "elevon_lock", ids)
     rec = _fake_record(setup, lanes, [kf + 20, -1, kf + 10, -1, -1, -1, -1])
-    t, r = classify(setup, "elevon_lock", "paper", ids, draws, inp, rec, 50)
+    assert spec.window == 50  # 5 s
+    t, r = classify(spec, "elevon_lock", "paper", ids, values, inp, rec)
     assert list(t["no_reset"]) == [True, False, False, False, True, True, False]
     assert list(t["correct"]) == [False, True, True, True, False, False, True]
     assert list(t["inappropriate"]) == [False, False, True, False, False, False, False]

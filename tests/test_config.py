@@ -6,8 +6,8 @@ from pathlib import Path
 import pytest
 import yaml
 
+from ftc_mc.config import Config, load_config, load_scenario, parse_config
 from ftc_mc.errors import UserError
-from ftc_mc.io.config import Config, load_config, load_scenario, parse_config
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "scripts"))
@@ -61,6 +61,7 @@ def test_scientific_notation_is_a_number(tmp_path):
     ("campaign:\n  transitions: []\n", "campaign.transitions"),
     ("timing:\n  fault_time_s: 20.05\n", "timing.fault_time_s"),
     ("timing:\n  duration_s: 5\n", "timing.duration_s"),
+    ("draws:\n  engine_lock_range: [0.5, 1.5]\n", "draws.engine_lock_range"),
     ("campaign: 3\n", "campaign"),
     ("- a\n- b\n", "mapping"),
     ("", "empty"),

@@ -22,8 +22,9 @@ from ftc_mc.core import excitation as ke
 from ftc_mc.core import kalman as kk
 from ftc_mc.core import signature as ks
 from ftc_mc.core.step import filter_step
-from ftc_mc.estimator import (PAPER_R_DIAG, EstimatorSettings, Workspace, belief_settings,
-                              detection, filter_model, initial_covariance, unit_rows)
+from ftc_mc.sim.estimator import (PAPER_R_DIAG, EstimatorSettings, Workspace,
+                                  belief_settings, detection, filter_model,
+                                  initial_covariance, unit_rows)
 from ftc_mc.model.faults import bias_matrix
 from ftc_mc.model.linear import build_plant
 

@@ -5,8 +5,8 @@ import pytest
 
 import ftc_mc
 from ftc_mc.campaign.sweep import run_sweep, threshold_points
+from ftc_mc.config import Config
 from ftc_mc.errors import UserError
-from ftc_mc.io.config import Config
 
 pytest.importorskip("dask.distributed")
 

@@ -23,8 +23,8 @@ from ftc_mc.core.excitation import saturate, signal_3211
 from ftc_mc.core.kalman import predict, update
 from ftc_mc.core.signature import NO_RESET, RESET_ELEVONS, RESET_THRUST
 from ftc_mc.core.step import filter_step
-from ftc_mc.estimator import (EstimatorSettings, Workspace, belief_settings, detection,
-                              filter_model, initial_covariance)
+from ftc_mc.sim.estimator import (EstimatorSettings, Workspace, belief_settings, detection,
+                                  filter_model, initial_covariance)
 from ftc_mc.model.faults import augmented, effect
 from ftc_mc.model.linear import build_plant
 

@@ -34,8 +34,8 @@ from hypothesis import HealthCheck, currently_in_test_context, event, given, set
 from hypothesis import strategies as st
 
 from ftc_mc.cli import cli
+from ftc_mc.config import Config, ScenarioConfig, parse_config
 from ftc_mc.errors import UserError
-from ftc_mc.io.config import Config, ScenarioConfig, parse_config
 
 ROOT = Path(__file__).resolve().parents[1]
 SHIPPED = {"run": ROOT / "configs" / "elevon_lock.yaml",
@@ -253,7 +253,7 @@ PYTHON_TAGS = [
     "!!python/object/apply:subprocess.check_output [['touch', 'PWNED_subprocess']]",
     "!!python/name:os.system",
     "!!python/module:os",
-    "!!python/object:ftc_mc.io.config.Config {}",
+    "!!python/object:ftc_mc.config.schema.Config {}",
     "!!python/tuple [1, 2]",
     "!!python/unicode 'x'",
     "!<tag:yaml.org,2002:python/object/apply:os.system> ['touch PWNED_verbatim']",

@@ -6,8 +6,8 @@ from numba import njit
 
 from ftc_mc.core.belief import belief_update
 from ftc_mc.core.step import filter_step
-from ftc_mc.estimator import (EstimatorSettings, belief_settings, detection,
-                              filter_model)
+from ftc_mc.sim.estimator import (EstimatorSettings, belief_settings, detection,
+                                  filter_model)
 
 
 @njit(cache=False)

@@ -8,8 +8,8 @@ from click.testing import CliRunner
 import ftc_mc
 from ftc_mc.campaign.sweep import parse_spec, run_sweep, threshold_points
 from ftc_mc.cli import cli
+from ftc_mc.config import Config
 from ftc_mc.errors import UserError
-from ftc_mc.io.config import Config
 from ftc_mc.io.results import read_metadata
 
 CFG = Config.model_validate({

@@ -21,17 +21,18 @@ import pytest
 import yaml
 from click.testing import CliRunner
 
-from ftc_mc.campaign.chunk import build_inputs, new_record
+from ftc_mc.campaign.chunk import chunk_spec, trial_inputs
 from ftc_mc.campaign.runner import run_campaign
-from ftc_mc.campaign.setup import build_setup
-from ftc_mc.campaign.sweep import _point_det, flight_inputs
-from ftc_mc.campaign.transitions import TRANSITION_TABLE, draw_trial
 from ftc_mc.cli import cli
+from ftc_mc.config import Config, parse_config
 from ftc_mc.core.trial import run_trials
-from ftc_mc.io.config import Config
+from ftc_mc.errors import UserError
 from ftc_mc.model import dynamics
 from ftc_mc.model.turbulence import dryden_model
-from ftc_mc.truth import truth_plant, wind_matrices
+from ftc_mc.sim.inputs import draw_lane, flight_inputs, trial_stream
+from ftc_mc.sim.lanes import new_record
+from ftc_mc.sim.setup import build_setup
+from ftc_mc.sim.truth import wind_matrices
 
 SHORT = {"fault_time_s": 2.0, "window_s": 2.0, "duration_s": 6.0}
 
@@ -70,9 +71,10 @@ def _rk4_twin(x, cmd, p, dt, n_sub):
 
 @pytest.mark.parametrize("transition", ["elevon_lock", "engine_loss"])
 def test_nonlinear_truth_matches_plain_python_twin(transition):
-    setup = build_setup(_cfg())
+    spec = dataclasses.replace(chunk_spec(_cfg()), seed=7)
+    setup = spec.setup
     ids = np.arange(2)
-    inp, _ = build_inputs(setup, transition, ids, 7)
+    inp, _ = trial_inputs(spec, transition, ids)
     rec = _run(setup, inp, 2)
     pl, u0 = setup.truth, setup.fm.u0
     kf = setup.tim.k_fault
@@ -90,8 +92,9 @@ def test_nonlinear_truth_matches_plain_python_twin(transition):
 
 
 def test_gusts_follow_the_dryden_recursion():
-    setup = build_setup(_cfg(turbulence="moderate"))
-    inp, _ = build_inputs(setup, "elevon_lock", np.arange(2), 3)
+    spec = dataclasses.replace(chunk_spec(_cfg(turbulence="moderate")), seed=3)
+    setup = spec.setup
+    inp, _ = trial_inputs(spec, "elevon_lock", np.arange(2))
     rec = _run(setup, inp, 2)
     g = setup.gust
     for l in range(2):
@@ -104,11 +107,10 @@ def test_gusts_follow_the_dryden_recursion():
 
 
 def test_gust_draws_come_after_the_still_air_draws():
-    tr = TRANSITION_TABLE["engine_loss"]
     chol = dryden_model("moderate").P0_chol
     q, r = np.full(9, 0.1), np.full(12, 0.2)
-    still = draw_trial(5, 11, tr, (0.0, 1.0), (0.0, 1.0), 40, q, r)
-    gusty = draw_trial(5, 11, tr, (0.0, 1.0), (0.0, 1.0), 40, q, r, chol)
+    still = draw_lane(trial_stream(5, 11), 40, q, r, fault_range=(0.0, 1.0))
+    gusty = draw_lane(trial_stream(5, 11), 40, q, r, chol, fault_range=(0.0, 1.0))
     assert still[3] is None
     assert still[0] == gusty[0]
     assert np.array_equal(still[1], gusty[1]) and np.array_equal(still[2], gusty[2])
@@ -150,7 +152,7 @@ def test_linear_and_nonlinear_agree_for_small_gusts(eps):
         s = dataclasses.replace(s, truth=s.truth._replace(Bd=s.truth.Bd * eps))
         inp = flight_inputs(s, np.arange(8), 2026)
         inp.g0[:] *= eps
-        det = _point_det(s, cfg, "swapped", math.inf, math.inf)
+        det = s.detection("swapped", math.inf, math.inf)
         recs[kind] = _run(s, inp, 8, det)
     a, b = recs["linear"].hist_x, recs["nonlinear"].hist_x
     rel = np.abs(a - b).max(axis=(0, 2)) / a.std(axis=(0, 2))
@@ -158,14 +160,13 @@ def test_linear_and_nonlinear_agree_for_small_gusts(eps):
     assert rel.max() > 0.1 * eps  # the plants do differ (nonlinearity is real)
 
 
-def test_truth_plant_rejects_bad_choices():
-    plant = build_setup(_cfg(kind="linear")).plant
-    with pytest.raises(ValueError, match="plant.kind"):
-        truth_plant(plant, kind="quadratic")
-    with pytest.raises(ValueError, match="plant.turbulence"):
-        truth_plant(plant, turbulence="stormy")
-    with pytest.raises(ValueError, match="plant.substeps"):
-        truth_plant(plant, kind="nonlinear", substeps=0)
+def test_bad_plant_choices_are_refused_by_the_schema():
+    # the schema is the only validator; sim/truth.py trusts what it passes
+    for plant, field in (({"kind": "quadratic"}, "plant.kind"),
+                         ({"turbulence": "stormy"}, "plant.turbulence"),
+                         ({"kind": "nonlinear", "substeps": 0}, "plant.substeps")):
+        with pytest.raises(UserError, match=field):
+            parse_config({"plant": plant})
 
 
 def test_nonlinear_turbulent_campaign_is_reproducible_across_chunks_and_jobs():

@@ -1,118 +1,116 @@
-"""Run one chunk of trials of one transition and classify them (worker side).
+"""One chunk of trials or fault-free flights: inputs -> kernels -> classified rows.
 
-A chunk is a fixed range of trial ids; its results depend only on those ids and
-the root seed, never on which worker runs it or how many chunks there are.
+The one chunk executor of ``ftc-mc run`` and ``ftc-mc sweep`` (worker side).  A
+chunk is a fixed range of trial ids of one transition, or of fault-free flights
+(:data:`FLIGHT`); its results depend only on those ids and the root seed, never
+on which worker runs it or how many chunks there are.  :func:`run_chunk` lays
+out the inputs (``ftc_mc/sim/inputs.py``), runs them under every signature
+variant (and, in a sweep, every threshold point) with
+:func:`ftc_mc.sim.lanes.simulate`, and classifies the records.
 """
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
+import pandas as pd
 
+from ..config.schema import Config
+from ..conventions import (BLOCK_NAMES, MODE_NAMES, STATUS_NAMES, STATUS_NONFINITE,
+                           STATUS_NOT_PSD)
 from ..core.settings import TrialInputs, TrialRecord
-from ..core.trial import STATUS_NAMES, STATUS_NONFINITE, STATUS_NOT_PSD, run_trials
-from .setup import CampaignSetup
-from .transitions import (BLOCK_NAMES, TRANSITION_TABLE, draw_trial, estimator_params,
-                          faulty_params, gust_lanes, mode_of)
+from ..sim.inputs import build_inputs, draw_lanes, flight_inputs
+from ..sim.lanes import simulate
+from ..sim.setup import SimSetup, build_setup, variants_of
+from .transitions import TRANSITION_TABLE, FaultRanges, fault_ranges
 
-from ..conventions import MODE_NAMES
+FLIGHT = "fault_free"
+"""Chunk name of the fault-free flights of a sweep (false resets per flight hour)."""
 
 
-def draw_lanes(setup: CampaignSetup, tr, trial_ids, seed: int, lock_range=(0.0, 1.0)):
-    """Every trial's draws (:func:`~ftc_mc.campaign.transitions.draw_trial`) in lanes.
+@dataclasses.dataclass(frozen=True)
+class ChunkSpec:
+    """What every chunk of one run or sweep shares (built once, sent to workers).
 
-    Returns
-    -------
-    draws : ndarray, shape (L,)
-        The fault draw of each trial (lock position or b1).
-    w, v : ndarray, shapes (n_steps, 9, L) and (n_steps, 12, L)
-    eta, g0 : ndarray
-        Gust draws and initial gust states (see
-        :func:`~ftc_mc.campaign.transitions.gust_lanes`).
+    Attributes
+    ----------
+    setup : SimSetup
+    seed : int
+        Root seed of the trial streams.
+    variants : tuple of str
+        Signature variants run on the same inputs.
+    ranges : FaultRanges
+        Ranges of the trials' fault values.
+    near_trim : tuple
+        ``(engine, elevon)`` half-widths of a lock 'near trim' (``explain``).
+    window : int
+        Judging window after the switch [steps].
+    max_resets : int
+        Resets stored per trial.
+    points : tuple of (float, float) or None
+        A sweep's ``(t_q, t_nx)`` threshold points, run sharing each trial's
+        start (``ftc_mc/sim/lanes.py``); ``None``: the config's thresholds.
     """
-    n, L = setup.tim.n_steps, len(trial_ids)
-    w = np.empty((n, 9, L))
-    v = np.empty((n, 12, L))
-    draws = np.empty(L)
-    eta, g0 = gust_lanes(n, L, setup.gust_chol is not None)
-    for l, tid in enumerate(trial_ids):
-        draws[l], w[:, :, l], v[:, :, l], gust = draw_trial(
-            int(tid), seed, tr, lock_range, setup.loss_range, n, setup.q_std,
-            setup.r_std, setup.gust_chol)
-        if gust is not None:
-            eta[:, :, l], g0[:, l] = gust
-    return draws, w, v, eta, g0
+
+    setup: SimSetup
+    seed: int
+    variants: tuple
+    ranges: FaultRanges
+    near_trim: tuple
+    window: int
+    max_resets: int
+    points: tuple | None = None
+
+    @property
+    def tables(self) -> tuple:
+        """Names of the tables :func:`run_chunk` returns (``trials`` first)."""
+        return ("trials", "resets") if self.points is None else ("trials", "steps")
 
 
-def build_inputs(setup: CampaignSetup, tr_name: str, trial_ids, seed: int):
-    """Draw every trial of a chunk and lay the inputs out in lanes.
+def chunk_spec(cfg: Config, setup: SimSetup | None = None, points=None) -> ChunkSpec:
+    """The :class:`ChunkSpec` of a validated campaign config.
+
+    Parameters
+    ----------
+    cfg : Config
+    setup : SimSetup, optional
+        Built from ``cfg`` when omitted.
+    points : list of (float, float), optional
+        Threshold points of a sweep.
+    """
+    setup = build_setup(cfg) if setup is None else setup
+    plant = setup.plant
+    return ChunkSpec(setup=setup, seed=cfg.campaign.seed,
+                     variants=variants_of(cfg.campaign.signature),
+                     ranges=fault_ranges(cfg.draws, plant.u_lower, plant.u_upper),
+                     near_trim=(cfg.explain.engine_lock_near_trim,
+                                cfg.explain.elevon_lock_near_trim_rad),
+                     window=cfg.steps(cfg.timing.window_s), max_resets=cfg.resets_stored(),
+                     points=None if points is None else tuple(map(tuple, points)))
+
+
+def trial_inputs(spec: ChunkSpec, tr_name: str, trial_ids):
+    """Draw every trial of a chunk of transition ``tr_name`` and lay out its inputs.
 
     Returns
     -------
     inp : TrialInputs
-    draws : ndarray, shape (L,)
-        The fault draw of each trial (lock position or b1).
+    values : ndarray, shape (L,)
+        The fault value of each trial (lock position or b1).
     """
     tr = TRANSITION_TABLE[tr_name]
-    tim = setup.tim
-    L = len(trial_ids)
-    b0 = {True: np.zeros((3, L)), False: np.zeros((3, L))}   # keyed by 'faulty'
-    b1 = {True: np.zeros((3, L)), False: np.zeros((3, L))}
-    mode_f = np.zeros(L, dtype=np.int64)
-    xa0 = np.zeros((14, L))
-    draws, w, v, eta, g0 = draw_lanes(setup, tr, trial_ids, seed,
-                                      setup.lock_range[tr.actuator])
-    for l, value in enumerate(draws):
-        fb0, fb1 = faulty_params(tr, value)
-        b0[True][:, l] = fb0
-        b1[True][:, l] = fb1
-        mode_f[l] = mode_of(fb1, *setup.beta)
-    mode_nominal = np.zeros(L, dtype=np.int64)
-    pre_faulty = not tr.onset
-    b0_sched = np.stack([b0[pre_faulty], b0[not pre_faulty]])
-    b1_sched = np.stack([b1[pre_faulty], b1[not pre_faulty]])
-    mode_pre = mode_f if pre_faulty else mode_nominal
-    mode_post = mode_nominal if pre_faulty else mode_f
-    for l in range(L):
-        # the trial starts with the initial mode already identified
-        xa0[9:, l] = estimator_params(b0_sched[0, :, l], b1_sched[0, :, l])
-    inp = TrialInputs(k_switch=np.array([0, tim.k_fault], dtype=np.int64), b0=b0_sched,
-                      b1=b1_sched, mode_pre=mode_pre, mode_post=mode_post, xa0=xa0,
-                      P0=setup.P0, w=w, v=v, eta=eta, g0=g0)
-    return inp, draws
+    setup = spec.setup
+    draws = draw_lanes(setup, trial_ids, spec.seed, spec.ranges.of(tr))
+    return build_inputs(setup, tr.schedule(draws.fault, setup.tim.k_fault), draws), draws.fault
 
 
-def new_record(setup: CampaignSetup, L: int, max_resets: int, history: bool = False
-               ) -> TrialRecord:
-    """Preallocated outputs of :func:`ftc_mc.core.trial.run_trials`.
-
-    ``history=True`` keeps every step's state, estimate, commands, residuals
-    and excitation (for scenarios); campaigns keep only the per-period arrays.
-    """
-    n_per = setup.tim.n_steps // setup.tim.reconf_every
-    n_hist = setup.tim.n_steps if history else 0
-    return TrialRecord(
-        reset_k=np.zeros((max_resets, L), dtype=np.int64),
-        reset_block=np.zeros((max_resets, L), dtype=np.int64),
-        reset_res=np.zeros((max_resets, 3, L)),
-        n_resets=np.zeros(L, dtype=np.int64),
-        belief=np.zeros((n_per, 4, L)), bhat=np.zeros((n_per, 5, L)),
-        detect_k=np.zeros(L, dtype=np.int64), status=np.zeros(L, dtype=np.int64),
-        stop_k=np.zeros(L, dtype=np.int64),
-        controller=np.zeros((n_per, L), dtype=np.int64),
-        hist_x=np.zeros((n_hist, 9, L)), hist_xa=np.zeros((n_hist, 14, L)),
-        hist_pdiag=np.zeros((n_hist, 5, L)), hist_u=np.zeros((n_hist, 3, L)),
-        hist_res=np.zeros((n_hist, 3, L)), hist_exc=np.zeros((n_hist, 4, L)),
-        hist_block=np.zeros((n_hist, L), dtype=np.int64),
-        hist_wind=np.zeros((n_hist, 3, L)),
-        xa_end=np.zeros((14, L)))
-
-
-def classify(setup: CampaignSetup, tr_name: str, variant: str, trial_ids, draws,
-             inp: TrialInputs, rec: TrialRecord, window_steps: int):
+def classify(spec: ChunkSpec, tr_name: str, variant: str, trial_ids, values,
+             inp: TrialInputs, rec: TrialRecord):
     """Per-trial and per-reset columns of one kernel call.
 
     Definitions (DESIGN.md section 6), with ``k_f`` the switch step and the
-    window the steps ``k_f < k <= k_f + window_steps``:
+    window the steps ``k_f < k <= k_f + spec.window``:
 
     * ``correct``: the transition's block was reset in the window;
     * ``inappropriate``: the other block was reset in the window (whether or
@@ -128,11 +126,24 @@ def classify(setup: CampaignSetup, tr_name: str, variant: str, trial_ids, draws,
       numerically, left the validity envelope (if at all) only after the window,
       and stored all its resets.
 
+    Parameters
+    ----------
+    spec : ChunkSpec
+    tr_name : str
+    variant : str
+    trial_ids : ndarray, shape (L,)
+    values : ndarray, shape (L,)
+        The trials' fault values (lock position or ``b1``).
+    inp : TrialInputs
+    rec : TrialRecord
+
     Returns
     -------
     trials : dict of str to ndarray
     resets : dict of str to ndarray
     """
+    setup = spec.setup
+    window_steps = spec.window
     tr = TRANSITION_TABLE[tr_name]
     dt = setup.plant.dt
     kf = setup.tim.k_fault
@@ -156,10 +167,10 @@ def classify(setup: CampaignSetup, tr_name: str, variant: str, trial_ids, draws,
     a = tr.actuator
     u0 = setup.plant.u0[a]
     beta = setup.beta[0 if a == 0 else 1]
-    near = setup.near_trim[0 if a == 0 else 1]
+    near = spec.near_trim[0 if a == 0 else 1]
     is_lock = tr.kind == "lock"
-    small_b1 = np.zeros(L, dtype=bool) if is_lock else draws < beta
-    near_trim = np.abs(draws - u0) < near if is_lock else np.zeros(L, dtype=bool)
+    small_b1 = np.zeros(L, dtype=bool) if is_lock else values < beta
+    near_trim = np.abs(values - u0) < near if is_lock else np.zeros(L, dtype=bool)
     truncated = rec.n_resets > R
     # A trial is judged when it stayed valid through the whole window: numerical
     # failures never count; an envelope exit after the window does not matter.
@@ -172,8 +183,8 @@ def classify(setup: CampaignSetup, tr_name: str, variant: str, trial_ids, draws,
         "transition": np.full(L, tr_name, dtype=object),
         "variant": np.full(L, variant, dtype=object),
         "trial_id": np.asarray(trial_ids, dtype=np.int64),
-        "lock_position": draws if is_lock else np.full(L, np.nan),
-        "loss_b1": np.full(L, np.nan) if is_lock else draws,
+        "lock_position": values if is_lock else np.full(L, np.nan),
+        "loss_b1": np.full(L, np.nan) if is_lock else values,
         "mode_pre": np.array([MODE_NAMES[m] for m in inp.mode_pre], dtype=object),
         "mode_post": np.array([MODE_NAMES[m] for m in inp.mode_post], dtype=object),
         "correct": correct,
@@ -215,20 +226,76 @@ def classify(setup: CampaignSetup, tr_name: str, variant: str, trial_ids, draws,
     return trials, resets
 
 
-def run_chunk(setup: CampaignSetup, tr_name: str, trial_ids, seed: int, variants,
-              max_resets: int, window_steps: int):
-    """Draw, simulate both variants on the same draws, and classify.
+def count_flights(rec: TrialRecord) -> dict:
+    """Flights, judged flights (valid to the end) and their resets."""
+    ok = rec.status == 0
+    return {"flights": len(ok), "judged": int(ok.sum()),
+            "resets": int(rec.n_resets[ok].sum())}
+
+
+def _runs(spec: ChunkSpec):
+    """``(t_q, t_nx, variant, Detection)`` of every run of a chunk, point-major."""
+    setup = spec.setup
+    if spec.points is None:
+        return [(None, None, v, setup.det[v]) for v in spec.variants]
+    return [(tq, tnx, v, setup.detection(v, tq, tnx))
+            for tq, tnx in spec.points for v in spec.variants]
+
+
+def _columns(parts) -> dict:
+    return {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
+
+
+def run_chunk(spec: ChunkSpec, name: str, trial_ids) -> dict:
+    """Draw, simulate every run on the same inputs, and classify.
+
+    Parameters
+    ----------
+    spec : ChunkSpec
+    name : str
+        A transition, or :data:`FLIGHT` for fault-free flights (sweeps only).
+    trial_ids : ndarray of int
 
     Returns
     -------
-    list of (trials, resets)
-        One pair of column dicts per variant.
+    dict of str to DataFrame
+        Without threshold points: ``trials`` and ``resets`` (:func:`classify`
+        columns, variant-major).  With them: ``trials`` (plus ``t_q``, ``t_nx``;
+        for :data:`FLIGHT`, one row of :func:`count_flights` per point and
+        variant) and ``steps`` (trial steps ``simulated``, and ``alone``: what
+        the points would cost run one by one).
     """
-    inp, draws = build_inputs(setup, tr_name, trial_ids, seed)
-    out = []
-    for variant in variants:
-        rec = new_record(setup, len(trial_ids), max_resets)
-        run_trials(setup.scheme(variant), setup.flight, inp, rec)
-        out.append(classify(setup, tr_name, variant, trial_ids, draws, inp, rec,
-                            window_steps))
-    return out
+    setup = spec.setup
+    runs = _runs(spec)
+    L, n = len(trial_ids), setup.tim.n_steps
+    if name == FLIGHT:
+        assert spec.points is not None
+        inp = flight_inputs(setup, trial_ids, spec.seed)
+        recs, simulated = simulate(setup, inp, [r[2:] for r in runs], spec.max_resets, n)
+        rows = [{"t_q": tq, "t_nx": tnx, "variant": v, **count_flights(rec)}
+                for (tq, tnx, v, _), rec in zip(runs, recs)]
+        return {"trials": pd.DataFrame(rows),
+                "steps": pd.DataFrame({"simulated": [simulated], "alone": [L * n * len(runs)]})}
+    inp, values = trial_inputs(spec, name, trial_ids)
+    share = None if spec.points is None else setup.tim.k_fault
+    recs, simulated = simulate(setup, inp, [r[2:] for r in runs], spec.max_resets, share)
+    trials, resets = [], []
+    for (tq, tnx, v, _), rec in zip(runs, recs):
+        t, r = classify(spec, name, v, trial_ids, values, inp, rec)
+        if spec.points is not None:
+            t["t_q"] = np.full(L, tq)
+            t["t_nx"] = np.full(L, tnx)
+        trials.append(t)
+        resets.append(r)
+    if spec.points is None:
+        return {"trials": pd.DataFrame(_columns(trials)),
+                "resets": pd.DataFrame(_columns(resets))}
+    return {"trials": pd.DataFrame(_columns(trials)),
+            "steps": pd.DataFrame({"simulated": [simulated], "alone": [L * n * len(runs)]})}
+
+
+def warm_up(spec: ChunkSpec, tr_name: str) -> None:
+    """Compile (or load from Numba's cache) the kernels before fanning out: one
+    trial of ``tr_name`` under the first variant."""
+    run_chunk(dataclasses.replace(spec, variants=spec.variants[:1], max_resets=4, window=1,
+                                  points=None), tr_name, np.arange(1))

@@ -1,8 +1,11 @@
 """Where chunks run: local worker processes (joblib/loky) or a Dask cluster.
 
-The same chunk functions run either way, and results do not depend on where
-they ran.  With ``backend="dask"`` the chunks go through joblib's Dask backend
-to a ``distributed`` cluster: the one at ``scheduler`` (e.g.
+:func:`run_chunks` is the parent side of ``ftc-mc run`` and ``ftc-mc sweep``:
+it sends every chunk not yet finished to :func:`ftc_mc.campaign.chunk.run_chunk`,
+stores each as it completes, and returns them all.  The same chunk function
+runs either way, and results do not depend on where they ran.  With
+``backend="dask"`` the chunks go through joblib's Dask backend to a
+``distributed`` cluster: the one at ``scheduler`` (e.g.
 ``tcp://10.0.0.5:8786``), or a local cluster of single-threaded worker
 processes when no address is given.  Kernels are compiled (and cached on disk)
 in the parent before fanning out; Dask workers on other machines compile their
@@ -13,9 +16,11 @@ from __future__ import annotations
 
 import contextlib
 
-from joblib import parallel_config
+from joblib import Parallel, delayed, parallel_config
+from tqdm.auto import tqdm
 
 from ..errors import UserError
+from .chunk import ChunkSpec, run_chunk, warm_up
 
 BACKENDS = ("loky", "dask")
 
@@ -66,3 +71,56 @@ def backend(name: str = "loky", scheduler: str | None = None, n_workers: int = 2
         client.close()
         if cluster is not None:
             cluster.close()
+
+
+def run_chunks(spec: ChunkSpec, units, *, n_jobs: int = 1, backend_name: str = "loky",
+               scheduler: str | None = None, progress: bool = True, chunks=None,
+               desc: str = "trials") -> list:
+    """Run every chunk of a run or sweep; return their tables in the order of ``units``.
+
+    Parameters
+    ----------
+    spec : ChunkSpec
+    units : list of (str, ndarray)
+        ``(name, trial_ids)`` of every chunk (a transition or ``FLIGHT``).
+    n_jobs : int
+        Workers (1: in this process).
+    backend_name, scheduler
+        Where chunks run (:func:`backend`).
+    progress : bool
+        Show a tqdm bar counting finished trials.
+    chunks : ChunkStore, optional
+        Where finished chunks are stored as they complete; chunks already in it
+        are not run again (resume).  The tables are then read back from the
+        store, so they are the same whether or not the run was resumed.
+    desc : str
+        Label of the progress bar.
+
+    Returns
+    -------
+    list of dict of str to DataFrame
+        :func:`~ftc_mc.campaign.chunk.run_chunk`'s tables of each unit.
+    """
+    tables = spec.tables
+    todo = [(n, ids) for n, ids in units if chunks is None or not chunks.done(n, int(ids[0]))]
+    if todo:
+        warm_up(spec, units[0][0])
+    done = {}
+    total = sum(len(ids) for _, ids in units)
+    with tqdm(total=total, unit="trial", disable=not progress, desc=desc,
+              dynamic_ncols=True) as bar:
+        bar.update(total - sum(len(ids) for _, ids in todo))
+        with backend(backend_name, scheduler, n_jobs):
+            gen = Parallel(n_jobs=n_jobs, return_as="generator")(
+                delayed(run_chunk)(spec, name, ids) for name, ids in todo)
+            for (name, ids), out in zip(todo, gen):
+                if chunks is not None:
+                    chunks.write(name, int(ids[0]), out[tables[0]],
+                                 **{t: out[t] for t in tables[1:]})
+                else:
+                    done[name, int(ids[0])] = out
+                bar.update(len(ids))
+    if chunks is not None:
+        done = {(n, int(ids[0])): dict(zip(tables, chunks.read(n, int(ids[0]), tables)))
+                for n, ids in units}
+    return [done[n, int(ids[0])] for n, ids in units]

@@ -16,13 +16,11 @@ import os
 
 import numpy as np
 import pandas as pd
-from joblib import Parallel, delayed
-from tqdm.auto import tqdm
 
-from ..io.config import Config, load_config, parse_config, with_overrides
-from .chunk import run_chunk
-from .parallel import backend as parallel_backend
-from .setup import CampaignSetup, build_setup, variants_of
+from ..config.load import load_config, parse_config, with_overrides
+from ..config.schema import Config
+from .chunk import chunk_spec
+from .parallel import run_chunks
 from .summary import markdown_table, summarize
 
 
@@ -77,12 +75,6 @@ def plan_chunks(cfg: Config):
     return out
 
 
-def warm_up(setup: CampaignSetup, cfg: Config) -> None:
-    """Compile (or load from Numba's cache) every kernel before fanning out."""
-    run_chunk(setup, cfg.campaign.transitions[0], np.arange(1), cfg.campaign.seed,
-              variants_of(cfg.campaign.signature)[:1], 4, 1)
-
-
 SMALL_RUN_STEPS = 3_000_000
 """Below this many (controller-weighted) trial steps, ``jobs=-1`` runs in-process:
 starting worker processes (importing Numba and loading the cached kernels,
@@ -105,16 +97,20 @@ def auto_jobs(cfg: Config, n_variants: int) -> int:
     return max(1, min(os.cpu_count() or 1, len(plan_chunks(cfg))))
 
 
-def _frames(parts, key):
-    cols = {}
-    for part in parts:
-        for name, arr in part[key].items():
-            cols.setdefault(name, []).append(arr)
-    return pd.DataFrame({k: np.concatenate(v) for k, v in cols.items()})
+def sort_rows(df: pd.DataFrame, transitions, variants, extra) -> pd.DataFrame:
+    """Rows in (transition as configured, variant as configured, *extra) order (stable).
 
-
-def _sorted(df, order, vorder, extra):
-    """Rows in (transition as configured, variant, *extra) order (stable)."""
+    Parameters
+    ----------
+    df : DataFrame
+        With ``transition`` and ``variant`` columns and the columns ``extra``.
+    transitions, variants : sequence of str
+        Their order in the result.
+    extra : list of str
+        Further sort keys, most significant first.
+    """
+    order = {n: i for i, n in enumerate(transitions)}
+    vorder = {v: i for i, v in enumerate(variants)}
     keys = [df[c].to_numpy() for c in reversed(extra)]
     keys += [df["variant"].map(vorder).to_numpy(), df["transition"].map(order).to_numpy()]
     return df.iloc[np.lexsort(keys)].reset_index(drop=True)
@@ -153,45 +149,16 @@ def run_campaign(config, *, trials=None, seed=None, signature=None, jobs: int = 
     CampaignResult
     """
     cfg = resolve_config(config, trials, seed, signature)
-    setup = build_setup(cfg)
+    spec = chunk_spec(cfg)
     c = cfg.campaign
-    variants = variants_of(c.signature)
-    window = cfg.steps(cfg.timing.window_s)
-    plan = plan_chunks(cfg)
-    todo = [(n, ids) for n, ids in plan if chunks is None or not chunks.done(n, int(ids[0]))]
-    if todo:
-        warm_up(setup, cfg)
-    n_jobs = auto_jobs(cfg, len(variants)) if jobs == -1 else max(1, int(jobs))
-    total = c.trials * len(c.transitions)
-    parts = []
-    with tqdm(total=total, unit="trial", disable=not progress, desc="trials",
-              dynamic_ncols=True) as bar:
-        bar.update(total - sum(len(ids) for _, ids in todo))
-        if backend == "dask":
-            n_jobs = os.cpu_count() if jobs == -1 else n_jobs
-        with parallel_backend(backend, scheduler, n_jobs):
-            gen = Parallel(n_jobs=n_jobs, return_as="generator")(
-                delayed(run_chunk)(setup, name, ids, c.seed, variants, cfg.resets_stored(),
-                                   window)
-                for name, ids in todo)
-            for (name, ids), out in zip(todo, gen):
-                part = [dict(trials=t, resets=r) for t, r in out]
-                if chunks is not None:
-                    chunks.write(name, int(ids[0]), _frames(part, "trials"),
-                                 resets=_frames(part, "resets"))
-                else:
-                    parts.extend(part)
-                bar.update(len(ids))
-    if chunks is not None:
-        stored = [chunks.read(n, int(ids[0])) for n, ids in plan]
-        trials_df = pd.concat([t for t, _ in stored], ignore_index=True)
-        resets_df = pd.concat([r for _, r in stored], ignore_index=True)
-    else:
-        trials_df = _frames(parts, "trials")
-        resets_df = _frames(parts, "resets")
-    order = {n: i for i, n in enumerate(c.transitions)}
-    vorder = {v: i for i, v in enumerate(variants)}
-    trials_df = _sorted(trials_df, order, vorder, ["trial_id"])
-    resets_df = _sorted(resets_df, order, vorder, ["trial_id", "time_s"])
+    n_jobs = auto_jobs(cfg, len(spec.variants)) if jobs == -1 else max(1, int(jobs))
+    if backend == "dask" and jobs == -1:
+        n_jobs = os.cpu_count()
+    out = run_chunks(spec, plan_chunks(cfg), n_jobs=n_jobs, backend_name=backend,
+                     scheduler=scheduler, progress=progress, chunks=chunks, desc="trials")
+    trials_df = sort_rows(pd.concat([o["trials"] for o in out], ignore_index=True),
+                          c.transitions, spec.variants, ["trial_id"])
+    resets_df = sort_rows(pd.concat([o["resets"] for o in out], ignore_index=True),
+                          c.transitions, spec.variants, ["trial_id", "time_s"])
     return CampaignResult(trials=trials_df, resets=resets_df,
                           summary=summarize(trials_df), config=cfg)

@@ -1,15 +1,12 @@
-"""The eight fault transitions of Tables 2-3 and the per-trial draws.
+"""The eight fault transitions of Tables 2-3 and the ranges of their fault draws.
 
 A transition names the actuator (the faulty elevon is the left one, DESIGN.md
 section 6), the fault kind (lock or loss of effectiveness) and the direction
-(``onset``: nominal -> faulty; ``recovery``: faulty -> nominal).
-
-Draws per trial, from ``numpy.random.default_rng([trial_id, root_seed])`` in this
-order: the fault parameter (lock position uniform over the lock range, or
-effectiveness loss ``b1`` uniform over its range), then the process noise
-(``n_steps x 9``), then the measurement noise (``n_steps x 12``).  Trial ``i`` of
-every transition uses the same stream (common random numbers), and the two
-signature variants run on identical draws and noise.
+(``onset``: nominal -> faulty; ``recovery``: faulty -> nominal).  Its trials fly
+a two-entry schedule (:meth:`Transition.schedule`): the initial mode from the
+start, the final mode from the fault step on.  Each trial's fault value (lock
+position or effectiveness loss ``b1``) is the first draw of its stream, uniform
+over :meth:`FaultRanges.of` (``ftc_mc/sim/inputs.py`` gives the order of all draws).
 """
 
 from __future__ import annotations
@@ -18,9 +15,7 @@ import dataclasses
 
 import numpy as np
 
-from ..conventions import BLOCK_NAMES, MODE_ENGINE, MODE_NOMINAL  # noqa: F401
-from ..conventions import MODE_LEFT_ELEVON as MODE_LEFT
-from ..conventions import MODE_RIGHT_ELEVON as MODE_RIGHT
+from ..sim.inputs import Schedule
 
 ENGINE, LEFT, RIGHT = 0, 1, 2
 
@@ -58,6 +53,35 @@ class Transition:
         """The block whose reset is inappropriate."""
         return 2 if self.actuator == ENGINE else 1
 
+    def schedule(self, values: np.ndarray, k_fault: int) -> Schedule:
+        """The two-entry schedule of trials with the fault values ``values``.
+
+        Parameters
+        ----------
+        values : ndarray, shape (L,)
+            Each lane's lock position (absolute) or effectiveness loss ``b1``.
+        k_fault : int
+            Step of the switch to the final mode.
+
+        Returns
+        -------
+        Schedule
+            Entry 0 the initial mode, entry 1 the final one: nominal then faulty
+            for an onset, faulty then nominal for a recovery.
+        """
+        L = len(values)
+        nominal = np.zeros((2, 3, L))
+        b0, b1 = np.zeros((3, L)), np.zeros((3, L))
+        if self.kind == "lock":
+            b1[self.actuator] = 1.0
+            b0[self.actuator] = values
+        else:
+            b1[self.actuator] = values
+        faulty = 1 if self.onset else 0
+        b0s, b1s = nominal, nominal.copy()
+        b0s[faulty], b1s[faulty] = b0, b1
+        return Schedule(k_switch=np.array([0, k_fault], dtype=np.int64), b0=b0s, b1=b1s)
+
 
 TRANSITION_TABLE = {
     t.name: t for t in [
@@ -90,96 +114,34 @@ PAPER_TABLES = {
 """The paper's own Monte Carlo counts, for side-by-side reports."""
 
 
-def faulty_params(tr: Transition, value: float):
-    """Per-actuator truth ``(b0, b1)`` of the faulty mode.
+@dataclasses.dataclass(frozen=True)
+class FaultRanges:
+    """Uniform ranges of the trials' fault values (the config's ``draws`` section).
 
-    Parameters
+    Attributes
     ----------
-    tr : Transition
-    value : float
-        Lock position (absolute) or effectiveness loss ``b1``.
-
-    Returns
-    -------
-    b0, b1 : ndarray, shape (3,)
+    lock : dict of int to (float, float)
+        Absolute lock position range per actuator index (0 engine, 1 left elevon).
+    loss : (float, float)
+        Range of the effectiveness loss ``b1``.
     """
-    b0 = np.zeros(3)
-    b1 = np.zeros(3)
-    if tr.kind == "lock":
-        b1[tr.actuator] = 1.0
-        b0[tr.actuator] = value
-    else:
-        b1[tr.actuator] = value
-    return b0, b1
+
+    lock: dict
+    loss: tuple
+
+    def of(self, tr: Transition) -> tuple:
+        """The range of the fault values of ``tr``'s trials."""
+        return self.lock[tr.actuator] if tr.kind == "lock" else self.loss
 
 
-def mode_of(b1: np.ndarray, beta_engine: float, beta_elevon: float) -> int:
-    """The mode whose box holds the truth ``b1`` (single fault at a time)."""
-    if b1[ENGINE] > beta_engine:
-        return MODE_ENGINE
-    if b1[LEFT] > beta_elevon:
-        return MODE_LEFT
-    if b1[RIGHT] > beta_elevon:
-        return MODE_RIGHT
-    return MODE_NOMINAL
+def fault_ranges(draws, u_lower, u_upper) -> FaultRanges:
+    """The :class:`FaultRanges` of a validated ``draws`` section.
 
-
-def estimator_params(b0: np.ndarray, b1: np.ndarray) -> np.ndarray:
-    """Estimator parameters ``[b0_T, b0_L + b0_R, b1_T, b1_L, b1_R]`` of a truth."""
-    return np.array([b0[0], b0[1] + b0[2], b1[0], b1[1], b1[2]])
-
-
-def draw_trial(trial_id: int, seed: int, tr: Transition, lock_range, loss_range,
-               n_steps: int, q_std: np.ndarray, r_std: np.ndarray, gust_chol=None):
-    """All random draws of one trial.
-
-    Parameters
-    ----------
-    trial_id, seed : int
-        The stream is ``default_rng([trial_id, seed])``.
-    tr : Transition
-    lock_range, loss_range : tuple of float
-        Uniform ranges of the lock position and of ``b1``.
-    n_steps : int
-    q_std : ndarray, shape (9,)
-        Process-noise standard deviations.
-    r_std : ndarray, shape (12,)
-        Measurement-noise standard deviations.
-    gust_chol : ndarray, shape (4, 4), optional
-        Cholesky factor of the stationary Dryden state covariance
-        (:class:`~ftc_mc.model.turbulence.DrydenModel`); ``None`` in still air.
-
-    Returns
-    -------
-    value : float
-        The fault draw (lock position or ``b1``).
-    w : ndarray, shape (n_steps, 9)
-    v : ndarray, shape (n_steps, 12)
-    gust : tuple or None
-        ``(eta, g0)``: the gust draws, shape (n_steps, 4), and the initial gust
-        state, shape (4,), drawn after everything else so that the still-air
-        draws of a trial are the same with and without turbulence.
+    A lock range left null is the actuator's whole command range
+    ``[u_lower, u_upper]`` (the schema keeps a given range inside it).
     """
-    rng = np.random.default_rng([trial_id, seed])
-    lo, hi = lock_range if tr.kind == "lock" else loss_range
-    value = rng.uniform(lo, hi)
-    w = rng.standard_normal((n_steps, 9)) * q_std
-    v = rng.standard_normal((n_steps, 12)) * r_std
-    return value, w, v, draw_gusts(rng, n_steps, gust_chol)
-
-
-def draw_gusts(rng: np.random.Generator, n_steps: int, gust_chol):
-    """Gust draws ``(eta, g0)`` from ``rng`` (see :func:`draw_trial`), or None.
-
-    The initial state is stationary: ``g0 = gust_chol @ N(0, I_4)``.
-    """
-    if gust_chol is None:
-        return None
-    eta = rng.standard_normal((n_steps, 4))
-    g0 = gust_chol @ rng.standard_normal(4)
-    return eta, g0
-
-
-def gust_lanes(n_steps: int, L: int, turbulent: bool):
-    """Empty lane arrays ``eta`` (n_steps or 0, 4, L) and ``g0`` (4, L) of TrialInputs."""
-    return np.zeros((n_steps if turbulent else 0, 4, L)), np.zeros((4, L))
+    lock = {0: tuple(draws.engine_lock_range or (u_lower[0], u_upper[0])),
+            1: tuple(draws.elevon_lock_range_rad or (u_lower[1], u_upper[1]))}
+    for a, (lo, hi) in lock.items():
+        assert u_lower[a] <= lo < hi <= u_upper[a], (a, lo, hi)
+    return FaultRanges(lock=lock, loss=tuple(draws.loss_b1_range))

@@ -74,7 +74,6 @@ from __future__ import annotations
 
 import hashlib
 import math
-import os
 from pathlib import Path
 from typing import NamedTuple
 
@@ -82,7 +81,7 @@ import numpy as np
 import scipy.linalg
 
 from ..core.interp import EngineTables
-from ..io.atomic import atomic_path
+from .cache import default_cache_dir, write_atomic
 from .lqr import paper_q_lqr
 
 #: Bumped whenever the table computation changes, so old cache entries are ignored.
@@ -358,18 +357,6 @@ def engine_fault_tables(plant, b0_grid=None, b1_grid=None, Q=None, R=None, alpha
 
 
 # --------------------------------------------------------------------- cache
-def default_cache_dir() -> Path:
-    """Folder of the design cache.
-
-    ``$FTC_MC_CACHE_DIR/design`` when the environment variable is set (it names
-    the root of all ftc-mc caches), else ``~/.cache/ftc-mc/design``.
-    """
-    root = os.environ.get("FTC_MC_CACHE_DIR")
-    if root:
-        return Path(root).expanduser() / "design"
-    return Path.home() / ".cache" / "ftc-mc" / "design"
-
-
 def _hash_array(h, name, a):
     a = np.ascontiguousarray(a, dtype=np.float64)
     h.update(f"{name}:{a.shape}:".encode())
@@ -433,10 +420,10 @@ def cached_engine_tables(plant, b0_grid=None, b1_grid=None, Q=None, R=None, alph
         except (OSError, ValueError, KeyError):
             pass  # corrupt or foreign file: recompute below
     tables = engine_fault_tables(plant, b0_grid, b1_grid, Q, R, alpha)
-    with atomic_path(path) as tmp:
-        with open(tmp, "wb") as f:  # a file object: np.savez would append ".npz" to a name
-            np.savez(f, key=np.array(key), version=np.array(TABLES_VERSION), K=tables.K,
-                     k=tables.k, b0_grid=tables.b0_grid, b1_grid=tables.b1_grid)
+    # a file object: np.savez would append ".npz" to a name
+    write_atomic(path, lambda f: np.savez(
+        f, key=np.array(key), version=np.array(TABLES_VERSION), K=tables.K, k=tables.k,
+        b0_grid=tables.b0_grid, b1_grid=tables.b1_grid))
     return tables
 
 

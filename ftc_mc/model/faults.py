@@ -27,7 +27,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..conventions import (I_B0_ELEVONS, I_B0_THRUST, I_B1_LEFT,  # noqa: F401
-                           I_B1_RIGHT, I_B1_THRUST, N_AUG, N_B0, N_B1, N_FAULT)
+                           I_B1_RIGHT, I_B1_THRUST, MODE_ENGINE, MODE_LEFT_ELEVON,
+                           MODE_NOMINAL, MODE_RIGHT_ELEVON, N_AUG, N_B0, N_B1, N_FAULT)
 from ..conventions import ACTUATOR_NAMES as ACTUATORS
 
 
@@ -134,3 +135,42 @@ def fault_bounds(u_lower, u_upper):
     lo = np.array([u_lower[0], 2 * u_lower[1], 0.0, 0.0, 0.0])
     hi = np.array([u_upper[0], 2 * u_upper[1], 1.0, 1.0, 1.0])
     return lo, hi
+
+
+def estimator_params(b0, b1):
+    """The estimator's parameters ``[b0_T, b0_L + b0_R, b1_T, b1_L, b1_R]`` of a truth.
+
+    Parameters
+    ----------
+    b0, b1 : ndarray, shape (3,) or (3, L)
+        Per-actuator truth (one column per lane).
+
+    Returns
+    -------
+    ndarray, shape (5,) or (5, L)
+    """
+    return np.stack([b0[0], b0[1] + b0[2], b1[0], b1[1], b1[2]])
+
+
+def mode_of(b1, beta_engine: float, beta_elevon: float):
+    """The belief mode whose box holds the truth ``b1`` (one fault at a time).
+
+    The engine is faulty when its ``b1`` exceeds ``beta_engine``, else an elevon
+    when its ``b1`` exceeds ``beta_elevon`` (the left one first); otherwise the
+    mode is nominal (DESIGN.md section 4).
+
+    Parameters
+    ----------
+    b1 : ndarray, shape (3,) or (3, L)
+    beta_engine, beta_elevon : float
+
+    Returns
+    -------
+    ndarray of int64, shape () or (L,)
+        Mode codes (:data:`ftc_mc.conventions.MODE_NAMES`).
+    """
+    b1 = np.asarray(b1, dtype=float)
+    mode = np.full(b1.shape[1:], MODE_NOMINAL, dtype=np.int64)
+    mode = np.where(b1[2] > beta_elevon, MODE_RIGHT_ELEVON, mode)
+    mode = np.where(b1[1] > beta_elevon, MODE_LEFT_ELEVON, mode)
+    return np.where(b1[0] > beta_engine, MODE_ENGINE, mode).astype(np.int64)

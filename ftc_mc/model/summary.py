@@ -111,7 +111,7 @@ def save_npz(plant: LinearPlant, f) -> None:
     if plant.Bw is not None and plant.Dw is not None:
         Bw, Dw = plant.Bw, plant.Dw
     else:
-        from ..truth import wind_matrices  # compiles the Numba dynamics: only here
+        from ..sim.truth import wind_matrices  # compiles the Numba dynamics: only here
         Bw, Dw, _ = wind_matrices(plant)
     tp = plant.trim
     np.savez(f, A=plant.A, B=plant.B, C=plant.C, u0=plant.u0, u_lower=plant.u_lower,

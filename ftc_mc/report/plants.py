@@ -16,7 +16,7 @@ import numpy as np
 import pandas as pd
 
 from ..conventions import PLANT_KINDS, TRANSITIONS, TURBULENCE_LEVELS
-from ..io.config import TimingConfig
+from ..config.schema import TimingConfig
 from ..stats import finite_median, poisson_rate
 from .markdown import DEFAULT_PLANT, LABELS, label, num, plant_condition, rel_link
 from .runs import exclusion_reason, why, window_end_s

@@ -1,4 +1,4 @@
-"""Build the truth plant a trial simulates (:class:`~ftc_mc.core.settings.TruthPlant`).
+"""The truth plant a trial simulates (:class:`~ftc_mc.core.settings.TruthPlant`).
 
 The estimator and the controllers always use the linear model of eq. (1); the
 truth they act on can be that same linear model (the paper's setting) or the
@@ -16,12 +16,13 @@ from __future__ import annotations
 import numpy as np
 import scipy.signal
 
-from .core.nonlinear import derivatives_nb, outputs_nb
-from .core.settings import TruthPlant
-from .io.config import PLANT_KINDS, TURBULENCE_LEVELS
-from .model.dynamics import N_OUTPUT, N_STATE
-from .model.linear import LinearPlant, jacobian
-from .model.turbulence import DrydenModel, dryden_model
+from ..conventions import PLANT_KINDS, TURBULENCE_LEVELS
+from ..core.nonlinear import derivatives_nb, outputs_nb
+from ..core.settings import TruthPlant
+from ..model.dynamics import N_OUTPUT, N_STATE
+from ..model.linear import LinearPlant, jacobian
+from ..model.turbulence import DrydenModel, dryden_model
+
 
 def wind_matrices(plant: LinearPlant):
     """Gust input matrices of the linear plant.
@@ -76,6 +77,7 @@ def truth_plant(plant: LinearPlant, kind: str = "linear", substeps: int = 10,
     kind : {"linear", "nonlinear"}
     substeps : int
         RK4 sub-steps per control period of the nonlinear plant (>= 1).
+        The choices are trusted: they come from a validated ``plant`` section.
     turbulence : {"none", "light", "moderate", "severe"}
         MIL-F-8785C level (W20 = 0, 15, 30, 45 kt).
     altitude_m : float
@@ -87,13 +89,9 @@ def truth_plant(plant: LinearPlant, kind: str = "linear", substeps: int = 10,
     gust : DrydenModel or None
         ``None`` in still air.
     """
-    if kind not in PLANT_KINDS:
-        raise ValueError(f"plant.kind: must be one of {list(PLANT_KINDS)}, got {kind!r}")
-    if turbulence not in TURBULENCE_LEVELS:
-        raise ValueError(f"plant.turbulence: must be one of {list(TURBULENCE_LEVELS)}, "
-                         f"got {turbulence!r}")
-    if not (isinstance(substeps, int) and substeps >= 1):
-        raise ValueError(f"plant.substeps: must be an integer >= 1, got {substeps!r}")
+    # the choices come from a validated config (config/schema.py: PlantConfig)
+    assert kind in PLANT_KINDS and turbulence in TURBULENCE_LEVELS, (kind, turbulence)
+    assert isinstance(substeps, int) and substeps >= 1, substeps
     tp = plant.trim
     gust: DrydenModel | None = None
     Ad = np.zeros((4, 4))

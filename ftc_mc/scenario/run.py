@@ -1,32 +1,29 @@
-"""The closed-loop scenario of the paper's section 5 (Table 4) and user schedules.
+"""One flight of the full loop with a fault schedule (paper section 5, Table 4).
 
 One trajectory of the full reconfiguring loop (estimator, belief, controller
-selection among c0/c1/c2, excitation) on the linear plant with a fault schedule,
-kept step by step.  :func:`run_scenario` returns the time series and the events
-(fault switches, resets, excitations, detections, controller switches) and
-:func:`write_scenario` writes them with figures like the paper's Figs. 6-12.
+selection among c0/c1/c2, excitation) on the truth plant with the config's
+fault schedule, kept step by step.  :func:`run_scenario` builds the setup from
+the scenario config (``ftc_mc/sim/setup.py``), maps the schedule to the trial
+inputs (``ftc_mc/sim/inputs.py``), runs the kernel and returns the time series,
+the events (fault switches, resets, excitations, detections, controller
+switches) and one row per schedule entry.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import math
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
-from .campaign.chunk import new_record
-from .campaign.setup import CampaignSetup, build_setup
-from .campaign.transitions import draw_gusts, gust_lanes, mode_of
-from .core.settings import TrialInputs
-from .core.trial import STATUS_NAMES, run_trials
-from .errors import UserError
-from .estimator import MODE_NAMES
-from .io.config import ACTUATOR_NAMES, ScenarioConfig
-
-from .conventions import CONTROLLER_NAMES  # noqa: E402
-from .paper import PAPER_TIMELINE
+from ..config.schema import ScenarioConfig
+from ..conventions import CONTROLLER_NAMES, MODE_NAMES, STATUS_NAMES
+from ..model.faults import mode_of
+from ..sim.inputs import scenario_inputs
+from ..sim.lanes import HISTORY_RESETS, run_alone
+from ..sim.setup import SimSetup, build_setup
+from ..paper import PAPER_TIMELINE
 
 
 @dataclasses.dataclass
@@ -53,66 +50,8 @@ class ScenarioResult:
     status: str
 
 
-def schedule_arrays(sc: ScenarioConfig, u0: np.ndarray, dt: float):
-    """Per-actuator truth of each schedule entry.
-
-    Returns
-    -------
-    k_switch : ndarray, shape (E,)
-    b0, b1 : ndarray, shape (E, 3)
-    """
-    events = sc.scenario.schedule
-    k = np.array([int(round(e.time_s / dt)) for e in events], dtype=np.int64)
-    b0 = np.zeros((len(events), 3))
-    b1 = np.zeros((len(events), 3))
-    for i, e in enumerate(events):
-        if e.fault == "nominal":
-            continue
-        a = ACTUATOR_NAMES.index(e.actuator)
-        if e.fault == "lock":
-            b1[i, a] = 1.0
-            b0[i, a] = u0[a] if e.position == "trim" else float(e.position)
-        else:
-            b1[i, a] = e.b1
-    return k, b0, b1
-
-
-def scenario_inputs(sc: ScenarioConfig, setup: CampaignSetup):
-    """The kernel inputs of a scenario (one lane) and its schedule arrays.
-
-    The noise is ``default_rng([0, seed])``: process noise, measurement noise,
-    then (in turbulence) the gust draws and the initial gust state.
-
-    Returns
-    -------
-    inp : TrialInputs
-    k_switch, b0, b1 : ndarray
-        See :func:`schedule_arrays`.
-    modes : ndarray, shape (E,)
-        Mode of each schedule entry.
-    """
-    plant = setup.plant
-    k_sw, b0, b1 = schedule_arrays(sc, plant.u0, plant.dt)
-    n = setup.tim.n_steps
-    rng = np.random.default_rng([0, sc.scenario.seed])
-    w = rng.standard_normal((n, 9)) * setup.q_std
-    v = rng.standard_normal((n, 12)) * setup.r_std
-    eta, g0 = gust_lanes(n, 1, setup.gust_chol is not None)
-    gust = draw_gusts(rng, n, setup.gust_chol)
-    if gust is not None:
-        eta[:, :, 0], g0[:, 0] = gust
-    modes = np.array([mode_of(b, *setup.beta) for b in b1], dtype=np.int64)
-    xa0 = np.zeros((14, 1))
-    xa0[9:, 0] = [b0[0, 0], b0[0, 1] + b0[0, 2], *b1[0]]
-    inp = TrialInputs(k_switch=k_sw, b0=b0[:, :, None].copy(), b1=b1[:, :, None].copy(),
-                      mode_pre=modes[:1].copy(), mode_post=modes[-1:].copy(), xa0=xa0,
-                      P0=setup.P0, w=w[:, :, None].copy(), v=v[:, :, None].copy(),
-                      eta=eta, g0=g0)
-    return inp, k_sw, b0, b1, modes
-
-
 def run_scenario(sc: ScenarioConfig, seed: int | None = None,
-                 setup: CampaignSetup | None = None) -> ScenarioResult:
+                 setup: SimSetup | None = None) -> ScenarioResult:
     """Simulate the scenario.
 
     Parameters
@@ -120,7 +59,7 @@ def run_scenario(sc: ScenarioConfig, seed: int | None = None,
     sc : ScenarioConfig
     seed : int, optional
         Overrides ``scenario.seed``; the noise is ``default_rng([0, seed])``.
-    setup : CampaignSetup, optional
+    setup : SimSetup, optional
         Prebuilt kernel settings (benchmarks); built from ``sc`` when omitted.
 
     Returns
@@ -129,20 +68,13 @@ def run_scenario(sc: ScenarioConfig, seed: int | None = None,
     """
     if seed is not None:
         sc = sc.model_copy(update={"scenario": sc.scenario.model_copy(update={"seed": seed})})
-    cfg = sc.campaign_config()
     if setup is None:
-        setup = build_setup(cfg)
-    plant = setup.plant
-    for i, e in enumerate(sc.scenario.schedule):
-        if e.fault == "lock" and e.position != "trim":
-            a = ACTUATOR_NAMES.index(e.actuator)
-            if not plant.u_lower[a] <= e.position <= plant.u_upper[a]:
-                raise UserError(f"scenario.schedule.{i}.position: {e.position:g} is outside "
-                                f"the {e.actuator} command range "
-                                f"[{plant.u_lower[a]:g}, {plant.u_upper[a]:g}]")
-    inp, k_sw, b0, b1, modes = scenario_inputs(sc, setup)
-    rec = new_record(setup, 1, 100_000, history=True)
-    run_trials(setup.scheme(sc.scenario.signature), setup.flight, inp, rec)
+        setup = build_setup(sc)
+    sig = sc.scenario.signature
+    inp = scenario_inputs(setup, sc.scenario)
+    rec = run_alone(setup, sig, setup.det[sig], inp, HISTORY_RESETS, history=True)
+    k_sw, b0, b1 = inp.k_switch, inp.b0[:, :, 0], inp.b1[:, :, 0]
+    modes = np.array([int(mode_of(b, *setup.beta)) for b in b1], dtype=np.int64)
     ts = _timeseries(setup, sc, rec, k_sw, b0, b1)
     events = _events(ts, sc, rec, setup)
     segments = _segments(ts, sc, modes, setup)
@@ -283,68 +215,3 @@ def _recovery(err: np.ndarray, dt: float, tol: float = 1.0) -> float:
         return np.nan
     out = np.flatnonzero(~inside)
     return float((out[-1] + 1) * dt if out.size else 0.0)
-
-
-def summary_markdown(res: ScenarioResult) -> str:
-    """Our timeline beside the paper's, event by event."""
-    seg = res.segments.copy()
-    ev = res.events
-    lines = ["# ftc-mc scenario", "",
-             f"Signature: `{res.config.scenario.signature}`; controller: "
-             f"`{res.config.controller.kind}`; seed {res.config.scenario.seed}; "
-             f"truth plant `{res.config.plant.kind}`, turbulence "
-             f"`{res.config.plant.turbulence}`; run status: `{res.status}`.", "",
-             "## Detection of each schedule entry", ""]
-    tab = seg[["start_s", "truth_mode", "detection_s", "paper_detection_s",
-               "max_cross_track_m", "max_along_track_m", "cross_track_recovery_s",
-               "position_recovery_s"]]
-    lines.append(tab.to_markdown(index=False, floatfmt=".2f"))
-    lines += ["", "Paper: faults detected in less than 3 s, engine recoveries in 8 s "
-              "and 6 s; `detection_s` is ours (first belief update where the true mode "
-              f"is the most probable with at least {res.config.scenario.detection_probability}"
-              "); `cross_track_recovery_s` and `position_recovery_s` are the times after "
-              "the entry from which the distance to the glide path, and to the moving "
-              "reference point, stay below 1 m (paper: tracking recovered 15 s after the "
-              "engine recovers; with the paper's Q_lqr the along-track error is weighted by "
-              "tan^2(gamma) only, so the UAV is 'late but almost on the desired slope').",
-              "",
-              "## Controller switches", ""]
-    sw = ev[ev.kind == "controller_switch"]
-    lines.append(sw[["time_s", "detail"]].to_markdown(index=False, floatfmt=".1f")
-                 if len(sw) else "No switch: c0 throughout.")
-    lines += ["", "Paper: c1 at 11 s (before the engine fault is detected at 13 s; the "
-              "text also says the controller changes at 12 s once it is), "
-              "c1 kept after the engine recovers (the penalty outweighs the gain), "
-              "c2 at 91 s.", "", "## Excitations and resets", ""]
-    ex = ev[ev.kind == "excitation"]
-    lines.append(ex[["time_s", "detail"]].to_markdown(index=False, floatfmt=".1f")
-                 if len(ex) else "No excitation.")
-    rs = ev[ev.kind == "reset"]
-    lines += ["", f"{len(rs)} covariance resets ({(rs.detail.str.startswith('thrust')).sum()} "
-              f"thrust, {(rs.detail.str.startswith('elevons')).sum()} elevons).", "",
-              "Paper: the doublet was sent six times (10 s, 12.6 s, 15.6 s, 30 s, 50 s, "
-              "70 s), the 3211 once (90 s).", ""]
-    return "\n".join(lines)
-
-
-def write_scenario(res: ScenarioResult, out: Path, meta: dict) -> list:
-    """Write timeseries.parquet, events.parquet, figures and summary.md to ``out``.
-
-    Returns
-    -------
-    list of Path
-        The files written.
-    """
-    from .io.atomic import write_text
-    from .io.results import write_parquet
-    from .plots import scenario_figures
-
-    out.mkdir(parents=True, exist_ok=True)
-    write_parquet(res.timeseries, out / "timeseries.parquet", meta)
-    write_parquet(res.events, out / "events.parquet", meta)
-    write_parquet(res.segments, out / "segments.parquet", meta)
-    figs = scenario_figures(res, out)
-    write_text(out / "summary.md", summary_markdown(res) + "\n## Figures\n\n"
-               + "\n".join(f"![{p.stem}]({p.name})" for p in figs) + "\n")
-    return [out / f for f in ("timeseries.parquet", "events.parquet", "segments.parquet",
-                              "summary.md")] + figs

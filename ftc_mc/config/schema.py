@@ -1,28 +1,22 @@
-"""Campaign configuration: pydantic models loaded from YAML.
+"""The configuration schema: pydantic models of campaign, sweep and scenario files.
 
-Every field has a documented default (the paper's value where it gives one);
-unknown keys, wrong types, NaN/inf and out-of-range numbers are refused with a
-message that names the field.  YAML is read with ``yaml.safe_load`` only, so no
-tag can construct a Python object.
+The only validator of user values.  Every field has a documented default (the
+paper's value where it gives one); unknown keys, wrong types, NaN/inf,
+out-of-range numbers and periods that are not whole sampling periods are
+refused with a message that names the field (``section.field: problem``).
+What is built from a validated config (:mod:`ftc_mc.sim.setup`) trusts it.
+Reading YAML and formatting errors: :mod:`ftc_mc.config.load`.
 """
 
 from __future__ import annotations
 
 import math
-import re
-import reprlib
-from pathlib import Path
 from typing import Annotated, Literal
 
-import yaml
-from pydantic import (BaseModel, BeforeValidator, ConfigDict, Field, ValidationError,
-                      model_validator)
+from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, model_validator
 
-from ..errors import UserError
+from ..conventions import ACTUATOR_NAMES, PLANT_KINDS, TRANSITIONS, TURBULENCE_LEVELS
 from ..model.airframe import X8
-
-from ..conventions import (ACTUATOR_NAMES, PLANT_KINDS, TRANSITIONS,  # noqa: F401
-                           TURBULENCE_LEVELS)
 
 
 def _no_bool(value):
@@ -41,6 +35,51 @@ Finite = Annotated[float, NoBool, Field(allow_inf_nan=False)]
 
 class _Strict(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True, use_attribute_docstrings=True)
+
+
+MAX_STEPS = 1_000_000
+"""Longest run [control steps] of a trial or scenario."""
+
+
+def _check_periods(dt: float, periods) -> None:
+    """Each ``(name, seconds)`` must be a whole number of sampling periods ``dt``
+    (at least one, except ``excitation.resend_delay_s``) and at most 1e9 of them."""
+    for name, value in periods:
+        steps = value / dt
+        if not math.isfinite(steps) or steps > 1e9:
+            raise ValueError(f"{name}: {value:g} s is more than 1e9 steps of "
+                             f"model.dt_s ({dt:g} s)")
+        if abs(steps - round(steps)) > 1e-9 * max(1.0, steps) or (
+                round(steps) < 1 and name != "excitation.resend_delay_s"):
+            raise ValueError(f"{name}: must be a positive multiple of model.dt_s "
+                             f"({dt:g} s), got {value:g}")
+
+
+def _check_length(name: str, duration_s: float, dt: float) -> None:
+    """A run of ``duration_s`` must take at most :data:`MAX_STEPS` steps."""
+    n_steps = round(duration_s / dt)
+    if n_steps > MAX_STEPS:
+        raise ValueError(f"{name}: {n_steps} steps is more than 1e6")
+
+
+def _shared_periods(cfg) -> list:
+    """``(name, seconds)`` of the periods in the sections a campaign and a scenario
+    share (excitation, controller, validity)."""
+    e = cfg.excitation
+    return [("excitation.doublet_half_period_s", e.doublet_half_period_s),
+            ("excitation.s3211_unit_s", e.s3211_unit_s),
+            ("excitation.resend_delay_s", e.resend_delay_s),
+            ("controller.horizon_s", cfg.controller.horizon_s),
+            ("controller.terminal_horizon_s", cfg.controller.terminal_horizon_s),
+            ("validity.psd_check_period_s", cfg.validity.psd_check_period_s)]
+
+
+class _Sampled(_Strict):
+    """A whole file: its ``model.dt_s`` turns seconds into control steps."""
+
+    def steps(self, seconds: float) -> int:
+        """Number of sampling periods in ``seconds``."""
+        return int(round(seconds / self.model.dt_s))
 
 
 class ModelConfig(_Strict):
@@ -149,6 +188,12 @@ class DrawsConfig(_Strict):
             r = getattr(self, name)
             if r is not None and not r[0] < r[1]:
                 raise ValueError(f"{name}: must be [low, high] with low < high, got {list(r)}")
+        lower, upper = X8.command_lower, X8.command_upper
+        for a, name in ((0, "engine_lock_range"), (1, "elevon_lock_range_rad")):
+            r = getattr(self, name)
+            if r is not None and (r[0] < lower[a] or r[1] > upper[a]):
+                raise ValueError(f"{name}: must lie within the command range "
+                                 f"[{lower[a]:g}, {upper[a]:g}], got {list(r)}")
         return self
 
 
@@ -228,7 +273,7 @@ class CampaignConfig(_Strict):
         return self
 
 
-class Config(_Strict):
+class Config(_Sampled):
     """A whole campaign configuration (one YAML file)."""
 
     campaign: CampaignConfig = Field(default_factory=CampaignConfig)
@@ -247,216 +292,23 @@ class Config(_Strict):
     def _steps(self):
         dt = self.model.dt_s
         t = self.timing
-        e = self.excitation
-        for name, value in (("timing.fault_time_s", t.fault_time_s),
+        _check_periods(dt, [("timing.fault_time_s", t.fault_time_s),
                             ("timing.window_s", t.window_s),
                             ("timing.duration_s", t.duration_s),
-                            ("timing.reconfiguration_period_s", t.reconfiguration_period_s),
-                            ("excitation.doublet_half_period_s", e.doublet_half_period_s),
-                            ("excitation.s3211_unit_s", e.s3211_unit_s),
-                            ("excitation.resend_delay_s", e.resend_delay_s),
-                            ("controller.horizon_s", self.controller.horizon_s),
-                            ("controller.terminal_horizon_s",
-                             self.controller.terminal_horizon_s),
-                            ("validity.psd_check_period_s",
-                             self.validity.psd_check_period_s)):
-            steps = value / dt
-            if not math.isfinite(steps) or steps > 1e9:
-                raise ValueError(f"{name}: {value:g} s is more than 1e9 steps of "
-                                 f"model.dt_s ({dt:g} s)")
-            if abs(steps - round(steps)) > 1e-9 * max(1.0, steps) or (
-                    round(steps) < 1 and name != "excitation.resend_delay_s"):
-                raise ValueError(f"{name}: must be a positive multiple of model.dt_s "
-                                 f"({dt:g} s), got {value:g}")
+                            ("timing.reconfiguration_period_s",
+                             t.reconfiguration_period_s),
+                            *_shared_periods(self)])
         if self.controller.horizon_s > t.duration_s:
             raise ValueError("controller.horizon_s: must not exceed timing.duration_s "
                              f"({t.duration_s:g} s), got {self.controller.horizon_s:g}")
-        n_steps = round(t.duration_s / dt)
-        if n_steps > 1_000_000:
-            raise ValueError(f"timing.duration_s: {n_steps} steps is more than 1e6")
+        _check_length("timing.duration_s", t.duration_s, dt)
         return self
-
-    def steps(self, seconds: float) -> int:
-        """Number of sampling periods in ``seconds``."""
-        return int(round(seconds / self.model.dt_s))
 
     def resets_stored(self) -> int:
         """Resets stored per trial: ``campaign.max_resets``, or every step's when null
         (a trial resets at most one block per step, so then none is lost)."""
         m = self.campaign.max_resets
         return self.steps(self.timing.duration_s) if m is None else m
-
-
-_REPR = reprlib.Repr()
-_REPR.maxstring = _REPR.maxother = 80
-_REPR.maxlevel = 2
-"""Bounded repr of rejected values: error lines stay short whatever the input."""
-
-
-def _format_error(exc: ValidationError, source: str) -> str:
-    err = exc.errors()[0]
-    loc = ".".join(str(p) for p in err["loc"]) or "(top level)"
-    msg = err["msg"]
-    if msg.startswith("Value error, "):
-        msg = msg[len("Value error, "):]
-    prefix = re.match(r"^([A-Za-z_][\w.]*): (.*)$", msg)
-    if prefix and err["type"] == "value_error":
-        # a model validator names the field itself: "field: problem"
-        loc = prefix.group(1) if loc == "(top level)" else f"{loc}.{prefix.group(1)}"
-        return f"{source}: {loc}: {prefix.group(2)}"
-    got = err.get("input")
-    extra = ""
-    if err["type"] not in ("missing",) and not isinstance(got, (dict, list, tuple)):
-        extra = f" (got {_REPR.repr(got)})"
-    more = len(exc.errors()) - 1
-    tail = f" [and {more} more problem{'s' if more > 1 else ''}]" if more else ""
-    return f"{source}: {loc}: {msg}{extra}{tail}"
-
-
-def parse_config(data, source: str = "config") -> Config:
-    """Validate a mapping as a :class:`Config`.
-
-    Parameters
-    ----------
-    data : dict
-        Parsed YAML.
-    source : str
-        Name used in error messages.
-
-    Raises
-    ------
-    UserError
-        Naming the field and the problem.
-    """
-    if data is None:
-        raise UserError(f"{source}: the file is empty; expected a mapping of sections")
-    if not isinstance(data, dict):
-        raise UserError(f"{source}: expected a mapping of sections at the top level, "
-                        f"got {type(data).__name__}")
-    try:
-        return Config.model_validate(data)
-    except ValidationError as exc:
-        raise UserError(_format_error(exc, source)) from None
-
-
-def _read_yaml(path):
-    """Parsed YAML of a file (safe loader), or :class:`UserError`."""
-    path = Path(path)
-    try:
-        exists, is_file = path.exists(), path.is_file()
-    except OSError as exc:
-        raise UserError(f"{path}: cannot read ({exc.strerror})") from None
-    if not exists:
-        raise UserError(f"{path}: no such file")
-    if not is_file:
-        raise UserError(f"{path}: not a regular file")
-    try:
-        text = path.read_bytes().decode("utf-8")
-    except UnicodeDecodeError as exc:
-        raise UserError(f"{path}: not UTF-8 text (byte {exc.start})") from None
-    except OSError as exc:
-        raise UserError(f"{path}: cannot read ({exc.strerror})") from None
-    try:
-        return yaml.safe_load(text)
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
-        problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
-        raise UserError(f"{path}: malformed YAML{where}: {problem}") from None
-    except RecursionError:
-        raise UserError(f"{path}: malformed YAML: nested too deeply") from None
-    except Exception as exc:  # PyYAML's constructors raise plain errors on bad tags
-        first = (str(exc).splitlines() or [type(exc).__name__])[0]
-        raise UserError(f"{path}: malformed YAML: {_REPR.repr(first)[1:-1]}") from None
-
-
-def load_config(path) -> Config:
-    """Read and validate a YAML campaign configuration file.
-
-    Parameters
-    ----------
-    path : str or Path
-
-    Returns
-    -------
-    Config
-
-    Raises
-    ------
-    UserError
-        Missing or unreadable file, malformed YAML, or an invalid field.
-    """
-    return parse_config(_read_yaml(path), str(path))
-
-
-def with_overrides(cfg, **sections):
-    """Return ``cfg`` with fields replaced, re-validated.
-
-    Parameters
-    ----------
-    cfg : Config or ScenarioConfig
-    **sections : dict
-        ``section={field: value}`` pairs, e.g. ``campaign={"trials": 10}``;
-        ``None`` values are left as they are.
-
-    Raises
-    ------
-    UserError
-        Naming the field and the problem (source ``options``).
-    """
-    data = cfg.model_dump()
-    for section, fields in sections.items():
-        data[section].update({k: v for k, v in fields.items() if v is not None})
-    if isinstance(cfg, Config):
-        return parse_config(data, "options")
-    try:
-        return type(cfg).model_validate(data)
-    except ValidationError as exc:
-        raise UserError(_format_error(exc, "options")) from None
-
-
-
-def render_yaml(cfg: BaseModel, title: str) -> str:
-    """A complete, commented YAML file for ``cfg``: every field with its doc.
-
-    Parameters
-    ----------
-    cfg : Config or ScenarioConfig
-    title : str
-        First comment line.
-
-    Returns
-    -------
-    str
-        YAML that :func:`load_config` reads back to ``cfg``.
-    """
-    lines = [f"# {title}", "# Every field is listed with its default; delete a field to "
-             "use the default.", ""]
-    for section in type(cfg).model_fields:
-        sub = getattr(cfg, section)
-        doc = (type(sub).__doc__ or "").strip().splitlines()[0]
-        lines.append(f"{section}:  # {doc}")
-        for name, info in type(sub).model_fields.items():
-            value = getattr(sub, name)
-            if isinstance(value, tuple):
-                value = list(value)
-            if isinstance(value, list) and value and isinstance(value[0], BaseModel):
-                lines.append(f"  {name}:  # {' '.join((info.description or '').split())}")
-                for item in value:
-                    d = {k: v for k, v in item.model_dump().items() if v is not None}
-                    flow = yaml.safe_dump(d, default_flow_style=True, sort_keys=False).strip()
-                    lines.append(f"    - {flow}")
-                continue
-            text = yaml.safe_dump(value, default_flow_style=True).strip()
-            if text.endswith("\n..."):
-                text = text[:-4].strip()
-            text = text.removesuffix("...").strip()
-            doc = " ".join((info.description or "").split())
-            lines.append(f"  {name}: {text}  # {doc}".rstrip())
-        lines.append("")
-    return "\n".join(lines)
-
-
 
 
 class FaultEvent(_Strict):
@@ -526,11 +378,7 @@ class ScenarioSpec(_Strict):
         return self
 
 
-SHARED_SECTIONS = ("model", "plant", "estimator", "controller", "excitation", "noise", "validity")
-"""Sections a scenario file has in common with a campaign config."""
-
-
-class ScenarioConfig(_Strict):
+class ScenarioConfig(_Sampled):
     """A scenario file: ``ftc-mc scenario CONFIG``."""
 
     scenario: ScenarioSpec = Field(default_factory=ScenarioSpec)
@@ -542,46 +390,13 @@ class ScenarioConfig(_Strict):
     noise: NoiseConfig = Field(default_factory=NoiseConfig)
     validity: ValidityConfig = Field(default_factory=ValidityConfig)
 
-    def campaign_config(self) -> Config:
-        """The equivalent campaign settings (one trial) for building the kernels."""
-        sc = self.scenario
-        dt = self.model.dt_s
-        last = sc.schedule[-1].time_s
-        try:
-            return Config.model_validate({
-                "campaign": {"signature": sc.signature, "trials": 1, "seed": sc.seed},
-                **{name: getattr(self, name).model_dump() for name in SHARED_SECTIONS},
-                "timing": {"duration_s": sc.duration_s,
-                           "fault_time_s": last if last > 0 else dt,
-                           "window_s": max(sc.duration_s - last, dt) if last > 0 else dt,
-                           "reconfiguration_period_s": sc.reconfiguration_period_s,
-                           "detection_probability": sc.detection_probability}})
-        except ValidationError as exc:
-            err = exc.errors()[0]
-            msg = err["msg"].removeprefix("Value error, ")
-            loc = ".".join(str(p) for p in err["loc"])
-            named = re.match(r"^([A-Za-z_][\w.]*): (.*)$", msg)
-            if named:  # a model validator named the field itself
-                loc = named.group(1) if not loc else f"{loc}.{named.group(1)}"
-                msg = named.group(2)
-            loc = loc.replace("timing.window_s", "scenario.schedule").replace(
-                "timing.fault_time_s", "scenario.schedule").replace("timing.", "scenario.")
-            msg = msg.replace("timing.", "scenario.")
-            raise ValueError(f"{loc}: {msg}") from None
-
     @model_validator(mode="after")
     def _steps(self):
         dt = self.model.dt_s
         sc = self.scenario
-        for name, value in (("duration_s", sc.duration_s),
-                            ("reconfiguration_period_s", sc.reconfiguration_period_s)):
-            n = value / dt
-            if not math.isfinite(n) or n > 1e9:
-                raise ValueError(f"scenario.{name}: {value:g} s is more than 1e9 steps of "
-                                 f"model.dt_s ({dt:g} s)")
-            if abs(n - round(n)) > 1e-9 * max(1.0, n) or round(n) < 1:
-                raise ValueError(f"scenario.{name}: must be a positive multiple of "
-                                 f"model.dt_s ({dt:g} s), got {value:g}")
+        _check_periods(dt, [("scenario.duration_s", sc.duration_s),
+                            ("scenario.reconfiguration_period_s",
+                             sc.reconfiguration_period_s)])
         if self.controller.horizon_s > sc.duration_s:
             raise ValueError(f"controller.horizon_s: must not exceed scenario.duration_s "
                              f"({sc.duration_s:g} s), got {self.controller.horizon_s:g}")
@@ -593,24 +408,11 @@ class ScenarioConfig(_Strict):
                     raise ValueError(f"scenario.schedule.{i}.position: {e.position:g} is "
                                      f"outside the {e.actuator} command range "
                                      f"[{lower[a]:g}, {upper[a]:g}]")
-        for i, e in enumerate(self.scenario.schedule):
+        for i, e in enumerate(sc.schedule):
             n = e.time_s / dt
             if not math.isfinite(n) or abs(n - round(n)) > 1e-9 * max(1.0, n):
                 raise ValueError(f"scenario.schedule.{i}.time_s: must be a multiple of "
                                  f"model.dt_s ({dt:g} s), got {e.time_s:g}")
-        self.campaign_config()
+        _check_periods(dt, _shared_periods(self))
+        _check_length("scenario.duration_s", sc.duration_s, dt)
         return self
-
-
-def load_scenario(path) -> ScenarioConfig:
-    """Read and validate a scenario YAML file (see :func:`load_config`)."""
-    data = _read_yaml(path)
-    if data is None:
-        raise UserError(f"{path}: the file is empty; expected a mapping of sections")
-    if not isinstance(data, dict):
-        raise UserError(f"{path}: expected a mapping of sections at the top level, "
-                        f"got {type(data).__name__}")
-    try:
-        return ScenarioConfig.model_validate(data)
-    except ValidationError as exc:
-        raise UserError(_format_error(exc, str(path))) from None

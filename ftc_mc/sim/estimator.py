@@ -1,10 +1,14 @@
-"""Build the kernels' settings (namedtuples of arrays) from the plant and options.
+"""The estimator's kernel settings (namedtuples of arrays) from the plant and options.
 
-This is the bridge between the Python world (plant model, validated settings)
-and :mod:`ftc_mc.core`.  Paper values (section 5.1) are the defaults:
-``Q^x = 0.01^2 dt I_9``, ``Q^b = 0.001^2 dt I_5``, R from the sensor accuracies
-(``e^{-2}`` read as 1e-2 and ``e^{-6}`` as 1e-6, DESIGN.md section 4),
-thresholds ``t_q = t_nx = 25`` and the transition matrix ``T_M``.
+This is the bridge between the linear plant and :mod:`ftc_mc.core`: the
+augmented filter model (eqs. 4-6), the Table 1 detection with its reset
+variances (section 3.2.2), and the mode boxes of the belief (eq. 12).  Paper
+values (section 5.1): ``Q^x = 0.01^2 dt I_9``, ``Q^b = 0.001^2 dt I_5``, R from
+the sensor accuracies (``e^{-2}`` read as 1e-2 and ``e^{-6}`` as 1e-6,
+DESIGN.md section 4), thresholds ``t_q = t_nx = 25`` and the transition matrix
+``T_M``.  The tunable values come from the validated ``estimator`` section
+(:class:`~ftc_mc.config.schema.EstimatorConfig`, which holds their defaults);
+the builders here trust them.
 """
 
 from __future__ import annotations
@@ -14,9 +18,11 @@ import math
 
 import numpy as np
 
-from .core.settings import Belief, Detection, FilterModel
-from .model.faults import N_AUG, bias_matrix, fault_bounds
-from .model.linear import LinearPlant
+from ..config.schema import EstimatorConfig
+from ..conventions import VARIANTS
+from ..core.settings import Belief, Detection, FilterModel
+from ..model.faults import N_AUG, bias_matrix, fault_bounds
+from ..model.linear import LinearPlant
 
 DEG = math.pi / 180.0
 _ANG = (0.05 * DEG) ** 2
@@ -32,12 +38,16 @@ PAPER_TM = (
 )
 """Mode transition matrix T_M (paper section 5.1), column j = from mode j."""
 
-from .conventions import MODE_NAMES  # noqa: E402,F401
+_PAPER = EstimatorConfig()
+"""The schema's defaults: the paper's values (section 5.1)."""
 
 
 @dataclasses.dataclass(frozen=True)
 class EstimatorSettings:
-    """Tunable settings of the estimation, detection and belief (section 3).
+    """Settings of the estimation, detection and belief (section 3), as the builders
+    below read them: the ``estimator`` section of a validated config plus the
+    signature variant, ``R`` and ``T_M``.  Defaults are the schema's; nothing is
+    validated here (:meth:`from_config` takes values the schema has checked).
 
     Parameters
     ----------
@@ -60,42 +70,22 @@ class EstimatorSettings:
         Mode transition matrix (column-stochastic).
     """
 
-    sigma_qx: float = 0.01
-    sigma_qb: float = 0.001
+    sigma_qx: float = _PAPER.sigma_qx
+    sigma_qb: float = _PAPER.sigma_qb
     r_diag: tuple = PAPER_R_DIAG
-    t_q: float = 25.0
-    t_nx: float = 25.0
-    signature: str = "paper"
-    beta_engine: float = 0.2
-    beta_elevon: float = 0.1
-    b0_nominal_engine: float = 0.05
-    b0_nominal_elevon: float = 0.05
+    t_q: float = _PAPER.t_q
+    t_nx: float = _PAPER.t_nx
+    signature: str = VARIANTS[0]
+    beta_engine: float = _PAPER.beta_engine
+    beta_elevon: float = _PAPER.beta_elevon
+    b0_nominal_engine: float = _PAPER.b0_nominal_engine
+    b0_nominal_elevon: float = _PAPER.b0_nominal_elevon
     tm: tuple = PAPER_TM
 
-    def __post_init__(self):
-        for name in ("sigma_qx", "sigma_qb", "t_q", "t_nx", "b0_nominal_engine",
-                     "b0_nominal_elevon"):
-            v = getattr(self, name)
-            if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
-                raise ValueError(f"estimator parameter {name!r} must be a finite "
-                                 f"number > 0, got {v!r}")
-        for name in ("beta_engine", "beta_elevon"):
-            v = getattr(self, name)
-            if not (isinstance(v, (int, float)) and 0 < v < 1):
-                raise ValueError(f"estimator parameter {name!r} must lie in (0, 1), "
-                                 f"got {v!r}")
-        r = np.asarray(self.r_diag, dtype=float)
-        if r.shape != (12,) or not np.all(np.isfinite(r)) or np.any(r <= 0):
-            raise ValueError("estimator parameter 'r_diag' must be 12 finite "
-                             f"variances > 0, got {self.r_diag!r}")
-        if self.signature not in ("paper", "swapped"):
-            raise ValueError("estimator parameter 'signature' must be 'paper' or "
-                             f"'swapped', got {self.signature!r}")
-        tm = np.asarray(self.tm, dtype=float)
-        if (tm.shape != (4, 4) or np.any(tm < 0)
-                or not np.allclose(tm.sum(axis=0), 1.0, atol=1e-12)):
-            raise ValueError("estimator parameter 'tm' must be a 4x4 "
-                             "column-stochastic matrix")
+    @classmethod
+    def from_config(cls, est: EstimatorConfig, signature: str) -> "EstimatorSettings":
+        """The settings of a validated ``estimator`` section for one signature variant."""
+        return cls(signature=signature, **est.model_dump())
 
 
 def unit_rows(C: np.ndarray) -> np.ndarray:
@@ -120,6 +110,7 @@ def filter_model(plant: LinearPlant, s: EstimatorSettings) -> FilterModel:
     -------
     FilterModel
     """
+    assert s.sigma_qx > 0 and s.sigma_qb > 0 and len(s.r_diag) == plant.C.shape[0], s
     C = plant.C
     n = plant.A.shape[0]
     q = np.empty(N_AUG)
@@ -140,6 +131,7 @@ def detection(plant: LinearPlant, s: EstimatorSettings) -> Detection:
     elevon block: ``((u_max - u_min)/t_q)^2`` (one elevon's range) for the b0
     sum, ``1/t_q^2`` for both b1.
     """
+    assert s.t_q > 0 and s.t_nx > 0 and s.signature in VARIANTS, s
     rng = plant.u_upper - plant.u_lower
     reset_var = np.array([(rng[0] / s.t_nx) ** 2, (rng[1] / s.t_q) ** 2,
                           1.0 / s.t_nx ** 2, 1.0 / s.t_q ** 2, 1.0 / s.t_q ** 2])
@@ -155,6 +147,7 @@ def belief_settings(plant: LinearPlant, s: EstimatorSettings) -> Belief:
     its ``b1`` in ``[beta_i, 1]``, its ``b0`` free over its command range (a lock
     has ``b1 = 1``, ``b0`` = the lock position), every other parameter nominal.
     """
+    assert 0 < s.beta_engine < 1 and 0 < s.beta_elevon < 1, s
     be, bt = s.beta_elevon, s.beta_engine
     d_t, d_e = s.b0_nominal_engine, s.b0_nominal_elevon
     nom_lo = np.array([-d_t, -d_e, 0.0, 0.0, 0.0])

@@ -1,0 +1,48 @@
+"""The on-disk cache of offline designs: its folder, and atomic writes into it.
+
+A cache file is written under a temporary name in its final folder and then
+renamed onto its name (``os.replace``), so a reader never sees a half-written
+file and concurrent processes at worst compute the same design twice.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+
+
+def default_cache_dir() -> Path:
+    """Folder of the design cache.
+
+    ``$FTC_MC_CACHE_DIR/design`` when the environment variable is set (it names
+    the root of all ftc-mc caches), else ``~/.cache/ftc-mc/design``.
+    """
+    root = os.environ.get("FTC_MC_CACHE_DIR")
+    if root:
+        return Path(root).expanduser() / "design"
+    return Path.home() / ".cache" / "ftc-mc" / "design"
+
+
+def write_atomic(path: Path, write) -> None:
+    """Call ``write(f)`` on a binary file that replaces ``path`` only once complete.
+
+    Parameters
+    ----------
+    path : Path
+        Final file name; its folder is created if missing.
+    write : callable
+        Writes the content to the open binary file object it is given.
+    """
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "wb") as f:
+            write(f)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+    finally:
+        if os.path.exists(tmp):
+            os.unlink(tmp)

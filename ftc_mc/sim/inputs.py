@@ -1,0 +1,219 @@
+"""Trial inputs (:class:`~ftc_mc.core.settings.TrialInputs`) from per-lane schedules.
+
+One builder, :func:`build_inputs`, lays out every kind of flight the kernels
+run: a campaign trial (two schedule entries: the initial mode, and the final
+mode from the fault step on; see ``Transition.schedule`` in
+``ftc_mc/campaign/transitions.py``), a fault-free flight (one nominal entry,
+:func:`flight_schedule`) and a scenario (the config's schedule,
+:func:`scenario_schedule`).
+
+Random numbers
+--------------
+Each lane owns its stream, ``numpy.random.default_rng([trial_id, root_seed])``,
+and draws from it in this order (:func:`draw_lane`):
+
+1. the fault value, uniform over the transition's range (lock position or
+   effectiveness loss ``b1``); a fault-free flight draws it too and ignores it,
+   so flight ``i`` flies the noise of trial ``i``; a scenario draws none;
+2. the process noise, ``n_steps x 9``, scaled by ``setup.q_std``;
+3. the measurement noise, ``n_steps x 12``, scaled by ``setup.r_std``;
+4. in turbulence only: the gust draws ``eta`` (``n_steps x 4``), then the initial
+   gust state ``g0 = gust_chol @ N(0, I_4)``; drawn last so that the still-air
+   draws of a lane are the same with and without turbulence.
+
+Trial ``i`` of every transition uses the same stream (common random numbers),
+and the signature variants run on identical inputs.  A scenario is lane 0 of
+its own seed.  Results depend only on the trial ids and the seed, never on the
+chunking or the worker count.
+"""
+
+from __future__ import annotations
+
+from collections import namedtuple
+
+import numpy as np
+
+from ..conventions import ACTUATOR_NAMES
+from ..core.settings import TrialInputs
+from ..model.faults import estimator_params, mode_of
+
+Schedule = namedtuple("Schedule", [
+    "k_switch",  # (E,) int64 step from which each entry holds, k_switch[0] == 0
+    "b0",        # (E, 3, L) per-actuator truth b0 of each entry (absolute lock position)
+    "b1",        # (E, 3, L) per-actuator truth b1 of each entry
+])
+"""Per-lane fault schedule: the truth in force from each switch step on."""
+
+LaneDraws = namedtuple("LaneDraws", [
+    "fault",  # (L,) the fault value of each lane (NaN when none was drawn)
+    "w",      # (n_steps, 9, L) process noise, scaled
+    "v",      # (n_steps, 12, L) measurement noise, scaled
+    "eta",    # (n_steps, 4, L) gust draws, or (0, 4, L) in still air
+    "g0",     # (4, L) initial gust states (zeros in still air)
+])
+"""Every random number of a chunk of lanes (module docstring)."""
+
+FLIGHT_FAULT_RANGE = (0.0, 1.0)
+"""Range of the fault value a fault-free flight draws and ignores."""
+
+
+def trial_stream(trial_id: int, seed: int) -> np.random.Generator:
+    """The random stream of trial ``trial_id`` under the root seed ``seed``."""
+    return np.random.default_rng([int(trial_id), seed])
+
+
+def draw_lane(rng: np.random.Generator, n_steps: int, q_std: np.ndarray, r_std: np.ndarray,
+              gust_chol=None, fault_range=None):
+    """One lane's draws from its stream, in the order of the module docstring.
+
+    Parameters
+    ----------
+    rng : numpy.random.Generator
+        The lane's stream (:func:`trial_stream`).
+    n_steps : int
+    q_std : ndarray, shape (9,)
+        Process-noise standard deviations.
+    r_std : ndarray, shape (12,)
+        Measurement-noise standard deviations.
+    gust_chol : ndarray, shape (4, 4), optional
+        Cholesky factor of the stationary Dryden state covariance
+        (:class:`~ftc_mc.model.turbulence.DrydenModel`); ``None`` in still air.
+    fault_range : (float, float), optional
+        Uniform range of the fault value; ``None``: no fault value is drawn.
+
+    Returns
+    -------
+    value : float
+        The fault value (NaN without ``fault_range``).
+    w : ndarray, shape (n_steps, 9)
+    v : ndarray, shape (n_steps, 12)
+    gust : tuple or None
+        ``(eta, g0)`` of shapes (n_steps, 4) and (4,); ``None`` in still air.
+    """
+    value = np.nan if fault_range is None else rng.uniform(*fault_range)
+    w = rng.standard_normal((n_steps, 9)) * q_std
+    v = rng.standard_normal((n_steps, 12)) * r_std
+    gust = None
+    if gust_chol is not None:
+        eta = rng.standard_normal((n_steps, 4))
+        gust = eta, gust_chol @ rng.standard_normal(4)
+    return value, w, v, gust
+
+
+def draw_lanes(setup, trial_ids, seed: int, fault_range=None) -> LaneDraws:
+    """Every lane's draws (:func:`draw_lane`), lane-last.
+
+    Parameters
+    ----------
+    setup : SimSetup
+        Supplies ``tim.n_steps``, ``q_std``, ``r_std`` and ``gust_chol``.
+    trial_ids : array_like of int
+        One lane per trial id.
+    seed : int
+        Root seed.
+    fault_range : (float, float), optional
+        Uniform range of each lane's fault value (none drawn if ``None``).
+
+    Returns
+    -------
+    LaneDraws
+    """
+    n, L = setup.tim.n_steps, len(trial_ids)
+    fault = np.empty(L)
+    w = np.empty((n, 9, L))
+    v = np.empty((n, 12, L))
+    turbulent = setup.gust_chol is not None
+    eta = np.zeros((n if turbulent else 0, 4, L))
+    g0 = np.zeros((4, L))
+    for l, tid in enumerate(trial_ids):
+        fault[l], w[:, :, l], v[:, :, l], gust = draw_lane(
+            trial_stream(tid, seed), n, setup.q_std, setup.r_std, setup.gust_chol,
+            fault_range)
+        if gust is not None:
+            eta[:, :, l], g0[:, l] = gust
+    return LaneDraws(fault=fault, w=w, v=v, eta=eta, g0=g0)
+
+
+def entry_modes(schedule: Schedule, beta) -> np.ndarray:
+    """Mode of every schedule entry and lane, shape (E, L) (:func:`mode_of`)."""
+    return np.stack([mode_of(b1, *beta) for b1 in schedule.b1])
+
+
+def build_inputs(setup, schedule: Schedule, draws: LaneDraws) -> TrialInputs:
+    """The kernels' inputs of lanes flying ``schedule`` with ``draws``.
+
+    Each lane starts with its initial mode identified: the belief is one-hot on
+    the first entry's mode and the estimate holds its fault parameters.
+
+    Parameters
+    ----------
+    setup : SimSetup
+    schedule : Schedule
+    draws : LaneDraws
+
+    Returns
+    -------
+    TrialInputs
+    """
+    E, _, L = schedule.b0.shape
+    assert schedule.k_switch.shape == (E,) and schedule.k_switch[0] == 0
+    assert draws.w.shape[2] == L
+    modes = entry_modes(schedule, setup.beta)
+    xa0 = np.zeros((14, L))
+    xa0[9:] = estimator_params(schedule.b0[0], schedule.b1[0])
+    return TrialInputs(k_switch=schedule.k_switch, b0=schedule.b0, b1=schedule.b1,
+                       mode_pre=modes[0].copy(), mode_post=modes[-1].copy(), xa0=xa0,
+                       P0=setup.P0, w=draws.w, v=draws.v, eta=draws.eta, g0=draws.g0)
+
+
+def flight_schedule(L: int) -> Schedule:
+    """Nominal throughout: one entry, every actuator healthy."""
+    return Schedule(k_switch=np.zeros(1, dtype=np.int64), b0=np.zeros((1, 3, L)),
+                    b1=np.zeros((1, 3, L)))
+
+
+def flight_inputs(setup, trial_ids, seed: int) -> TrialInputs:
+    """Fault-free flights on the streams of the campaign's trials ``trial_ids``."""
+    return build_inputs(setup, flight_schedule(len(trial_ids)),
+                        draw_lanes(setup, trial_ids, seed, FLIGHT_FAULT_RANGE))
+
+
+def scenario_schedule(events, u0: np.ndarray, dt: float) -> Schedule:
+    """The schedule of a scenario (one lane).
+
+    Parameters
+    ----------
+    events : list of FaultEvent
+        A validated ``scenario.schedule``.
+    u0 : ndarray, shape (3,)
+        Trim commands: the position of a lock ``at trim``.
+    dt : float
+        Control period [s].
+    """
+    k = np.array([int(round(e.time_s / dt)) for e in events], dtype=np.int64)
+    b0 = np.zeros((len(events), 3, 1))
+    b1 = np.zeros((len(events), 3, 1))
+    for i, e in enumerate(events):
+        if e.fault == "nominal":
+            continue
+        a = ACTUATOR_NAMES.index(e.actuator)
+        if e.fault == "lock":
+            b1[i, a, 0] = 1.0
+            b0[i, a, 0] = u0[a] if e.position == "trim" else float(e.position)
+        else:
+            b1[i, a, 0] = e.b1
+    return Schedule(k_switch=k, b0=b0, b1=b1)
+
+
+def scenario_inputs(setup, spec) -> TrialInputs:
+    """The inputs of a scenario: its schedule, on lane 0 of its seed's stream.
+
+    Parameters
+    ----------
+    setup : SimSetup
+    spec : ScenarioSpec
+        The validated ``scenario`` section (schedule and seed).
+    """
+    plant = setup.plant
+    return build_inputs(setup, scenario_schedule(spec.schedule, plant.u0, plant.dt),
+                        draw_lanes(setup, [0], spec.seed))

@@ -1,0 +1,121 @@
+"""Run lanes of trial inputs through the kernels: alone, or sharing their start.
+
+:func:`simulate` runs the same inputs under several Table 1 detections (the
+signature variants, and in a sweep the threshold points).  Alone, each
+detection runs every lane from the start (:func:`ftc_mc.core.trial.run_trials`).
+Shared, the lanes are first advanced once to a step ``k_share`` with resets
+disabled, recording the largest ``r_q`` and ``r_nx`` of each lane; then, for
+each detection:
+
+* a lane whose residuals stayed below its thresholds until ``k_share`` had no
+  reset there either, so it continues from that shared state;
+* any other lane runs again from the start.
+
+Until its first reset a lane does not depend on the thresholds (the residuals
+are the same, and the initial covariance uses the paper's thresholds whatever
+is run, see ``ftc_mc/sim/setup.py``), so both ways give bit-identical records
+(``tests/test_sweep.py``).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..conventions import VARIANTS
+from ..core.settings import TrialInputs, TrialRecord
+from ..core.trial import advance, init_state, new_state, run_trials
+
+HISTORY_RESETS = 100_000
+"""Resets stored per lane when every step is kept (a scenario)."""
+
+
+def new_record(setup, L: int, max_resets: int, history: bool = False) -> TrialRecord:
+    """Preallocated outputs of :func:`ftc_mc.core.trial.run_trials`.
+
+    ``history=True`` keeps every step's state, estimate, commands, residuals
+    and excitation (for scenarios); campaigns keep only the per-period arrays.
+    """
+    n_per = setup.tim.n_steps // setup.tim.reconf_every
+    n_hist = setup.tim.n_steps if history else 0
+    return TrialRecord(
+        reset_k=np.zeros((max_resets, L), dtype=np.int64),
+        reset_block=np.zeros((max_resets, L), dtype=np.int64),
+        reset_res=np.zeros((max_resets, 3, L)),
+        n_resets=np.zeros(L, dtype=np.int64),
+        belief=np.zeros((n_per, 4, L)), bhat=np.zeros((n_per, 5, L)),
+        detect_k=np.zeros(L, dtype=np.int64), status=np.zeros(L, dtype=np.int64),
+        stop_k=np.zeros(L, dtype=np.int64),
+        controller=np.zeros((n_per, L), dtype=np.int64),
+        hist_x=np.zeros((n_hist, 9, L)), hist_xa=np.zeros((n_hist, 14, L)),
+        hist_pdiag=np.zeros((n_hist, 5, L)), hist_u=np.zeros((n_hist, 3, L)),
+        hist_res=np.zeros((n_hist, 3, L)), hist_exc=np.zeros((n_hist, 4, L)),
+        hist_block=np.zeros((n_hist, L), dtype=np.int64),
+        hist_wind=np.zeros((n_hist, 3, L)),
+        xa_end=np.zeros((14, L)))
+
+
+def run_alone(setup, variant: str, det, inp: TrialInputs, max_resets: int,
+              history: bool = False) -> TrialRecord:
+    """Every lane of ``inp`` from the start to the end under the detection ``det``."""
+    rec = new_record(setup, inp.w.shape[2], max_resets, history)
+    run_trials(setup.scheme(variant, det), setup.flight, inp, rec)
+    return rec
+
+
+def take_lanes(nt, idx, shared=("k_switch", "P0")):
+    """A namedtuple of lane-last arrays restricted to the lanes ``idx``."""
+    return type(nt)(**{f: (v if f in shared else v[..., idx]) for f, v in nt._asdict().items()})
+
+
+def _copy(nt):
+    return type(nt)(**{f: v.copy() for f, v in nt._asdict().items()})
+
+
+def simulate(setup, inp: TrialInputs, runs, max_resets: int, k_share: int | None = None):
+    """Records of the lanes of ``inp`` under each detection of ``runs``.
+
+    Parameters
+    ----------
+    setup : SimSetup
+    inp : TrialInputs
+    runs : list of (str, Detection)
+        Signature variant and Table 1 settings of each run.
+    max_resets : int
+        Resets stored per lane.
+    k_share : int, optional
+        ``None``: every run from the start, alone.  Else the step up to which the
+        runs share the lanes' start (module docstring), ``0 < k_share <= n_steps``.
+
+    Returns
+    -------
+    recs : list of TrialRecord
+        One per run, in order.
+    simulated : int
+        Lane steps simulated (``L n_steps len(runs)`` when alone).
+    """
+    L, n = inp.w.shape[2], setup.tim.n_steps
+    if k_share is None:
+        return [run_alone(setup, v, det, inp, max_resets) for v, det in runs], L * n * len(runs)
+    assert 0 < k_share <= n
+    rec0 = new_record(setup, L, max_resets)
+    st0 = new_state(L)
+    init_state(inp, st0, rec0)
+    no_resets = setup.detection(VARIANTS[0], math.inf, math.inf)
+    advance(setup.scheme(VARIANTS[0], no_resets), setup.flight, inp, rec0, st0, 0, k_share)
+    simulated = L * k_share
+    recs = []
+    for variant, det in runs:
+        rec, st = _copy(rec0), _copy(st0)
+        if k_share < n:
+            advance(setup.scheme(variant, det), setup.flight, inp, rec, st, k_share, n)
+            simulated += L * (n - k_share)
+        dirty = np.flatnonzero((st0.rmax[0] >= det.t_q) | (st0.rmax[1] >= det.t_nx))
+        if len(dirty):
+            sub = run_alone(setup, variant, det, take_lanes(inp, dirty), max_resets)
+            for f, v in sub._asdict().items():
+                getattr(rec, f)[..., dirty] = v
+            simulated += len(dirty) * n
+        recs.append(rec)
+    return recs, simulated
