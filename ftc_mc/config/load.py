@@ -71,7 +71,7 @@ def validate_model(model: type[BaseModel], data, source: str):
         raise UserError(f"{source}: expected a mapping of sections at the top level, "
                         f"got {type(data).__name__}")
     try:
-        return model.modelvalidate_model(data)
+        return model.model_validate(data)
     except ValidationError as exc:
         raise UserError(_format_error(exc, source)) from None
 
