@@ -32,7 +32,7 @@ from ftc_mc.model.turbulence import dryden_model
 from ftc_mc.sim.inputs import draw_lane, flight_inputs, trial_stream
 from ftc_mc.sim.lanes import new_record
 from ftc_mc.sim.setup import build_setup
-from ftc_mc.sim.truth import wind_matrices
+from ftc_mc.model.wind import wind_matrices
 
 SHORT = {"fault_time_s": 2.0, "window_s": 2.0, "duration_s": 6.0}
 

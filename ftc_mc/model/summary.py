@@ -104,15 +104,13 @@ def save_npz(plant: LinearPlant, f) -> None:
     ----------
     plant : LinearPlant
         A plant built from an airframe (its ``Bw``, ``Dw`` are computed by
-        :func:`ftc_mc.truth.wind_matrices`) or read from a file (its own).
+        :func:`ftc_mc.model.wind.wind_matrices`) or read from a file (its own).
     f : str, Path or binary file
         Destination, as for :func:`numpy.savez`.
     """
-    if plant.Bw is not None and plant.Dw is not None:
-        Bw, Dw = plant.Bw, plant.Dw
-    else:
-        from ..sim.truth import wind_matrices  # compiles the Numba dynamics: only here
-        Bw, Dw, _ = wind_matrices(plant)
+    from .wind import plant_wind_matrices  # compiles the Numba dynamics: only here
+
+    Bw, Dw = plant_wind_matrices(plant)
     tp = plant.trim
     np.savez(f, A=plant.A, B=plant.B, C=plant.C, u0=plant.u0, u_lower=plant.u_lower,
              u_upper=plant.u_upper, dt=np.float64(plant.dt), x0=tp.x0, y0=tp.y0,
