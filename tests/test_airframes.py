@@ -22,7 +22,7 @@ from ftc_mc.model.airframe_files import (AIRFRAME_FIELDS, LINEAR_MODEL_VARIABLES
 from ftc_mc.model.linear import build_plant, trim
 from ftc_mc.model.presets import PRESETS, list_airframes, resolve_airframe
 from ftc_mc.model.summary import save_npz
-from ftc_mc.sim.truth import wind_matrices
+from ftc_mc.model.wind import wind_matrices
 
 # github.com/krisgry/x8, x8_param.mat, commit 8bfb2d945dbff9abdfda6431b8f1d962c9d45b30
 # (2018-06-14): the authors' simulator for Gryte et al., ICUAS 2018.

@@ -13,10 +13,12 @@ from __future__ import annotations
 import math
 from typing import Annotated, Literal
 
-from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, model_validator
+from pydantic import (BaseModel, BeforeValidator, ConfigDict, Field, field_validator,
+                      model_validator)
 
 from ..conventions import ACTUATOR_NAMES, PLANT_KINDS, TRANSITIONS, TURBULENCE_LEVELS
-from ..model.airframe import X8
+from ..errors import UserError
+from ..model.source import DEFAULT_AIRFRAME, check_airframe, command_limits, is_linear_model
 
 
 def _no_bool(value):
@@ -74,6 +76,17 @@ def _shared_periods(cfg) -> list:
             ("validity.psd_check_period_s", cfg.validity.psd_check_period_s)]
 
 
+def _check_airframe_use(cfg) -> tuple:
+    """Refuse the nonlinear truth plant with a linear model (it has no equations);
+    return the airframe's absolute command limits ``(lower, upper)``."""
+    spec = cfg.model.airframe
+    if cfg.plant.kind == "nonlinear" and is_linear_model(spec):
+        raise ValueError(f"plant.kind: nonlinear needs an airframe's equations, but "
+                         f"model.airframe is a linear model ({spec}); use a preset or an "
+                         "airframe YAML file, or plant.kind: linear")
+    return command_limits(spec)
+
+
 class _Sampled(_Strict):
     """A whole file: its ``model.dt_s`` turns seconds into control steps."""
 
@@ -83,14 +96,27 @@ class _Sampled(_Strict):
 
 
 class ModelConfig(_Strict):
-    """Trim point and sampling (paper section 5.1)."""
+    """Airframe, trim point and sampling (paper section 5.1)."""
 
+    airframe: str = DEFAULT_AIRFRAME
+    """Preset (`ftc-mc airframes` lists them), airframe YAML file, or linear model (.npz/.mat: linear plant only)."""
     airspeed_mps: Pos = 20.0
     """Trim airspeed [m/s]."""
     gamma_deg: Annotated[float, NoBool, Field(gt=-30, lt=30, allow_inf_nan=False)] = -3.0
     """Trim flight-path angle [deg]."""
     dt_s: Annotated[float, NoBool, Field(gt=0, le=1, allow_inf_nan=False)] = 0.1
     """Control sampling period [s]."""
+
+    @field_validator("airframe")
+    @classmethod
+    def _airframe(cls, spec: str) -> str:
+        if not spec.strip():
+            raise ValueError("must name a preset or a file, got an empty string")
+        try:
+            check_airframe(spec)
+        except UserError as exc:
+            raise ValueError(str(exc)) from None
+        return spec
 
 
 class PlantConfig(_Strict):
@@ -188,12 +214,6 @@ class DrawsConfig(_Strict):
             r = getattr(self, name)
             if r is not None and not r[0] < r[1]:
                 raise ValueError(f"{name}: must be [low, high] with low < high, got {list(r)}")
-        lower, upper = X8.command_lower, X8.command_upper
-        for a, name in ((0, "engine_lock_range"), (1, "elevon_lock_range_rad")):
-            r = getattr(self, name)
-            if r is not None and (r[0] < lower[a] or r[1] > upper[a]):
-                raise ValueError(f"{name}: must lie within the command range "
-                                 f"[{lower[a]:g}, {upper[a]:g}], got {list(r)}")
         return self
 
 
@@ -302,6 +322,12 @@ class Config(_Sampled):
             raise ValueError("controller.horizon_s: must not exceed timing.duration_s "
                              f"({t.duration_s:g} s), got {self.controller.horizon_s:g}")
         _check_length("timing.duration_s", t.duration_s, dt)
+        lower, upper = _check_airframe_use(self)
+        for a, name in ((0, "engine_lock_range"), (1, "elevon_lock_range_rad")):
+            r = getattr(self.draws, name)
+            if r is not None and (r[0] < lower[a] or r[1] > upper[a]):
+                raise ValueError(f"draws.{name}: must lie within the command range "
+                                 f"[{lower[a]:g}, {upper[a]:g}], got {list(r)}")
         return self
 
     def resets_stored(self) -> int:
@@ -400,7 +426,7 @@ class ScenarioConfig(_Sampled):
         if self.controller.horizon_s > sc.duration_s:
             raise ValueError(f"controller.horizon_s: must not exceed scenario.duration_s "
                              f"({sc.duration_s:g} s), got {self.controller.horizon_s:g}")
-        lower, upper = X8.command_lower, X8.command_upper
+        lower, upper = _check_airframe_use(self)
         for i, e in enumerate(sc.schedule):
             if e.fault == "lock" and e.position != "trim":
                 a = ACTUATOR_NAMES.index(e.actuator)

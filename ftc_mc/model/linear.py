@@ -191,7 +191,7 @@ class LinearPlant:
     Bw, Dw : ndarray or None
         Gust input matrices, shapes (9, 3) and (12, 3), of a model read from a
         file; ``None`` for a model built from an airframe, whose gust matrices
-        :func:`ftc_mc.truth.wind_matrices` computes.
+        :func:`ftc_mc.model.wind.wind_matrices` computes.
     """
 
     A: np.ndarray

@@ -28,8 +28,8 @@ from ..core.settings import (Belief, Controller, Detection, Excitation, FilterMo
 from ..design.lqr import discounted_lqr, paper_q_lqr
 from ..design.terminal import terminal_costs
 from ..design.theorem41 import cached_engine_tables
-from ..model.airframe import X8
-from ..model.linear import LinearPlant, build_plant
+from ..model.linear import LinearPlant
+from ..model.source import load_plant
 from ..model.turbulence import DrydenModel
 from .estimator import (EstimatorSettings, belief_settings, detection, filter_model,
                         initial_covariance)
@@ -153,7 +153,9 @@ def build_setup(cfg: Config | ScenarioConfig) -> SimSetup:
                  else cfg.campaign.signature)
     variants = variants_of(signature)
     m = cfg.model
-    plant = build_plant(X8, m.airspeed_mps, m.gamma_deg, m.dt_s)
+    vc = cfg.validity
+    plant = load_plant(m.airframe, m.airspeed_mps, m.gamma_deg, m.dt_s,
+                       (math.radians(vc.alpha_min_deg), math.radians(vc.alpha_max_deg)))
     est = EstimatorSettings.from_config(cfg.estimator, variants[0])
     fm = filter_model(plant, est)
     det = {v: detection(plant, dataclasses.replace(est, signature=v)) for v in variants}
@@ -178,7 +180,6 @@ def build_setup(cfg: Config | ScenarioConfig) -> SimSetup:
                      s3211_unit=cfg.steps(x.s3211_unit_s),
                      resend_delay=cfg.steps(x.resend_delay_s),
                      resend_b1=float(x.resend_b1_threshold))
-    vc = cfg.validity
     val = Validity(va_trim=float(plant.trim.y0[11]), va_min=vc.airspeed_min_mps,
                    va_max=vc.airspeed_max_mps, alpha_trim=plant.trim.alpha,
                    alpha_min=math.radians(vc.alpha_min_deg),
