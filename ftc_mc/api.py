@@ -77,7 +77,7 @@ def _listed(names):
 
 
 def campaign_config(config, *, trials=None, seed=None, signature=None, transitions=None,
-                    controller=None, plant=None, turbulence=None):
+                    controller=None, plant=None, turbulence=None, airframe=None):
     """A validated campaign :class:`~ftc_mc.config.Config` with overrides.
 
     Parameters
@@ -91,6 +91,9 @@ def campaign_config(config, *, trials=None, seed=None, signature=None, transitio
     controller : {"nominal", "reconfiguring"}, optional
     plant : {"linear", "nonlinear"}, optional
     turbulence : {"none", "light", "moderate", "severe"}, optional
+    airframe : str or Path, optional
+        ``model.airframe``: a preset name, an airframe YAML file or a linear
+        model (``.npz``/``.mat``).
     """
     from .config import Config, ScenarioConfig, load_config as load_campaign
     from .config import parse_config, with_overrides
@@ -107,18 +110,19 @@ def campaign_config(config, *, trials=None, seed=None, signature=None, transitio
     over = {"campaign": {"trials": trials, "seed": seed, "signature": signature,
                          "transitions": _listed(transitions)},
             "controller": {"kind": controller},
-            "plant": {"kind": plant, "turbulence": turbulence}}
+            "plant": {"kind": plant, "turbulence": turbulence},
+            "model": {"airframe": None if airframe is None else str(airframe)}}
     over = {k: v for k, v in over.items() if any(x is not None for x in v.values())}
     return with_overrides(cfg, **over) if over else cfg
 
 
-def scenario_config(config, *, plant=None, turbulence=None):
+def scenario_config(config, *, plant=None, turbulence=None, airframe=None):
     """A validated :class:`~ftc_mc.config.ScenarioConfig` with plant overrides.
 
     Parameters
     ----------
     config : str, Path, dict or ScenarioConfig
-    plant, turbulence : str, optional
+    plant, turbulence, airframe : str, optional
         As in :func:`campaign_config`.
     """
     from .config import Config, ScenarioConfig, load_scenario, with_overrides
@@ -133,9 +137,10 @@ def scenario_config(config, *, plant=None, turbulence=None):
         sc = validate_model(ScenarioConfig, config, "config")
     else:
         sc = load_scenario(config)
-    if plant is None and turbulence is None:
-        return sc
-    return with_overrides(sc, plant={"kind": plant, "turbulence": turbulence})
+    over = {"plant": {"kind": plant, "turbulence": turbulence},
+            "model": {"airframe": None if airframe is None else str(airframe)}}
+    over = {k: v for k, v in over.items() if any(x is not None for x in v.values())}
+    return with_overrides(sc, **over) if over else sc
 
 
 # -- output directories -----------------------------------------------------------
@@ -200,7 +205,7 @@ def _finished(out_dir: Path, kind: str, files, identity: dict) -> bool:
 # -- the commands -----------------------------------------------------------------
 
 def run_campaign(config, *, trials=None, seed=None, signature=None, controller=None,
-                 plant=None, turbulence=None, jobs: int = 1, progress: bool = True,
+                 plant=None, turbulence=None, airframe=None, jobs: int = 1, progress: bool = True,
                  backend: str = "loky", scheduler: str | None = None, out=None,
                  overwrite: bool = False, resume: bool = False,
                  command: str | None = None):
@@ -210,7 +215,7 @@ def run_campaign(config, *, trials=None, seed=None, signature=None, controller=N
     ----------
     config : str, Path, dict or Config
         YAML path, parsed mapping or validated configuration.
-    trials, seed, signature, controller, plant, turbulence : optional
+    trials, seed, signature, controller, plant, turbulence, airframe : optional
         Overrides of the config (:func:`campaign_config`).
     jobs : int
         Worker processes; 1 runs here, -1 uses every core (or this process
@@ -253,7 +258,8 @@ def run_campaign(config, *, trials=None, seed=None, signature=None, controller=N
 
     _check_jobs(jobs)
     cfg = campaign_config(config, trials=trials, seed=seed, signature=signature,
-                          controller=controller, plant=plant, turbulence=turbulence)
+                          controller=controller, plant=plant, turbulence=turbulence,
+                          airframe=airframe)
     kw = dict(jobs=jobs, progress=progress, backend=backend, scheduler=scheduler)
     out_dir = _check_out(out, resume)
     if out_dir is None:
@@ -293,9 +299,10 @@ def _spec(values, option: str):
 
 def run_sweep(config, thresholds=None, *, tq=None, tnx=None, transitions=None,
               signature=None, trials=None, seed=None, flights: int | None = None,
-              plant=None, turbulence=None, jobs: int = 1, progress: bool = True,
-              backend: str = "loky", scheduler: str | None = None, out=None,
-              overwrite: bool = False, resume: bool = False, command: str | None = None):
+              plant=None, turbulence=None, airframe=None, jobs: int = 1,
+              progress: bool = True, backend: str = "loky", scheduler: str | None = None,
+              out=None, overwrite: bool = False, resume: bool = False,
+              command: str | None = None):
     """Sweep the Table 1 thresholds (``ftc-mc sweep``).
 
     Parameters
@@ -305,7 +312,7 @@ def run_sweep(config, thresholds=None, *, tq=None, tnx=None, transitions=None,
         ``t_q = t_nx`` values: ``"start:stop:step"``, ``"a,b,c"`` or numbers.
     tq, tnx : str or sequence of float, optional
         A grid of ``t_q`` by ``t_nx`` values instead of ``thresholds``.
-    transitions, signature, trials, seed, plant, turbulence : optional
+    transitions, signature, trials, seed, plant, turbulence, airframe : optional
         Overrides of the config (:func:`campaign_config`).
     flights : int, optional
         Fault-free flights per point for the false-reset rate (default: trials).
@@ -326,7 +333,8 @@ def run_sweep(config, thresholds=None, *, tq=None, tnx=None, transitions=None,
     from .io.results import prepare_output_dir, provenance, write_parquet
 
     cfg = campaign_config(config, trials=trials, seed=seed, signature=signature,
-                          transitions=transitions, plant=plant, turbulence=turbulence)
+                          transitions=transitions, plant=plant, turbulence=turbulence,
+                          airframe=airframe)
     points = threshold_points(_spec(thresholds, "--thresholds"), _spec(tq, "--tq"),
                               _spec(tnx, "--tnx"))
     if flights is not None and flights < 1:
@@ -363,7 +371,7 @@ def run_sweep(config, thresholds=None, *, tq=None, tnx=None, transitions=None,
 
 
 def run_scenario(config, *, seed: int | None = None, plant=None, turbulence=None,
-                 out=None, overwrite: bool = False, command: str | None = None):
+                 airframe=None, out=None, overwrite: bool = False, command: str | None = None):
     """Fly one closed-loop scenario: the paper's Table 4 by default (``ftc-mc scenario``).
 
     Parameters
@@ -371,8 +379,8 @@ def run_scenario(config, *, seed: int | None = None, plant=None, turbulence=None
     config : str, Path, dict or ScenarioConfig
     seed : int, optional
         Noise seed (overrides ``scenario.seed``).
-    plant, turbulence : str, optional
-        Truth plant overrides, as in :func:`campaign_config`.
+    plant, turbulence, airframe : str, optional
+        Overrides, as in :func:`campaign_config`.
     out : str or Path, optional
         Write ``timeseries.parquet``, ``events.parquet``, ``segments.parquet``,
         Figs. 6-12 and ``summary.md`` there.
@@ -389,7 +397,7 @@ def run_scenario(config, *, seed: int | None = None, plant=None, turbulence=None
     from .io.results import prepare_output_dir, provenance
     from .scenario import run_scenario as run, write_scenario
 
-    sc = scenario_config(config, plant=plant, turbulence=turbulence)
+    sc = scenario_config(config, plant=plant, turbulence=turbulence, airframe=airframe)
     if seed is not None and seed < 0:
         raise UserError(f"--seed: must be >= 0, got {seed}")
     out_dir = _check_out(out, False)

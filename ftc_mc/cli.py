@@ -43,8 +43,15 @@ def cli():
 
 @cli.command()
 @click.option("--json", "as_json", is_flag=True, help="Print JSON instead of text.")
+@click.option("--airframe", metavar="NAME|PATH", help="A preset (see ftc-mc airframes), "
+              "an airframe YAML file or a linear model .npz/.mat [default: "
+              "the default preset].")
 @click.option("--save", type=click.Path(dir_okay=False, writable=True),
-              help="Write A, B, C, u0, limits and dt to this .npz file.")
+              help="Write the linear model (A, B, C, trim, limits, dt, gust matrices) to "
+              "this .npz file; it can be flown with --airframe FILE.npz.")
+@click.option("--export", type=click.Path(dir_okay=False, writable=True),
+              help="Write the airframe's parameters to this YAML file (every field with "
+              "its unit): edit it and fly it with --airframe FILE.yaml.")
 @click.option("--airspeed", default=20.0, show_default=True, type=float,
               help="Trim airspeed [m/s].")
 @click.option("--gamma", "gamma_deg", default=-3.0, show_default=True, type=float,
@@ -52,34 +59,83 @@ def cli():
 @click.option("--dt", default=0.1, show_default=True, type=float,
               help="Sampling period [s].")
 @user_errors
-def model(as_json, save, airspeed, gamma_deg, dt):
+def model(as_json, airframe, save, export, airspeed, gamma_deg, dt):
     """Trim point, named eigenvalues and redundancy check of the linear model."""
     from .io.atomic import atomic_path
-    from .model.linear import build_plant
+    from .model.airframe_files import export_airframe
+    from .model.presets import PRESETS, resolve_airframe
+    from .model.source import DEFAULT_AIRFRAME, is_linear_model, load_plant
     from .model.summary import format_summary, model_summary, save_npz
 
+    spec = airframe or DEFAULT_AIRFRAME
     if save is not None and not save.endswith(".npz"):
         raise UserError(f"--save: file name must end in .npz, got {save!r}")
-    plant = build_plant(V0=airspeed, gamma0_deg=gamma_deg, dt=dt)
-    summary = model_summary(plant)
+    if export is not None and not export.endswith((".yaml", ".yml")):
+        raise UserError(f"--export: file name must end in .yaml, got {export!r}")
+    if export is not None and is_linear_model(spec):
+        raise UserError(f"--export: {spec} is a linear model, it has no airframe "
+                        "parameters to export")
+    plant = load_plant(spec, airspeed, gamma_deg, dt)
+    summary = model_summary(plant) if plant.airframe is not None else None
     if save is not None:
         with atomic_path(save) as tmp, open(tmp, "wb") as f:
             save_npz(plant, f)
-    click.echo(json.dumps(summary, indent=2) if as_json else format_summary(summary))
+    if export is not None:
+        source = str(PRESETS[spec].source) if spec in PRESETS else str(spec)
+        with atomic_path(export) as tmp:
+            export_airframe(resolve_airframe(spec), tmp, name=spec, source=source)
+    if summary is None:
+        click.echo(f"{spec}: a linear model (trim throttle {plant.u0[0]:.4f}, "
+                   f"airspeed {plant.trim.V0:g} m/s, dt {plant.dt:g} s); it has no "
+                   "equations to summarise")
+    else:
+        click.echo(json.dumps(summary, indent=2) if as_json else format_summary(summary))
+    for what, path in (("linear model", save), ("airframe", export)):
+        if path is not None and not as_json:
+            click.echo(f"wrote the {what} to {path}")
+
+
+@cli.command()
+@click.option("--airspeed", default=20.0, show_default=True, type=float,
+              help="Trim airspeed [m/s].")
+@click.option("--gamma", "gamma_deg", default=-3.0, show_default=True, type=float,
+              help="Trim flight-path angle [deg].")
+@user_errors
+def airframes(airspeed, gamma_deg):
+    """The airframe presets: their sources and trim points."""
+    from .model.presets import list_airframes
+    from .model.source import DEFAULT_AIRFRAME
+
+    for row in list_airframes(airspeed, gamma_deg):
+        mark = " (default)" if row["name"] == DEFAULT_AIRFRAME else ""
+        click.echo(f"{row['name']}{mark}: {row['note']}")
+        click.echo(f"    source: {row['source']}")
+        click.echo(f"            {row['reference']}")
+        if row["refused"]:
+            click.echo(f"    trim at {airspeed:g} m/s, {gamma_deg:g} deg: {row['refused']}")
+        else:
+            click.echo(f"    trim at {airspeed:g} m/s, {gamma_deg:g} deg: throttle "
+                       f"{row['throttle']:.3f}, alpha {row['alpha_deg']:.3f} deg, elevons "
+                       f"{row['elevon_rad']:.4f} rad")
 
 
 def _default_out(config_path: str, cfg=None):
     """``results/<config stem>``, or the first ``-N`` suffix that holds no run.
 
-    A truth plant other than the paper's (linear, still air) is named in the
-    stem, e.g. ``results/paper_tables-nonlinear-moderate``.
+    An airframe other than the default, and a truth plant other than the
+    paper's (linear, still air), are named in the stem, e.g.
+    ``results/paper_tables-x8-gryte2018-nonlinear-moderate``.
     """
     from pathlib import Path
 
     from .io.lock import holder
     from .io.results import RUN_FILES
 
+    from .model.source import DEFAULT_AIRFRAME, airframe_label
+
     stem = Path(config_path).stem
+    if cfg is not None and cfg.model.airframe != DEFAULT_AIRFRAME:
+        stem += f"-{airframe_label(cfg.model.airframe)}"
     if cfg is not None and (cfg.plant.kind, cfg.plant.turbulence) != ("linear", "none"):
         stem += f"-{cfg.plant.kind}" + (f"-{cfg.plant.turbulence}"
                                         if cfg.plant.turbulence != "none" else "")
@@ -92,8 +148,14 @@ def _default_out(config_path: str, cfg=None):
     return cand
 
 
+AIRFRAME_HELP = ("Airframe: a preset (see ftc-mc airframes), an airframe YAML file, or a "
+                 "linear model .npz/.mat (overrides model.airframe).")
+
+
 def plant_options(func):
-    """``--plant`` and ``--turbulence`` of ``run``, ``sweep`` and ``scenario``."""
+    """``--airframe``, ``--plant`` and ``--turbulence`` of ``run``, ``sweep`` and
+    ``scenario``."""
+    func = click.option("--airframe", metavar="NAME|PATH", help=AIRFRAME_HELP)(func)
     func = click.option("--turbulence",
                         type=click.Choice(["none", "light", "moderate", "severe"]),
                         help="MIL-F-8785C Dryden gusts on the truth plant (overrides "
@@ -182,14 +244,15 @@ def terminal_table(summary) -> str:
 @parallel_options
 @user_errors
 def run(config, trials, seed, jobs, out, signature, controller, overwrite, resume, backend,
-        scheduler, quiet, plant, turbulence):
+        scheduler, quiet, plant, turbulence, airframe):
     """Run a Monte Carlo campaign (the paper's Tables 2-3) from CONFIG."""
     from pathlib import Path
 
     from . import api
 
     cfg = api.campaign_config(config, trials=trials, seed=seed, signature=signature,
-                              controller=controller, plant=plant, turbulence=turbulence)
+                              controller=controller, plant=plant, turbulence=turbulence,
+                              airframe=airframe)
     if resume and not out:
         raise UserError("--resume: name the run's directory with --out")
     out_dir = Path(out) if out else _default_out(config, cfg)
@@ -214,14 +277,14 @@ def run(config, trials, seed, jobs, out, signature, controller, overwrite, resum
 @click.option("--overwrite", is_flag=True, help="Replace results already in --out.")
 @plant_options
 @user_errors
-def scenario(config, out, seed, overwrite, plant, turbulence):
+def scenario(config, out, seed, overwrite, plant, turbulence, airframe):
     """Run the closed-loop scenario of CONFIG (the paper's Table 4 by default)."""
     from pathlib import Path
 
     from . import api
     from .scenario import summary_markdown
 
-    sc = api.scenario_config(config, plant=plant, turbulence=turbulence)
+    sc = api.scenario_config(config, plant=plant, turbulence=turbulence, airframe=airframe)
     out_dir = Path(out) if out else _default_out(config, sc)
     res = api.run_scenario(sc, seed=seed, out=out_dir, overwrite=overwrite,
                            command=shlex.join(["ftc-mc", "scenario", config]))
@@ -251,7 +314,7 @@ def scenario(config, out, seed, overwrite, plant, turbulence):
 @parallel_options
 @user_errors
 def sweep(config, thresholds, tq, tnx, transitions, signature, trials, flights, jobs, out,
-          overwrite, resume, backend, scheduler, quiet, plant, turbulence):
+          overwrite, resume, backend, scheduler, quiet, plant, turbulence, airframe):
     """Sweep the Table 1 thresholds: Tables 2-3 and false resets per flight hour."""
     from pathlib import Path
 
@@ -259,7 +322,8 @@ def sweep(config, thresholds, tq, tnx, transitions, signature, trials, flights, 
     from .campaign.sweep import sweep_markdown
 
     cfg = api.campaign_config(config, trials=trials, signature=signature,
-                              transitions=transitions, plant=plant, turbulence=turbulence)
+                              transitions=transitions, plant=plant, turbulence=turbulence,
+                              airframe=airframe)
     if resume and not out:
         raise UserError("--resume: name the sweep's directory with --out")
     out_dir = Path(out) if out else _default_out(config, cfg)

@@ -172,12 +172,12 @@ def test_bad_parameters_below_the_config_are_one_line(tmp_path):
 
 def test_an_unexpected_value_error_is_not_hidden(tmp_path, monkeypatch):
     import ftc_mc.campaign.runner
-    import ftc_mc.model.linear
+    import ftc_mc.model.source
 
     def bug(*args, **kwargs):
         raise ValueError("a bug, not the user's input")
 
-    monkeypatch.setattr(ftc_mc.model.linear, "build_plant", bug)
+    monkeypatch.setattr(ftc_mc.model.source, "load_plant", bug)
     res = CliRunner().invoke(cli, ["model"])
     assert res.exit_code == 1 and type(res.exception) is ValueError
     assert "ftc-mc: error" not in res.output

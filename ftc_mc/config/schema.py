@@ -18,7 +18,8 @@ from pydantic import (BaseModel, BeforeValidator, ConfigDict, Field, field_valid
 
 from ..conventions import ACTUATOR_NAMES, PLANT_KINDS, TRANSITIONS, TURBULENCE_LEVELS
 from ..errors import UserError
-from ..model.source import DEFAULT_AIRFRAME, check_airframe, command_limits, is_linear_model
+from ..model.source import (DEFAULT_AIRFRAME, check_airframe, check_condition,
+                            command_limits, is_linear_model)
 
 
 def _no_bool(value):
@@ -77,14 +78,21 @@ def _shared_periods(cfg) -> list:
 
 
 def _check_airframe_use(cfg) -> tuple:
-    """Refuse the nonlinear truth plant with a linear model (it has no equations);
-    return the airframe's absolute command limits ``(lower, upper)``."""
-    spec = cfg.model.airframe
-    if cfg.plant.kind == "nonlinear" and is_linear_model(spec):
+    """Refuse the nonlinear truth plant with a linear model (it has no equations)
+    and a trim condition the airframe cannot fly; return the airframe's absolute
+    command limits ``(lower, upper)``."""
+    m = cfg.model
+    if cfg.plant.kind == "nonlinear" and is_linear_model(m.airframe):
         raise ValueError(f"plant.kind: nonlinear needs an airframe's equations, but "
-                         f"model.airframe is a linear model ({spec}); use a preset or an "
-                         "airframe YAML file, or plant.kind: linear")
-    return command_limits(spec)
+                         f"model.airframe is a linear model ({m.airframe}); use a preset "
+                         "or an airframe YAML file, or plant.kind: linear")
+    alpha = (math.radians(cfg.validity.alpha_min_deg),
+             math.radians(cfg.validity.alpha_max_deg))
+    try:
+        check_condition(m.airframe, m.airspeed_mps, m.gamma_deg, m.dt_s, alpha)
+    except UserError as exc:
+        raise ValueError(str(exc)) from None
+    return command_limits(m.airframe)
 
 
 class _Sampled(_Strict):

@@ -21,7 +21,7 @@ from pathlib import Path
 
 from ..errors import UserError
 from .airframe_files import load_linear_model
-from .linear import LinearPlant, build_plant
+from .linear import LinearPlant, build_plant, trim
 from .presets import PRESETS, resolve_airframe
 
 DEFAULT_AIRFRAME = "x8-gryte2018"
@@ -61,6 +61,16 @@ def command_limits(spec: str) -> tuple:
         return tuple(plant.u_lower), tuple(plant.u_upper)
     af = resolve_airframe(spec)
     return af.command_lower, af.command_upper
+
+
+def check_condition(spec: str, V0: float, gamma_deg: float, dt: float,
+                    alpha_range=None) -> None:
+    """Refuse, as :func:`load_plant` would, a condition the airframe cannot fly
+    (only the trim is computed, not the linearisation)."""
+    if is_linear_model(spec):
+        load_plant(spec, V0, gamma_deg, dt)
+    else:
+        trim(resolve_airframe(spec), V0, gamma_deg, alpha_range)
 
 
 def load_plant(spec: str, V0: float, gamma_deg: float, dt: float,
