@@ -105,6 +105,11 @@ TRANSITIONS = ("elevon_lock", "elevon_unlock", "elevon_loss", "elevon_loss_recov
                "engine_lock", "engine_unlock", "engine_loss", "engine_loss_recover")
 """The eight transitions of Tables 2-3 (DESIGN.md section 6)."""
 
+AIRFRAME_PRESETS = ("x8-pyfly", "x8-gryte2018")
+"""Airframe presets (:mod:`ftc_mc.model.presets`), the default first."""
+DEFAULT_AIRFRAME = AIRFRAME_PRESETS[0]
+"""Airframe flown when a config names none (``docs/airframes.md``: why)."""
+
 PLANT_KINDS = ("linear", "nonlinear")
 TURBULENCE_LEVELS = ("none", "light", "moderate", "severe")
 """Truth plants and MIL-F-8785C turbulence levels (W20 = 0, 15, 30, 45 kt)."""

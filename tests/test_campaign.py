@@ -192,16 +192,22 @@ def test_cli_run_missing_file_and_bad_options(tmp_path):
     assert not (tmp_path / "o").exists()
 
 
-def test_every_transition_behaves():
-    """Small campaign of each transition: what must hold whatever the airframe.
+@pytest.mark.parametrize("airframe", ["x8-gryte2018", "x8-pyfly"])
+def test_every_transition_behaves(airframe):
+    """Small campaign of each transition: what must hold on each preset.
 
     With the swapped signature (the variant Table 1 logic predicts right for an
     elevon fault), elevon faults reset the elevon block in most trials, almost
     no trial resets before the fault, and no-reset trials concentrate at small
-    b1 or locks near trim.
+    b1 or locks near trim.  Which trials leave the envelope depends on the
+    airframe (docs/airframes.md): the authors' engine (full throttle 22 times
+    the trim thrust) overspeeds after engine locks far from trim; PyFly's (4.4
+    times) does not, but its weaker pitch stiffness lets elevon locks beyond
+    about -0.41 rad (-24 deg) dive out of the envelope.
     """
     cfg = Config.model_validate({"campaign": {"transitions": list(TRANSITIONS),
-                                              "trials": 48, "signature": "swapped"}})
+                                              "trials": 48, "signature": "swapped"},
+                                 "model": {"airframe": airframe}})
     res = ftc_mc.run_campaign(cfg, jobs=2, progress=False)
     t = res.trials
     assert (t["false_resets"] == 0).mean() > 0.9
@@ -213,10 +219,15 @@ def test_every_transition_behaves():
     assert len(nr) > 0
     # no-reset trials have smaller effectiveness losses than reset trials
     assert nr["loss_b1"].median() < loss[~loss.no_reset]["loss_b1"].median()
-    # every trial of the elevon and loss rows stays judged (inside the envelope);
-    # engine locks far from trim overspeed the linear plant and are excluded
     s = res.summary.set_index("transition")
     assert (s["trials"] + s["excluded"] == 48).all()
-    for name in ("elevon_lock", "elevon_loss", "elevon_loss_recover", "engine_loss"):
+    for name in ("elevon_loss", "elevon_loss_recover", "engine_loss"):
         assert s.loc[name, "excluded"] <= 2, s.loc[name]
-    assert s.loc["engine_lock", "stopped_airspeed_out_of_bounds"] > 0
+    lock = t[t.transition == "elevon_lock"]
+    if airframe == "x8-gryte2018":
+        assert s.loc["elevon_lock", "excluded"] <= 2
+        assert s.loc["engine_lock", "stopped_airspeed_out_of_bounds"] > 0
+    else:
+        assert s.loc["engine_lock", "excluded"] <= 2
+        assert (lock.loc[~lock.judged, "lock_position"] < -0.4).all()
+        assert s.loc["elevon_lock", "excluded"] <= 0.2 * 48

@@ -39,6 +39,7 @@ from click.testing import CliRunner
 from ftc_mc.campaign.transitions import TRANSITION_TABLE
 from ftc_mc.cli import cli
 from ftc_mc.io.results import read_metadata, write_parquet
+from ftc_mc.conventions import DEFAULT_AIRFRAME
 from ftc_mc.report import (build_report, condition_labels, condition_order,
                            config_differences, reference_index)
 
@@ -51,6 +52,9 @@ FAULT_TIME_S = 5.0
 BASE = {"campaign": {"transitions": ["elevon_lock", "engine_lock"], "trials": 6,
                      "signature": "swapped", "seed": 2026},
         "controller": {"kind": "nominal"},
+        # the authors' strong engine: engine locks leave the envelope, so some
+        # trials are excluded (test_excluded_trials_do_not_enter_the_rates)
+        "model": {"airframe": "x8-gryte2018"},
         "timing": {"fault_time_s": FAULT_TIME_S, "window_s": 3.0, "duration_s": 10.0}}
 RUNS = {
     "lin": ({"kind": "linear"}, {}),
@@ -307,3 +311,26 @@ def test_sweep_section_names_its_plant(runs, tmp_path):
     section = text.split(f"## Sweep `{sweep}`", 1)[1].split("\n## ", 1)[0]
     assert "truth plant `nonlinear`, turbulence `light`." in section
     assert HEADING not in text  # a sweep is not a run: nothing to compare
+
+
+def test_runs_on_two_airframes_are_compared_side_by_side(runs, tmp_path):
+    # the same config flown on the default airframe: the airframe enters the
+    # conditions, the default one is the reference, and no warning is raised
+    other = tmp_path / "pyfly"
+    cfg_path = tmp_path / "pyfly.yaml"
+    data = _config(*RUNS["lin"])
+    data["model"] = {"airframe": DEFAULT_AIRFRAME}
+    cfg_path.write_text(yaml.safe_dump(data), encoding="utf-8")
+    res = CliRunner().invoke(cli, ["run", str(cfg_path), "--out", str(other), "--quiet",
+                                   "--jobs", "1"])
+    assert res.exit_code == 0, res.output
+    same_stamp(runs["lin"], other)
+    text = _report([runs["lin"], runs["nl"], other], tmp_path / "r")
+    assert "## Airframe, truth plant and turbulence" in text and HEADING not in text
+    table = _table(text, "## Airframe, truth plant and turbulence")
+    conds = list(dict.fromkeys(table["condition"]))
+    assert conds == [f"{DEFAULT_AIRFRAME} / linear / none", "x8-gryte2018 / linear / none",
+                     "x8-gryte2018 / nonlinear / none"]
+    assert f"reference `{DEFAULT_AIRFRAME} / linear / none`" in text
+    assert "Warning: the compared runs also differ" not in text
+    assert "airframe `x8-gryte2018`, truth plant `nonlinear`" in text

@@ -19,13 +19,12 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
+from ..conventions import DEFAULT_AIRFRAME  # noqa: F401  (re-exported)
 from ..errors import UserError
 from .airframe_files import load_linear_model
 from .linear import LinearPlant, build_plant, trim
 from .presets import PRESETS, resolve_airframe
 
-DEFAULT_AIRFRAME = "x8-gryte2018"
-"""Preset flown when a config names none (``docs/airframes.md``: why)."""
 
 LINEAR_MODEL_SUFFIXES = (".npz", ".mat")
 

@@ -17,6 +17,9 @@ from ..campaign.transitions import TRANSITION_TABLE
 from ..stats import wilson
 
 DEFAULT_PLANT = ("linear", "none")
+LEGACY_AIRFRAME = "x8-gryte2018"
+"""Airframe of results written before ``model.airframe`` existed."""
+AIRFRAME_FILE_SUFFIXES = (".yaml", ".yml", ".npz", ".mat")
 """Truth plant of results written before the ``plant`` section existed; the
 reference condition of the plant comparison."""
 
@@ -94,7 +97,18 @@ def plant_condition(cfg: dict) -> tuple:
             str(plant.get("turbulence", DEFAULT_PLANT[1])))
 
 
+def airframe_of(cfg: dict) -> str:
+    """The airframe of a config: a preset name or a file's stem.
+
+    Results written before ``model.airframe`` existed flew the X8 of the
+    authors' simulator (:data:`LEGACY_AIRFRAME`, to four digits).
+    """
+    spec = str((cfg.get("model") or {}).get("airframe", LEGACY_AIRFRAME))
+    return Path(spec).stem if Path(spec).suffix.lower() in AIRFRAME_FILE_SUFFIXES else spec
+
+
 def plant_text(cfg: dict) -> str:
-    """``truth plant `kind`, turbulence `level``` of a config."""
+    """``airframe `name`, truth plant `kind`, turbulence `level``` of a config."""
     kind, turbulence = plant_condition(cfg)
-    return f"truth plant `{kind}`, turbulence `{turbulence}`"
+    return (f"airframe `{airframe_of(cfg)}`, truth plant `{kind}`, "
+            f"turbulence `{turbulence}`")

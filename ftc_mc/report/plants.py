@@ -1,8 +1,8 @@
-"""The report's comparison of runs flown on different truth plants or turbulence.
+"""The report's comparison of runs flown on different airframes, plants or turbulence.
 
-When at least two runs differ in ``(plant.kind, plant.turbulence)``
-(:func:`plant_conditions_differ`), :func:`plant_section` sets their rates side
-by side per transition: inappropriate and no-reset rates, false resets per
+When at least two runs differ in ``(model.airframe, plant.kind,
+plant.turbulence)`` (:func:`plant_conditions_differ`), :func:`plant_section`
+sets their rates side by side per transition: inappropriate and no-reset rates, false resets per
 flight hour with the exact Poisson interval (:func:`ftc_mc.stats.poisson_rate`),
 median delays, and the changes against the reference condition
 (:data:`ftc_mc.report.markdown.DEFAULT_PLANT` if present).
@@ -15,10 +15,12 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..conventions import PLANT_KINDS, TRANSITIONS, TURBULENCE_LEVELS
+from ..conventions import (AIRFRAME_PRESETS, DEFAULT_AIRFRAME, PLANT_KINDS, TRANSITIONS,
+                           TURBULENCE_LEVELS)
 from ..config.schema import TimingConfig
 from ..stats import finite_median, poisson_rate
-from .markdown import DEFAULT_PLANT, LABELS, label, num, plant_condition, rel_link
+from .markdown import (DEFAULT_PLANT, LABELS, airframe_of, label, num, plant_condition,
+                       rel_link)
 from .runs import exclusion_reason, why, window_end_s
 
 IGNORED_CAMPAIGN_KEYS = ("trials", "seed", "chunk_size")
@@ -36,24 +38,54 @@ def _rank(seq: tuple, value: str) -> int:
     return seq.index(value) if value in seq else len(seq)
 
 
-def condition_order(conditions: list) -> list:
-    """Indices of ``conditions`` in report order.
-
-    :data:`DEFAULT_PLANT` first, then by plant kind (:data:`PLANT_KINDS`), then
-    by turbulence (:data:`TURBULENCE_LEVELS`); ties keep the input order.
+def run_conditions(configs: list) -> list:
+    """The condition of each run: ``(kind, turbulence)``, with the airframe in
+    front, ``(airframe, kind, turbulence)``, when the runs fly several.
 
     Parameters
     ----------
-    conditions : list of (str, str)
-        ``(kind, turbulence)`` of each run.
+    configs : list of dict
+        The configs stored in the runs' metadata.
+
+    Returns
+    -------
+    list of tuple of str
+    """
+    plants = [plant_condition(c) for c in configs]
+    frames = [airframe_of(c) for c in configs]
+    if len(set(frames)) > 1:
+        return [(f, *p) for f, p in zip(frames, plants)]
+    return plants
+
+
+def _is_reference(cond: tuple) -> bool:
+    """The default airframe (if named) on the linear plant in still air."""
+    *frame, kind, turbulence = cond
+    return (kind, turbulence) == DEFAULT_PLANT and frame in ([], [DEFAULT_AIRFRAME])
+
+
+def condition_order(conditions: list) -> list:
+    """Indices of ``conditions`` in report order.
+
+    The reference condition (the default airframe, when named, on
+    :data:`DEFAULT_PLANT`) first, then by airframe
+    (:data:`AIRFRAME_PRESETS`, then files), plant kind (:data:`PLANT_KINDS`) and
+    turbulence (:data:`TURBULENCE_LEVELS`); ties keep the input order.
+
+    Parameters
+    ----------
+    conditions : list of tuple of str
+        ``(kind, turbulence)`` or ``(airframe, kind, turbulence)`` of each run
+        (:func:`run_conditions`).
 
     Returns
     -------
     list of int
     """
     def key(i):
-        kind, turbulence = conditions[i]
-        return (conditions[i] != DEFAULT_PLANT, _rank(PLANT_KINDS, kind), kind,
+        *frame, kind, turbulence = conditions[i]
+        name = frame[0] if frame else ""
+        return (not _is_reference(conditions[i]), _rank(AIRFRAME_PRESETS, name), name, _rank(PLANT_KINDS, kind), kind,
                 _rank(TURBULENCE_LEVELS, turbulence), turbulence, i)
     return sorted(range(len(conditions)), key=key)
 
@@ -78,13 +110,19 @@ def condition_labels(conditions: list, slugs: list) -> list:
 
 
 def reference_index(conditions: list) -> int:
-    """The reference run: the first with :data:`DEFAULT_PLANT`, else the first."""
-    return conditions.index(DEFAULT_PLANT) if DEFAULT_PLANT in conditions else 0
+    """The reference run: the first of the default airframe (when airframes
+    differ) on the linear plant in still air (:data:`DEFAULT_PLANT`); else the
+    first on that plant; else the first."""
+    for test in (_is_reference, lambda c: tuple(c[-2:]) == DEFAULT_PLANT):
+        for i, cond in enumerate(conditions):
+            if test(cond):
+                return i
+    return 0
 
 
 def plant_conditions_differ(runs: list) -> bool:
-    """True if at least two runs differ in (plant kind, turbulence)."""
-    return len({plant_condition(r.meta.get("config", {})) for r in runs}) >= 2
+    """True if at least two runs differ in (airframe, plant kind, turbulence)."""
+    return len(set(run_conditions([r.meta.get("config", {}) for r in runs]))) >= 2
 
 
 # ------------------------------------------------------------------ rates
@@ -151,8 +189,8 @@ def plant_rates(runs: list, conds: list, labels: list) -> pd.DataFrame:
     ----------
     runs : list of ResultDir
         Run directories.
-    conds : list of (str, str)
-        Their conditions (:func:`ftc_mc.report.markdown.plant_condition`).
+    conds : list of tuple of str
+        Their conditions (:func:`run_conditions`).
     labels : list of str
         Their labels (:func:`condition_labels`).
 
@@ -230,8 +268,11 @@ def _excluded_note(runs: list, labels: list, order: list) -> str:
 
 
 def _comparable(cfg: dict) -> dict:
-    """``cfg`` without the ``plant`` section and :data:`IGNORED_CAMPAIGN_KEYS`."""
+    """``cfg`` without the ``plant`` section, ``model.airframe`` and
+    :data:`IGNORED_CAMPAIGN_KEYS`."""
     out = {k: v for k, v in cfg.items() if k != "plant"}
+    if isinstance(out.get("model"), dict):
+        out["model"] = {k: v for k, v in out["model"].items() if k != "airframe"}
     if isinstance(out.get("campaign"), dict):
         out["campaign"] = {k: v for k, v in out["campaign"].items()
                            if k not in IGNORED_CAMPAIGN_KEYS}
@@ -269,7 +310,7 @@ def _difference_warning(configs: list) -> list:
     if not diff:
         return []
     return [f"> **Warning: the compared runs also differ in "
-            f"{', '.join(f'`{d}`' for d in diff)}** (besides `plant` and "
+            f"{', '.join(f'`{d}`' for d in diff)}** (besides `plant`, `model.airframe` and "
             f"`campaign.{'`/`campaign.'.join(IGNORED_CAMPAIGN_KEYS)}`): the changes "
             "below need not come from the plant alone.", ""]
 
@@ -303,14 +344,18 @@ def plant_section(runs: list, slugs: list, fig_dir: Path, report: Path) -> list:
     from ..plots.campaign import plant_figure  # matplotlib only when drawing
 
     configs = [r.meta.get("config", {}) for r in runs]
-    conds = [plant_condition(c) for c in configs]
+    conds = run_conditions(configs)
     labels = condition_labels(conds, slugs)
     ref = reference_index(conds)
     rates = plant_rates(runs, conds, labels)
     variant = _figure_variant(rates)
     fig = plant_figure(rates, variant, fig_dir / PLANT_FIGURE, LABELS)
-    return (["## Truth plant and turbulence", "",
-             f"{len(runs)} runs, one condition each (plant / turbulence); reference "
+    airframes = len(conds[0]) == 3
+    what = "airframe / plant / turbulence" if airframes else "plant / turbulence"
+    heading = ("## Airframe, truth plant and turbulence" if airframes
+               else "## Truth plant and turbulence")
+    return ([heading, "",
+             f"{len(runs)} runs, one condition each ({what}); reference "
              f"`{labels[ref]}` (`{runs[ref].path}`).", ""]
             + _difference_warning(configs)
             + [pd.DataFrame([_plant_row(r) for _, r in rates.iterrows()])
