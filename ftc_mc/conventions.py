@@ -5,7 +5,7 @@ kernel, a table and a report agree on what "index 11" or "mode 2" means.  Pure
 Python constants (Numba reads module-level ints and tuples as compile-time
 constants).  See ``docs/paper-map.md`` for the paper's symbols.
 
-Plant and filter (DESIGN.md section 2, paper eqs. 1-5)
+Plant and filter (docs/airframes.md, paper eqs. 1-5)
 ------------------------------------------------------
 The linear plant's state has ``N_X = 9`` entries (:data:`STATE_NAMES`), its
 outputs ``N_Z = 12`` (:data:`OUTPUT_NAMES`, the paper's order), its commands
@@ -103,7 +103,7 @@ STATUS_NAMES = ("ok", "nonfinite", "covariance_not_psd", "airspeed_out_of_bounds
 # ------------------------------------------------------------------ campaigns, plants
 TRANSITIONS = ("elevon_lock", "elevon_unlock", "elevon_loss", "elevon_loss_recover",
                "engine_lock", "engine_unlock", "engine_loss", "engine_loss_recover")
-"""The eight transitions of Tables 2-3 (DESIGN.md section 6)."""
+"""The eight transitions of Tables 2-3 (docs/paper-map.md)."""
 
 AIRFRAME_PRESETS = ("x8-pyfly", "x8-gryte2018")
 """Airframe presets (:mod:`ftc_mc.model.presets`), the default first."""

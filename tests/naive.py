@@ -10,7 +10,7 @@ is evidence that the structure was exploited correctly.
 Paper: "Reconfiguration control method for non-redundant actuator faults on UAV"
 (``../shared/seeds/000_6d7db61963b544ed.txt``), sections 2-3 and 5.1.
 
-Conventions (DESIGN.md section 3, ``ftc_mc.model.faults``): augmented state
+Conventions (docs/paper-map.md, ``ftc_mc.model.faults``): augmented state
 ``X = [x (9), b0 (2), b1 (3)]`` with ``b0 = [thrust, elevon sum]`` and
 ``b1 = [thrust, left, right]``; indices of the measured outputs are 0-based, so
 the paper's outputs 3, 7, 8 (q, n_x, n_z) are 2, 6, 7 here.
@@ -54,7 +54,7 @@ class RefModel:
     t_q, t_nx : float
         Thresholds of Table 1.
     variant : str
-        ``"paper"`` or ``"swapped"`` (DESIGN.md section 4).
+        ``"paper"`` or ``"swapped"`` (docs/paper-map.md).
     reset_var : ndarray, shape (5,)
         Variances after a reset (section 3.2.2).
     """

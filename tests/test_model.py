@@ -28,7 +28,7 @@ def test_trim_is_an_equilibrium(plant):
 def test_trim_matches_hand_solution():
     # Hand solution with small-angle force balance (drag and thrust-line terms
     # neglected): Cm = 0 and L = m g cos(gamma) give two linear equations in
-    # alpha and de (DESIGN.md section 2 quotes alpha about 1.1 deg, throttle 0.08).
+    # alpha and de (the design notes expected alpha about 1.1 deg, throttle 0.08).
     a = X8
     qS = 0.5 * a.rho * 20.0 ** 2 * a.S
     CL = a.mass * a.g * math.cos(math.radians(-3)) / qS

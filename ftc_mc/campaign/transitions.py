@@ -1,7 +1,7 @@
 """The eight fault transitions of Tables 2-3 and the ranges of their fault draws.
 
-A transition names the actuator (the faulty elevon is the left one, DESIGN.md
-section 6), the fault kind (lock or loss of effectiveness) and the direction
+A transition names the actuator (the faulty elevon is the left one,
+``docs/paper-map.md``), the fault kind (lock or loss of effectiveness) and the direction
 (``onset``: nominal -> faulty; ``recovery``: faulty -> nominal).  Its trials fly
 a two-entry schedule (:meth:`Transition.schedule`): the initial mode from the
 start, the final mode from the fault step on.  Each trial's fault value (lock

@@ -206,7 +206,7 @@ class NoiseConfig(_Strict):
 
 
 class DrawsConfig(_Strict):
-    """Per-trial draws (DESIGN.md section 6)."""
+    """Per-trial draws (docs/paper-map.md)."""
 
     engine_lock_range: tuple[Finite, Finite] | None = None
     """Absolute throttle lock position range; null = the command range [0, 1]."""
@@ -282,7 +282,7 @@ class CampaignConfig(_Strict):
 
     transitions: list[Literal[TRANSITIONS]] = Field(default_factory=lambda: ["elevon_lock"],
                                                     min_length=1)
-    """Transitions to run (names of DESIGN.md section 6)."""
+    """Transitions to run (names of docs/paper-map.md)."""
     trials: Annotated[int, NoBool, Field(gt=0, le=10_000_000)] = 1000
     """Trials per transition."""
     seed: Annotated[int, NoBool, Field(ge=0, lt=2 ** 63)] = 2026

@@ -100,7 +100,7 @@ def forces(x, p, out):
     Cm = p[P_CM0] + p[P_CMA] * alpha + p[P_CMQ] * qhat + p[P_CMDE] * de
     ca = math.cos(alpha)
     sa = math.sin(alpha)
-    # Beard & McLain propeller model as given in DESIGN.md section 2
+    # Beard & McLain propeller model as given in docs/airframes.md
     Vd = Va + x[6] * (p[P_KMOTOR] - Va)
     thrust = 0.5 * p[P_RHO] * p[P_SPROP] * p[P_CPROP] * Vd * (Vd - Va)
     out[0] = qbar_S * (-CD * ca + CL * sa) + thrust
