@@ -283,3 +283,87 @@ def signal_3211_ref(k, unit_steps, amplitude):
 def saturate_ref(U, s, A, lo, hi):
     """Eq. (15): clip ``U`` to ``[lo + A, hi - A]``, add ``s``, clip to ``[lo, hi]``."""
     return float(np.clip(np.clip(U, lo + A, hi - A) + s, lo, hi))
+
+
+# ------------------------------------------------------------- X8 nonlinear
+X8_PARAMS = ("mass", "Jy", "S", "c", "rho", "g", "CL0", "CLa", "CLq", "CLde", "CD0",
+             "CDa", "CDa2", "CDde2", "Cm0", "Cma", "Cmq", "Cmde", "S_prop", "k_motor",
+             "C_prop", "tau_thrust", "tau_elevon", "V0", "gamma0")
+"""Names of the packed parameter vector, in ``model.dynamics.pack_parameters``'s order."""
+
+
+def rotation(angle):
+    """2-D rotation by ``angle`` [rad]: ``[[cos, -sin], [sin, cos]]``."""
+    c, s = np.cos(angle), np.sin(angle)
+    return np.array([[c, -s], [s, c]])
+
+
+def x8_forces_ref(x, p, wind):
+    """Body-axis force ``[X, Z]`` [N] (aerodynamic + thrust), moment ``M`` [N m],
+    ``alpha`` [rad], ``Va`` [m/s] of the X8 (DESIGN.md section 2), air-relative.
+
+    Lift and drag are formed in wind axes and rotated into body axes by the angle
+    of attack: ``[X, Z]_aero = R(alpha) [-D, -L]``.
+    """
+    a = dict(zip(X8_PARAMS, p))
+    v_air = np.asarray(x[:2]) - np.asarray(wind[:2])
+    q_air = x[2] - wind[2]
+    Va = float(np.hypot(v_air[0], v_air[1]))
+    alpha = float(np.arctan2(v_air[1], v_air[0]))
+    de = np.mean(x[7:9])
+    qhat = a["c"] * q_air / (2.0 * Va)
+    CL = a["CL0"] + a["CLa"] * alpha + a["CLq"] * qhat + a["CLde"] * de
+    CD = np.polyval([a["CDa2"], a["CDa"], a["CD0"]], alpha) + a["CDde2"] * de ** 2
+    Cm = a["Cm0"] + a["Cma"] * alpha + a["Cmq"] * qhat + a["Cmde"] * de
+    qbar = 0.5 * a["rho"] * Va ** 2
+    lift, drag = qbar * a["S"] * CL, qbar * a["S"] * CD
+    Vd = Va + x[6] * (a["k_motor"] - Va)  # propeller discharge speed
+    thrust = 0.5 * a["rho"] * a["S_prop"] * a["C_prop"] * Vd * (Vd - Va)
+    F = rotation(alpha) @ np.array([-drag, -lift]) + np.array([thrust, 0.0])
+    return F, qbar * a["S"] * a["c"] * Cm, alpha, Va
+
+
+def x8_derivatives_ref(x, cmd, p, wind):
+    """``dx/dt`` of the X8 (9 states): body-axis Newton-Euler with the Coriolis
+    term ``q x [u, w]``, gravity rotated into body axes, the position error of the
+    glide-path reference point and three first-order actuators."""
+    a = dict(zip(X8_PARAMS, p))
+    x = np.asarray(x, dtype=float)
+    F, M, _, _ = x8_forces_ref(x, p, wind)
+    vel = x[:2]
+    q, theta = x[2], x[5]
+    gravity = a["g"] * np.array([-np.sin(theta), np.cos(theta)])
+    coriolis = q * np.array([-vel[1], vel[0]])
+    accel = F / a["mass"] + gravity + coriolis
+    # body -> (forward, down) earth axes: rotation by -theta
+    pos_rate = rotation(-theta) @ vel - a["V0"] * np.array([np.cos(a["gamma0"]),
+                                                            -np.sin(a["gamma0"])])
+    tau = np.array([a["tau_thrust"], a["tau_elevon"], a["tau_elevon"]])
+    act = (np.asarray(cmd) - x[6:9]) / tau
+    return np.concatenate([accel, [M / a["Jy"]], pos_rate, [q], act])
+
+
+def x8_outputs_ref(x, p, wind):
+    """The 12 outputs: the first six states, specific forces over ``g``
+    (``n_z`` up), ``alpha``, ``gamma = theta - alpha``, ``CAS = Va`` (sea level)
+    and ``Va``."""
+    a = dict(zip(X8_PARAMS, p))
+    F, _, alpha, Va = x8_forces_ref(x, p, wind)
+    mg = a["mass"] * a["g"]
+    return np.concatenate([x[:6], [F[0] / mg, -F[1] / mg, alpha, x[5] - alpha, Va, Va]])
+
+
+def rk4_ref(x, cmd, p, wind, dt, n_sub):
+    """``n_sub`` classical RK4 steps over ``dt`` with commands and wind held."""
+    def f(s):
+        return x8_derivatives_ref(s, cmd, p, wind)
+
+    h = dt / n_sub
+    x = np.array(x, dtype=float)
+    for _ in range(n_sub):
+        k1 = f(x)
+        k2 = f(x + h / 2 * k1)
+        k3 = f(x + h / 2 * k2)
+        k4 = f(x + h * k3)
+        x = x + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+    return x
