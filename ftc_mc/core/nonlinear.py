@@ -59,7 +59,13 @@ import numpy as np
 
 from ..conventions import N_X as N_STATE
 from ..conventions import N_Z as N_OUTPUT
+from ..conventions import OUT_ALPHA, OUT_NX, OUT_NZ, OUT_VA, OUTPUT_NAMES
 from .jit import kernel
+
+OUT_GAMMA = OUTPUT_NAMES.index("gamma")
+OUT_CAS = OUTPUT_NAMES.index("CAS")
+N_DIRECT = OUTPUT_NAMES.index("n_x")
+"""The outputs before ``n_x`` are the first states themselves."""
 
 # Index of each entry of the packed parameter vector (model/dynamics.pack_parameters).
 (P_MASS, P_JY, P_S, P_C, P_RHO, P_G, P_CL0, P_CLA, P_CLQ, P_CLDE, P_CD0, P_CDA,
@@ -160,14 +166,14 @@ def outputs_nb(x, p, wind, y):
     """
     X, Z, M, alpha, Va, thrust = air_forces(x, p, wind)
     mg = p[P_MASS] * p[P_G]
-    for i in range(6):
+    for i in range(N_DIRECT):
         y[i] = x[i]
-    y[6] = X / mg
-    y[7] = -Z / mg
-    y[8] = alpha
-    y[9] = x[5] - alpha
-    y[10] = Va  # sea level: calibrated airspeed equals true airspeed
-    y[11] = Va
+    y[OUT_NX] = X / mg
+    y[OUT_NZ] = -Z / mg
+    y[OUT_ALPHA] = alpha
+    y[OUT_GAMMA] = x[5] - alpha
+    y[OUT_CAS] = Va  # sea level: calibrated airspeed equals true airspeed
+    y[OUT_VA] = Va
 
 
 @kernel
