@@ -50,7 +50,7 @@ def schedule_entry(k_switch, k):
     return ev
 
 
-@kernel
+@kernel(inline="always")
 def actuator_effect(u0, b0, b1, u, e):
     """Effect of the actuators on every lane (eq. 2): ``e = b0 + (1 - b1) u - b1 u0``.
 
@@ -74,7 +74,7 @@ def actuator_effect(u0, b0, b1, u, e):
             e[i, l] = b0[i, l] + (1.0 - b1il) * u[i, l] - b1il * u0i
 
 
-@kernel
+@kernel(inline="always")
 def gust_lanes(plant, eta, gust, wind, wind_next, work):
     """Dryden gusts of every lane: the gust held over the step and the next one.
 
@@ -111,7 +111,7 @@ def gust_lanes(plant, eta, gust, wind, wind_next, work):
             wind_next[i, l] = acc
 
 
-@kernel
+@kernel(inline="always")
 def linear_step(model, flight, w, v, x, work):
     """Linear plant of eq. (1) on every lane, with gusts when ``flight.plant.turb``.
 
@@ -188,7 +188,7 @@ def linear_step(model, flight, w, v, x, work):
         work.alpha[l] = al
 
 
-@kernel
+@kernel(inline="always")
 def nonlinear_step(u0, plant, w, v, x, work):
     """Nonlinear X8 on every lane, one lane at a time (RK4, ``plant.n_sub`` steps).
 
@@ -231,7 +231,7 @@ def nonlinear_step(u0, plant, w, v, x, work):
         work.alpha[l] = y[OUT_ALPHA]
 
 
-@kernel
+@kernel(inline="always")
 def truth_step(model, flight, inp, k, st, work):
     """Stage 2: the truth plant over step ``k -> k+1`` on every lane (module docstring).
 

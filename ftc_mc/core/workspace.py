@@ -64,6 +64,7 @@ TrialWork = namedtuple("TrialWork", [
     "fwork",      # (step_rows(n), n, L) filter work
     "res",        # (N_RES, L) residuals r_q, r_nx, r_nz (eqs. 9-11)
     "block",      # (L,) int64 block reset this step (Table 1)
+    "finite",     # (L,) bool: the lane's estimate, variances and air data are finite
     # one lane at a time
     "xl",         # (n,) a lane's estimate
     "Pl",         # (n, n) a lane's covariance
@@ -107,7 +108,7 @@ def new_trial_work(L, n):
         x_next=np.zeros((N_X, L)), z=np.zeros((N_Z, L)), va=np.zeros(L),
         alpha=np.zeros(L), phi=np.zeros((N_X, N_FAULT, L)), T=np.zeros((N_X, n, L)),
         fwork=np.zeros((step_rows(n), n, L)), res=np.zeros((N_RES, L)),
-        block=np.zeros(L, dtype=np.int64),
+        block=np.zeros(L, dtype=np.int64), finite=np.zeros(L, dtype=np.bool_),
         xl=np.zeros(n), Pl=np.zeros((n, n)), Ul=np.zeros(N_U), chol=np.zeros((n, n)),
         gust=np.zeros(N_GUST_STATE), eta=np.zeros(N_GUST_NOISE), wl=np.zeros(N_GUST_OUT),
         xabs=np.zeros(N_X), cmd=np.zeros(N_U), y=np.zeros(N_Z),
