@@ -7,10 +7,19 @@ structure (no ``A_aug`` is ever formed, sequential scalar updates, logarithms,
 in-place work arrays); the twins do none of that, so an agreement to round-off
 is evidence that the structure was exploited correctly.
 
-Paper: "Reconfiguration control method for non-redundant actuator faults on UAV"
-(``../shared/seeds/000_6d7db61963b544ed.txt``), sections 2-3 and 5.1.
+Twins here: the filter (predict, residuals, Table 1, reset, update, projection,
+one step), the belief, the excitation signals and saturation, the X8 equations
+and RK4, the controllers and their selection (``controller_command_ref``,
+``horizon_cost_ref``, ``controller_objectives_ref``, ``select_controller_ref``),
+each stage of a trial step (``commands_ref``, ``truth_step_ref``,
+``filter_update_ref``, ``check_validity_ref``, ``handle_resets_ref``,
+``record_step_ref``, ``reconfigure_ref``) and the trial loop chaining them
+(``advance_ref``).
 
-Conventions (DESIGN.md section 3, ``ftc_mc.model.faults``): augmented state
+Paper: "Reconfiguration control method for non-redundant actuator faults on UAV"
+(``docs/paper-map.md`` maps it to the code), sections 2-5.
+
+Conventions (``ftc_mc.model.faults``): augmented state
 ``X = [x (9), b0 (2), b1 (3)]`` with ``b0 = [thrust, elevon sum]`` and
 ``b1 = [thrust, left, right]``; indices of the measured outputs are 0-based, so
 the paper's outputs 3, 7, 8 (q, n_x, n_z) are 2, 6, 7 here.
@@ -55,7 +64,7 @@ class RefModel:
     t_q, t_nx : float
         Thresholds of Table 1.
     variant : str
-        ``"paper"`` or ``"swapped"`` (DESIGN.md section 4).
+        ``"paper"`` or ``"swapped"`` (``docs/paper-map.md``).
     reset_var : ndarray, shape (5,)
         Variances after a reset (section 3.2.2).
     """
@@ -333,7 +342,7 @@ def rotation(angle):
 
 def x8_forces_ref(x, p, wind):
     """Body-axis force ``[X, Z]`` [N] (aerodynamic + thrust), moment ``M`` [N m],
-    ``alpha`` [rad], ``Va`` [m/s] of the X8 (DESIGN.md section 2), air-relative.
+    ``alpha`` [rad], ``Va`` [m/s] of the X8 (``ftc_mc/model/airframe.py``), air-relative.
 
     Lift and drag are formed in wind axes and rotated into body axes by the angle
     of attack: ``[X, Z]_aero = R(alpha) [-D, -L]``.

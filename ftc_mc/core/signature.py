@@ -5,9 +5,9 @@ Table 1 as printed (``swapped = 0``)::
     thrust  : (r_nx >= t_nx and r_q <  t_q) or (r_nx >= t_nx and r_q >= t_q and r_nz >= r_nx)
     elevons : (r_nx <  t_nx and r_q >= t_q) or (r_nx >= t_nx and r_q >= t_q and r_nz <  r_nx)
 
-``swapped = 1`` exchanges the ``r_nz`` comparison of the third clause (DESIGN.md
-section 4: an elevon fault drives ``r_q`` and ``r_nz`` far above ``r_nx``, which
-the printed rule sends to the thrust block).
+``swapped = 1`` exchanges the ``r_nz`` comparison of the third clause (an
+elevon fault drives ``r_q`` and ``r_nz`` far above ``r_nx``, which the printed
+rule sends to the thrust block; see ``docs/paper-map.md``).
 """
 
 from __future__ import annotations
