@@ -33,7 +33,8 @@ import pytest
 
 import naive
 from ftc_mc.campaign.setup import build_setup
-from ftc_mc.conventions import (C_ELEVON, C_ENGINE, C_NOMINAL, I_B1_THRUST, N_AUG,
+from ftc_mc.conventions import (C_ELEVON, C_ENGINE, C_NOMINAL, I_B0_ELEVONS,
+                                I_B0_THRUST, I_B1_LEFT, I_B1_RIGHT, I_B1_THRUST, N_AUG,
                                 N_CONTROLLERS, N_X, RESET_ELEVONS, RESET_THRUST,
                                 STATUS_AIRSPEED, STATUS_ALPHA, STATUS_NONFINITE,
                                 STATUS_NOT_PSD, STATUS_OK)
@@ -209,15 +210,16 @@ def test_controller_command(linear, c):
     for i in range(60):
         X = random_estimate(linear, rng)
         if i == 1:  # both elevons fully ineffective: no allocation possible
-            X[12:] = 1.0
+            X[I_B1_LEFT] = X[I_B1_RIGHT] = 1.0
         if i == 2:  # thrust parameters beyond the grid
-            X[9], X[11] = eng.b0_grid[-1] + 0.3, eng.b1_grid[0] - 0.2
+            X[I_B0_THRUST], X[I_B1_THRUST] = eng.b0_grid[-1] + 0.3, eng.b1_grid[0] - 0.2
         control.controller_command(c, X, ctl.K, eng, u0, U)
         want = naive.controller_command_ref(c, X, ctl.K, eng, u0)
         assert rel(U, want) <= 1e-12, (i, U, want)
         if c == C_ELEVON and i > 2:  # eq. 20: the elevon effect sum is the nominal one
-            eff = (1 - X[12]) * U[1] - X[12] * u0[1] + (1 - X[13]) * U[2] - X[13] * u0[2]
-            assert abs(eff + X[10] + 2 * ctl.K[1, :N_X] @ X[:N_X]) < 1e-12
+            bL, bR = X[I_B1_LEFT], X[I_B1_RIGHT]
+            eff = (1 - bL) * U[1] - bL * u0[1] + (1 - bR) * U[2] - bR * u0[2]
+            assert abs(eff + X[I_B0_ELEVONS] + 2 * ctl.K[1, :N_X] @ X[:N_X]) < 1e-12
 
 
 def selection_case(setup, rng):
