@@ -17,7 +17,8 @@ from collections import namedtuple
 
 import numpy as np
 
-from .core.batch import STEP_ROWS
+from .conventions import N_AUG, N_FAULT, N_X, RESIDUAL_NAMES
+from .core.batch import step_rows
 
 ALIGN = 64
 """Byte alignment of the arrays made here (one cache line, one AVX-512 vector)."""
@@ -46,17 +47,17 @@ def lane_zeros(shape, dtype=np.float64) -> np.ndarray:
 
 
 LaneWorkspace = namedtuple("LaneWorkspace", [
-    "phi",    # (9, 5, L)          Phi(u) of each lane (predict)
-    "T",      # (9, 14, L)         [A Phi] P (predict)
-    "work",   # (STEP_ROWS, 14, L) P_{k+1|k}, the update's gains, x_{k|k}
-    "res",    # (3, L)             [r_q, r_nx, r_nz] (eqs. 9-11)
-    "block",  # (L,) int64         block reset this step (Table 1)
+    "phi",    # (9, 5, L)             Phi(u) of each lane (predict)
+    "T",      # (9, n, L)             [A Phi] P (predict)
+    "work",   # (step_rows(n), n, L)  P_{k+1|k}, the update's gains, x_{k|k}
+    "res",    # (3, L)                [r_q, r_nx, r_nz] (eqs. 9-11)
+    "block",  # (L,) int64            block reset this step (Table 1)
 ])
 """Arrays for :func:`ftc_mc.core.batch.filter_step_lanes`, in its argument order:
 ``filter_step_lanes(xa, P, u, z, fm, det, ws.phi, ws.T, ws.work, ws.res, ws.block)``."""
 
 
-def new_lane_workspace(L: int) -> LaneWorkspace:
+def new_lane_workspace(L: int, n_aug: int = N_AUG) -> LaneWorkspace:
     """Zeroed, 64-byte aligned work arrays for ``L`` lanes.
 
     Parameters
@@ -64,12 +65,14 @@ def new_lane_workspace(L: int) -> LaneWorkspace:
     L : int
         Number of lanes (trajectories advanced together), >= 1; a multiple of 8
         keeps every lane row aligned (64 to 192 lanes run fastest).
+    n_aug : int, optional
+        Augmented dimension of the filter (default the paper's 14).
 
     Returns
     -------
     LaneWorkspace
-        ``phi`` (9, 5, L), ``T`` (9, 14, L), ``work`` (STEP_ROWS, 14, L),
-        ``res`` (3, L) float64 and ``block`` (L,) int64.  ``work[14:27]``
+        ``phi`` (9, 5, L), ``T`` (9, n, L), ``work`` (step_rows(n), n, L),
+        ``res`` (3, L) float64 and ``block`` (L,) int64.  ``work[n:n + 13]``
         can serve as the work array ``h`` of
         :func:`~ftc_mc.core.batch.update_lanes`.
 
@@ -81,6 +84,8 @@ def new_lane_workspace(L: int) -> LaneWorkspace:
     if isinstance(L, bool) or not isinstance(L, (int, np.integer)) or L < 1:
         raise ValueError(f"lane count 'L' must be an integer >= 1, got {L!r}")
     L = int(L)
-    return LaneWorkspace(phi=lane_zeros((9, 5, L)), T=lane_zeros((9, 14, L)),
-                         work=lane_zeros((STEP_ROWS, 14, L)), res=lane_zeros((3, L)),
+    n = int(n_aug)
+    return LaneWorkspace(phi=lane_zeros((N_X, N_FAULT, L)), T=lane_zeros((N_X, n, L)),
+                         work=lane_zeros((step_rows.py_func(n), n, L)),
+                         res=lane_zeros((len(RESIDUAL_NAMES), L)),
                          block=lane_zeros(L, dtype=np.int64))

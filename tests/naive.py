@@ -7,10 +7,19 @@ structure (no ``A_aug`` is ever formed, sequential scalar updates, logarithms,
 in-place work arrays); the twins do none of that, so an agreement to round-off
 is evidence that the structure was exploited correctly.
 
-Paper: "Reconfiguration control method for non-redundant actuator faults on UAV"
-(``../shared/seeds/000_6d7db61963b544ed.txt``), sections 2-3 and 5.1.
+Twins here: the filter (predict, residuals, Table 1, reset, update, projection,
+one step), the belief, the excitation signals and saturation, the X8 equations
+and RK4, the controllers and their selection (``controller_command_ref``,
+``horizon_cost_ref``, ``controller_objectives_ref``, ``select_controller_ref``),
+each stage of a trial step (``commands_ref``, ``truth_step_ref``,
+``filter_update_ref``, ``check_validity_ref``, ``handle_resets_ref``,
+``record_step_ref``, ``reconfigure_ref``) and the trial loop chaining them
+(``advance_ref``).
 
-Conventions (docs/paper-map.md, ``ftc_mc.model.faults``): augmented state
+Paper: "Reconfiguration control method for non-redundant actuator faults on UAV"
+(``docs/paper-map.md`` maps it to the code), sections 2-5.
+
+Conventions (``ftc_mc.model.faults``): augmented state
 ``X = [x (9), b0 (2), b1 (3)]`` with ``b0 = [thrust, elevon sum]`` and
 ``b1 = [thrust, left, right]``; indices of the measured outputs are 0-based, so
 the paper's outputs 3, 7, 8 (q, n_x, n_z) are 2, 6, 7 here.
@@ -30,6 +39,7 @@ NO_RESET, RESET_THRUST, RESET_ELEVONS = 0, 1, 2
 N_X = 9
 N_AUG = 14
 OUT_Q, OUT_NX, OUT_NZ = 2, 6, 7  # paper's mu_3, mu_7, mu_8 (eqs. 9-11)
+OUT_ALPHA, OUT_VA = 8, 11
 
 # fault-parameter indices in the augmented state
 B0_T, B0_E, B1_T, B1_L, B1_R = 9, 10, 11, 12, 13
@@ -54,7 +64,7 @@ class RefModel:
     t_q, t_nx : float
         Thresholds of Table 1.
     variant : str
-        ``"paper"`` or ``"swapped"`` (docs/paper-map.md).
+        ``"paper"`` or ``"swapped"`` (``docs/paper-map.md``).
     reset_var : ndarray, shape (5,)
         Variances after a reset (section 3.2.2).
     """
@@ -105,7 +115,7 @@ def ref_model(plant, settings):
     """Reference model built from the plant and ``EstimatorSettings`` directly.
 
     Uses the settings' scalars only, never the kernels' namedtuples, so the
-    builders of :mod:`ftc_mc.estimator` are checked too.
+    builders of :mod:`ftc_mc.sim.estimator` are checked too.
     """
     lo, hi = fault_bounds_ref(plant.u_lower, plant.u_upper)
     return RefModel(
@@ -266,6 +276,38 @@ def belief_update_ref(belief, TM, lo, hi, bhat, var):
     return post, int(np.argmax(post))
 
 
+def log_normal_interval_ref(a, b):
+    """``log(Phi(b) - Phi(a))`` for ``a <= b`` in log space: both bounds moved
+    to the left tail by symmetry, then ``log Phi(b) + log1p(-Phi(a)/Phi(b))``
+    with scipy's ``log_ndtr``; an interval across zero directly."""
+    from scipy.special import log_ndtr, ndtr
+
+    if a > 0:
+        a, b = -b, -a
+    if b <= 0:
+        la, lb = log_ndtr(a), log_ndtr(b)
+        return lb + np.log1p(-np.exp(la - lb))
+    return np.log(ndtr(b) - ndtr(a))
+
+
+def belief_update_log_ref(belief, TM, lo, hi, bhat, var):
+    """Eqs. (12)-(14) as :func:`belief_update_ref`, in log space (the likelihoods
+    of all four modes can underflow when the estimate is far from every box):
+    ``log p(omega|m) = sum_j log(Phi(..) - Phi(..)) - log(hi - lo)``, posterior by
+    log-sum-exp."""
+    from scipy.special import logsumexp
+
+    s = np.sqrt(var)
+    loglik = np.array([sum(log_normal_interval_ref((lo[m, j] - bhat[j]) / s[j],
+                                                   (hi[m, j] - bhat[j]) / s[j])
+                           - np.log(hi[m, j] - lo[m, j]) for j in range(len(bhat)))
+                       for m in range(lo.shape[0])])
+    with np.errstate(divide="ignore"):
+        logpost = np.log(TM @ belief) + loglik
+    post = np.exp(logpost - logsumexp(logpost))
+    return post, int(np.argmax(post))
+
+
 # -------------------------------------------------------------- excitation
 def doublet_ref(k, half_steps, amplitude):
     """Doublet of Fig. 4: two alternating steps ``+A`` then ``-A``."""
@@ -283,3 +325,406 @@ def signal_3211_ref(k, unit_steps, amplitude):
 def saturate_ref(U, s, A, lo, hi):
     """Eq. (15): clip ``U`` to ``[lo + A, hi - A]``, add ``s``, clip to ``[lo, hi]``."""
     return float(np.clip(np.clip(U, lo + A, hi - A) + s, lo, hi))
+
+
+# ------------------------------------------------------------- X8 nonlinear
+X8_PARAMS = ("mass", "Jy", "S", "c", "rho", "g", "CL0", "CLa", "CLq", "CLde", "CD0",
+             "CDa", "CDa2", "CDde2", "Cm0", "Cma", "Cmq", "Cmde", "S_prop", "k_motor",
+             "C_prop", "tau_thrust", "tau_elevon", "V0", "gamma0")
+"""Names of the packed parameter vector, in ``model.dynamics.pack_parameters``'s order."""
+
+
+def rotation(angle):
+    """2-D rotation by ``angle`` [rad]: ``[[cos, -sin], [sin, cos]]``."""
+    c, s = np.cos(angle), np.sin(angle)
+    return np.array([[c, -s], [s, c]])
+
+
+def x8_forces_ref(x, p, wind):
+    """Body-axis force ``[X, Z]`` [N] (aerodynamic + thrust), moment ``M`` [N m],
+    ``alpha`` [rad], ``Va`` [m/s] of the X8 (``ftc_mc/model/airframe.py``), air-relative.
+
+    Lift and drag are formed in wind axes and rotated into body axes by the angle
+    of attack: ``[X, Z]_aero = R(alpha) [-D, -L]``.
+    """
+    a = dict(zip(X8_PARAMS, p))
+    v_air = np.asarray(x[:2]) - np.asarray(wind[:2])
+    q_air = x[2] - wind[2]
+    Va = float(np.hypot(v_air[0], v_air[1]))
+    alpha = float(np.arctan2(v_air[1], v_air[0]))
+    de = np.mean(x[7:9])
+    qhat = a["c"] * q_air / (2.0 * Va)
+    CL = a["CL0"] + a["CLa"] * alpha + a["CLq"] * qhat + a["CLde"] * de
+    CD = np.polyval([a["CDa2"], a["CDa"], a["CD0"]], alpha) + a["CDde2"] * de ** 2
+    Cm = a["Cm0"] + a["Cma"] * alpha + a["Cmq"] * qhat + a["Cmde"] * de
+    qbar = 0.5 * a["rho"] * Va ** 2
+    lift, drag = qbar * a["S"] * CL, qbar * a["S"] * CD
+    Vd = Va + x[6] * (a["k_motor"] - Va)  # propeller discharge speed
+    thrust = 0.5 * a["rho"] * a["S_prop"] * a["C_prop"] * Vd * (Vd - Va)
+    F = rotation(alpha) @ np.array([-drag, -lift]) + np.array([thrust, 0.0])
+    return F, qbar * a["S"] * a["c"] * Cm, alpha, Va
+
+
+def x8_derivatives_ref(x, cmd, p, wind):
+    """``dx/dt`` of the X8 (9 states): body-axis Newton-Euler with the Coriolis
+    term ``q x [u, w]``, gravity rotated into body axes, the position error of the
+    glide-path reference point and three first-order actuators."""
+    a = dict(zip(X8_PARAMS, p))
+    x = np.asarray(x, dtype=float)
+    F, M, _, _ = x8_forces_ref(x, p, wind)
+    vel = x[:2]
+    q, theta = x[2], x[5]
+    gravity = a["g"] * np.array([-np.sin(theta), np.cos(theta)])
+    coriolis = q * np.array([-vel[1], vel[0]])
+    accel = F / a["mass"] + gravity + coriolis
+    # body -> (forward, down) earth axes: rotation by -theta
+    pos_rate = rotation(-theta) @ vel - a["V0"] * np.array([np.cos(a["gamma0"]),
+                                                            -np.sin(a["gamma0"])])
+    tau = np.array([a["tau_thrust"], a["tau_elevon"], a["tau_elevon"]])
+    act = (np.asarray(cmd) - x[6:9]) / tau
+    return np.concatenate([accel, [M / a["Jy"]], pos_rate, [q], act])
+
+
+def x8_outputs_ref(x, p, wind):
+    """The 12 outputs: the first six states, specific forces over ``g``
+    (``n_z`` up), ``alpha``, ``gamma = theta - alpha``, ``CAS = Va`` (sea level)
+    and ``Va``."""
+    a = dict(zip(X8_PARAMS, p))
+    F, _, alpha, Va = x8_forces_ref(x, p, wind)
+    mg = a["mass"] * a["g"]
+    return np.concatenate([x[:6], [F[0] / mg, -F[1] / mg, alpha, x[5] - alpha, Va, Va]])
+
+
+def rk4_ref(x, cmd, p, wind, dt, n_sub):
+    """``n_sub`` classical RK4 steps over ``dt`` with commands and wind held."""
+    def f(s):
+        return x8_derivatives_ref(s, cmd, p, wind)
+
+    h = dt / n_sub
+    x = np.array(x, dtype=float)
+    for _ in range(n_sub):
+        k1 = f(x)
+        k2 = f(x + h / 2 * k1)
+        k3 = f(x + h / 2 * k2)
+        k4 = f(x + h * k3)
+        x = x + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+    return x
+
+
+# ----------------------------------------------------------------- control
+# Controllers of section 4.1 and the selection of section 4.2; the commands are
+# deviations from trim [throttle, rad, rad].
+C0, C1, C2 = 0, 1, 2  # nominal, engine fault, elevon fault
+
+
+def engine_gain_ref(tables, b0, b1):
+    """Theorem 4.1's ``K(b0, b1)`` (3, 9) and ``k(b0, b1)`` (3,), bilinear in the
+    offline tables (scipy's ``RegularGridInterpolator``), the coordinates clamped
+    to the grid (section 4.1.5)."""
+    from scipy.interpolate import RegularGridInterpolator
+
+    g0, g1 = tables.b0_grid, tables.b1_grid
+    point = [[np.clip(b0, g0[0], g0[-1]), np.clip(b1, g1[0], g1[-1])]]
+    K = RegularGridInterpolator((g0, g1), tables.K)(point)[0]
+    k = RegularGridInterpolator((g0, g1), tables.k)(point)[0]
+    return K, k
+
+
+def controller_command_ref(c, X, K, tables, u0):
+    """Command of controller ``c`` from the augmented estimate ``X`` (no saturation).
+
+    c0: ``-K x`` (eq. 19).  c1: ``-K(b0_T, b1_T) x - k(b0_T, b1_T)`` (eq. 44).
+    c2: thrust ``-K_1 x``; elevons the minimum-norm ``U`` with
+    ``Phi(U) = 2 K_2 x + b0_e - b1_L u0_L - b1_R u0_R + a . U = 0``,
+    ``a = (1 - b1_L, 1 - b1_R)`` (eqs. 20-24), by the pseudo-inverse.
+    """
+    x = np.asarray(X[:N_X])
+    if c == C1:
+        Kc, kc = engine_gain_ref(tables, X[B0_T], X[B1_T])
+        return -Kc @ x - kc
+    U = -K @ x
+    if c == C2:
+        a = np.array([[1.0 - X[B1_L], 1.0 - X[B1_R]]])
+        rhs = 2.0 * (K[1] @ x) + X[B0_E] - X[B1_L] * u0[1] - X[B1_R] * u0[2]
+        U[1:] = (np.linalg.pinv(a) @ np.array([-rhs]))
+    return U
+
+
+def ref_of(scheme):
+    """A :class:`RefModel` holding the arrays of ``scheme.filter`` and
+    ``scheme.detection`` (the builders are checked in test_core_vs_naive)."""
+    fm, det = scheme.filter, scheme.detection
+    return RefModel(A=fm.A, B=fm.B, C=fm.C, u0=fm.u0, q=fm.q_diag, r=fm.r_diag, lo=fm.lo,
+                    hi=fm.hi, t_q=det.t_q, t_nx=det.t_nx,
+                    variant="swapped" if det.swapped else "paper", reset_var=det.reset_var)
+
+
+def horizon_cost_ref(c, X, P, scheme):
+    """Eq. (45): ``I(c) = sum_{k'=1..H} alpha^k' (x' Q_lqr x + u' R_lqr u)`` along
+    the prediction with controller ``c`` in the loop: saturated command (eq. 16),
+    prediction (eq. 5), update with the predicted measurement (zero
+    innovation), projection (eq. 8).  Returns ``I, X_{k+H}, P_{k+H|k+H}``."""
+    model = ref_of(scheme)
+    ctl, rc = scheme.controller, scheme.reconfig
+    _, _, C_aug = aug(model, np.zeros(3))
+    cost = 0.0
+    for step in range(1, rc.horizon + 1):
+        U = controller_command_ref(c, X, ctl.K, scheme.engine, model.u0)
+        U = np.clip(U, ctl.lo_dev, ctl.hi_dev)
+        X, P = predict_ref(X, P, U, model)
+        X, P = update_ref(X, P, C_aug @ X, model)
+        X, _ = project_ref(X, model.lo, model.hi)
+        x = X[:N_X]
+        cost += rc.alpha ** step * (x @ np.diag(rc.q_lqr) @ x + U @ np.diag(rc.r_lqr) @ U)
+    return cost, X, P
+
+
+def controller_objectives_ref(current, X, P, belief, scheme):
+    """Eq. (47) for each controller ``a``: ``I(a) + sum_m b_{k+H}(m) (J^N(m, a) +
+    P(c, a))`` with the belief updated on the predicted fault parameters."""
+    bs, rc = scheme.belief, scheme.reconfig
+    obj = np.zeros(3)
+    for a in range(3):
+        cost, Xh, Ph = horizon_cost_ref(a, X, P, scheme)
+        b, _ = belief_update_log_ref(belief, bs.TM, bs.lo, bs.hi, Xh[N_X:],
+                                     np.diag(Ph)[N_X:])
+        obj[a] = cost + b @ (rc.JN[:, a] + rc.penalty[current, a])
+    return obj
+
+
+def select_controller_ref(current, X, P, belief, scheme):
+    """The controller with the smallest objective (eq. 47); ``current`` if none is
+    finite.  Returns the controller and the objectives."""
+    obj = controller_objectives_ref(current, X, P, belief, scheme)
+    if not np.any(np.isfinite(obj)):
+        return current, obj
+    return int(np.nanargmin(obj)), obj
+
+
+# ------------------------------------------------------------ trial stages
+# Twins of the stage kernels of ftc_mc.core.stages and ftc_mc.core.plant, on
+# copies: each takes the lane state and returns what the stage writes.  Lane l
+# of every array is one trial (lane index last).
+NO_SIGNAL = -(1 << 40)
+STATUS = {"ok": 0, "nonfinite": 1, "not_psd": 2, "airspeed": 3, "alpha": 4}
+
+
+def running_ref(k, start, length):
+    return start <= k < start + length
+
+
+def commands_ref(scheme, st, k):
+    """Commands ``u_k`` (3, L) and the excitation record (4, L): doublet value,
+    3211 value, 1.0 where each starts at ``k`` (eqs. 15-25, 44)."""
+    ctl, exc, fm = scheme.controller, scheme.excitation, scheme.filter
+    L = st.xa.shape[1]
+    u = np.zeros((3, L))
+    out = np.zeros((4, L))
+    d_len, s_len = 2 * exc.doublet_half, 7 * exc.s3211_unit
+    for l in range(L):
+        X = st.xa[:, l]
+        if scheme.reconfig.kind == 0:
+            U = -ctl.K @ X[:N_X]
+        else:
+            U = controller_command_ref(int(st.cur[l]), X, ctl.K, scheme.engine, fm.u0)
+        sd, A_d = 0.0, 0.0
+        if running_ref(k, st.d_start[l], d_len):
+            sd = doublet_ref(k - st.d_start[l], exc.doublet_half, exc.doublet_amp)
+            A_d = exc.doublet_amp
+        s, A_s = 0.0, 0.0
+        if running_ref(k, st.s_start[l], s_len):
+            s = signal_3211_ref(k - st.s_start[l], exc.s3211_unit, exc.s3211_amp)
+            if st.cur[l] == C2:  # eq. 23
+                s = (1.0 - X[B1_L]) * s
+            A_s = exc.s3211_amp
+        sig, amp = (sd, s, -s), (A_d, A_s, A_s)
+        for i in range(3):
+            u[i, l] = saturate_ref(U[i], sig[i], amp[i], ctl.lo_dev[i], ctl.hi_dev[i])
+        out[:, l] = [sd, s, float(k == st.d_start[l]), float(k == st.s_start[l])]
+    return u, out
+
+
+def truth_step_ref(scheme, flight, inp, k, st, u):
+    """The truth over step ``k``: effect (eq. 2), Dryden gust, linear (eq. 1) or
+    nonlinear (RK4) plant, measurement and air data.  Returns a dict with ``x``,
+    ``gust``, ``e``, ``wind``, ``wind_next``, ``z``, ``va``, ``alpha``."""
+    from ftc_mc.model.faults import effect
+
+    fm, pl, val = scheme.filter, flight.plant, flight.validity
+    L = st.x.shape[1]
+    ev = int(np.searchsorted(inp.k_switch, k, side="right")) - 1
+    e = np.column_stack([effect(u[:, l], fm.u0, inp.b0[ev][:, l], inp.b1[ev][:, l])
+                         for l in range(L)])
+    gust = st.gust.copy()
+    wind = np.zeros((3, L))
+    wind_next = np.zeros((3, L))
+    if pl.turb:
+        wind = pl.Cd @ st.gust
+        gust = pl.Ad @ st.gust + pl.Bd @ inp.eta[k]
+        wind_next = pl.Cd @ gust
+    if pl.kind == 0:
+        x = fm.A @ st.x + fm.B @ e + pl.Bw @ wind + inp.w[k]
+        z = fm.C @ x + pl.Dw @ wind_next + inp.v[k]
+        va = val.va_trim + fm.C[OUT_VA] @ x + pl.Dw[OUT_VA] @ wind_next
+        alpha = val.alpha_trim + fm.C[OUT_ALPHA] @ x + pl.Dw[OUT_ALPHA] @ wind_next
+    else:
+        x = np.zeros_like(st.x)
+        z = np.zeros((12, L))
+        va, alpha = np.zeros(L), np.zeros(L)
+        for l in range(L):
+            xabs = rk4_ref(pl.x0 + st.x[:, l], fm.u0 + e[:, l], pl.p, wind[:, l], pl.dt,
+                           pl.n_sub) + inp.w[k][:, l]
+            x[:, l] = xabs - pl.x0
+            y = x8_outputs_ref(xabs, pl.p, wind_next[:, l])
+            z[:, l] = y - pl.y0 + inp.v[k][:, l]
+            va[l], alpha[l] = y[OUT_VA], y[OUT_ALPHA]
+    return dict(x=x, gust=gust, e=e, wind=wind, wind_next=wind_next, z=z, va=va,
+                alpha=alpha)
+
+
+def filter_update_ref(scheme, st, u, z):
+    """Every lane's filter step (:func:`filter_step_ref`) and the running maxima
+    of ``r_q``, ``r_nx``.  Returns ``xa, P, res, block, rmax``."""
+    model = ref_of(scheme)
+    L = st.xa.shape[1]
+    xa, P = st.xa.copy(), st.P.copy()
+    res, block = np.zeros((3, L)), np.zeros(L, dtype=np.int64)
+    for l in range(L):
+        xa[:, l], P[:, :, l], block[l], res[:, l] = filter_step_ref(
+            st.xa[:, l], st.P[:, :, l], u[:, l], z[:, l], model)
+    rmax = np.maximum(st.rmax, res[:2])
+    return xa, P, res, block, rmax
+
+
+def positive_definite_ref(P):
+    """``P + 1e-12 max|diag| I`` has only positive eigenvalues (finite ``P``)."""
+    M = P + 1e-12 * np.max(np.abs(np.diag(P))) * np.eye(P.shape[0])
+    return bool(np.all(np.isfinite(M)) and np.linalg.eigvalsh(M).min() > 0.0)
+
+
+def check_validity_ref(validity, st, kn, va, alpha, status, stop_k):
+    """Which live lanes stop, and why (precedence: not finite, covariance not
+    positive definite on a check step, airspeed, angle of attack).  Returns
+    ``alive, status, stop_k``."""
+    alive, status, stop_k = st.alive.copy(), status.copy(), stop_k.copy()
+    for l in np.flatnonzero(st.alive):
+        P = st.P[:, :, l]
+        if not (np.all(np.isfinite(st.xa[:, l])) and np.all(np.isfinite(np.diag(P)))
+                and np.isfinite(va[l]) and np.isfinite(alpha[l])):
+            why = "nonfinite"
+        elif kn % validity.psd_every == 0 and not positive_definite_ref(P):
+            why = "not_psd"
+        elif not validity.va_min <= va[l] <= validity.va_max:
+            why = "airspeed"
+        elif not validity.alpha_min <= alpha[l] <= validity.alpha_max:
+            why = "alpha"
+        else:
+            continue
+        alive[l], status[l], stop_k[l] = False, STATUS[why], kn
+    return alive, status, stop_k
+
+
+def handle_resets_ref(exc, st, kn, block, res, reset_k, reset_block, reset_res, n_resets):
+    """Reset records and excitation requests (sections 3.2.3, 4.1.1).  Returns a
+    dict of the updated ``d_start``, ``s_start``, ``recheck`` and record arrays."""
+    out = dict(d_start=st.d_start.copy(), s_start=st.s_start.copy(),
+               recheck=st.recheck.copy(), reset_k=reset_k.copy(),
+               reset_block=reset_block.copy(), reset_res=reset_res.copy(),
+               n_resets=n_resets.copy())
+    d_len, s_len = 2 * exc.doublet_half, 7 * exc.s3211_unit
+    for l in range(st.xa.shape[1]):
+        if st.alive[l] and block[l] in (RESET_THRUST, RESET_ELEVONS):
+            m = out["n_resets"][l]
+            if m < reset_k.shape[0]:
+                out["reset_k"][m, l] = kn
+                out["reset_block"][m, l] = block[l]
+                out["reset_res"][m, :, l] = res[:, l]
+            out["n_resets"][l] = m + 1
+            if block[l] == RESET_THRUST:
+                if not running_ref(kn, out["d_start"][l], d_len):
+                    out["d_start"][l] = kn
+                out["recheck"][l] = kn + exc.resend_delay
+            elif not running_ref(kn, out["s_start"][l], s_len):
+                out["s_start"][l] = kn
+        if out["recheck"][l] == kn:
+            out["recheck"][l] = -1
+            if st.xa[B1_T, l] > exc.resend_b1 and not running_ref(kn, out["d_start"][l],
+                                                                  d_len):
+                out["d_start"][l] = kn
+    return out
+
+
+def record_step_ref(k, st, u, res, exc, wind, block, hist):
+    """The history row ``k`` (only while ``k`` is below the history length)."""
+    hist = {f: v.copy() for f, v in hist.items()}
+    if k < hist["hist_x"].shape[0]:
+        hist["hist_x"][k] = st.x
+        hist["hist_xa"][k] = st.xa
+        hist["hist_pdiag"][k] = np.diagonal(st.P)[:, N_X:].T
+        hist["hist_u"][k] = u
+        hist["hist_res"][k] = res
+        hist["hist_exc"][k] = exc
+        hist["hist_wind"][k] = wind
+        hist["hist_block"][k] = block
+    return hist
+
+
+def reconfigure_ref(scheme, timing, inp, st, kn, period, rec):
+    """Belief update (eqs. 12-14), controller selection (eqs. 45-47) when
+    reconfiguring, detection time.  Returns a dict of the new ``belief``,
+    ``cur`` and the written record arrays."""
+    bs = scheme.belief
+    out = dict(belief=st.belief.copy(), cur=st.cur.copy(), rec_belief=rec.belief.copy(),
+               rec_bhat=rec.bhat.copy(), controller=rec.controller.copy(),
+               detect_k=rec.detect_k.copy())
+    for l in range(st.xa.shape[1]):
+        X, P = st.xa[:, l], st.P[:, :, l]
+        b, best = belief_update_log_ref(st.belief[:, l], bs.TM, bs.lo, bs.hi, X[N_X:],
+                                        np.diag(P)[N_X:])
+        out["belief"][:, l] = out["rec_belief"][period, :, l] = b
+        out["rec_bhat"][period, :, l] = X[N_X:]
+        if scheme.reconfig.kind != 0:
+            out["cur"][l], _ = select_controller_ref(int(st.cur[l]), X, P, b, scheme)
+        out["controller"][period, l] = out["cur"][l]
+        mp = inp.mode_post[l]
+        if (st.alive[l] and kn > timing.k_fault and out["detect_k"][l] < 0 and best == mp
+                and b[mp] >= timing.detect_prob):
+            out["detect_k"][l] = kn
+    return out
+
+
+def advance_ref(scheme, flight, inp, rec, st, k0, k1):
+    """The trial loop from step ``k0`` to ``k1`` chaining the stage twins; ``rec``
+    and ``st`` are namedtuples of arrays, returned as updated copies."""
+    st = type(st)(*(np.array(a, copy=True) for a in st))
+    rec = type(rec)(*(np.array(a, copy=True) for a in rec))
+    every = flight.timing.reconf_every
+    for k in range(k0, k1):
+        kn = k + 1
+        u, exc = commands_ref(scheme, st, k)
+        tr = truth_step_ref(scheme, flight, inp, k, st, u)
+        st.x[:], st.gust[:] = tr["x"], tr["gust"]
+        xa, P, res, block, rmax = filter_update_ref(scheme, st, u, tr["z"])
+        st.xa[:], st.P[:], st.rmax[:] = xa, P, rmax
+        alive, status, stop_k = check_validity_ref(flight.validity, st, kn, tr["va"],
+                                                   tr["alpha"], rec.status, rec.stop_k)
+        st.alive[:], rec.status[:], rec.stop_k[:] = alive, status, stop_k
+        out = handle_resets_ref(scheme.excitation, st, kn, block, res, rec.reset_k,
+                                rec.reset_block, rec.reset_res, rec.n_resets)
+        st.d_start[:], st.s_start[:], st.recheck[:] = (out["d_start"], out["s_start"],
+                                                       out["recheck"])
+        for f in ("reset_k", "reset_block", "reset_res", "n_resets"):
+            getattr(rec, f)[:] = out[f]
+        hist = record_step_ref(k, st, u, res, exc, tr["wind"], block,
+                               {f: getattr(rec, f) for f in rec._fields
+                                if f.startswith("hist_")})
+        for f, v in hist.items():
+            getattr(rec, f)[:] = v
+        if kn % every == 0:
+            period = kn // every - 1
+            out = reconfigure_ref(scheme, flight.timing, inp, st, kn, period, rec)
+            st.belief[:], st.cur[:] = out["belief"], out["cur"]
+            rec.belief[:], rec.bhat[:] = out["rec_belief"], out["rec_bhat"]
+            rec.controller[:], rec.detect_k[:] = out["controller"], out["detect_k"]
+    rec.xa_end[:] = st.xa
+    return rec, st

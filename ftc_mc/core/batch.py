@@ -3,9 +3,11 @@
 Each kernel here is the lane-wise twin of a single-trajectory kernel of
 :mod:`ftc_mc.core.kalman`, :mod:`ftc_mc.core.signature` and
 :mod:`ftc_mc.core.step`: lane ``l`` of every array is one trajectory, stored with
-the lane index *last* (``xa[14, L]``, ``P[14, 14, L]``, ``u[3, L]``, ``z[12, L]``)
+the lane index *last* (``xa[n, L]``, ``P[n, n, L]``, ``u[3, L]``, ``z[12, L]``;
+``n = 14`` for the paper's filter, taken from the arrays' shapes)
 so that the innermost loops run over lanes and compile to 512-bit vector code
-(PERFORMANCE.md, lesson 2).  ``L`` is a run-time shape.
+(2.3x the best per-trajectory layout when measured; ``scripts/bench_core.py``).
+``L`` is a run-time shape.
 
 Every lane is computed with the same floating-point operations, in the same
 order, as the single-trajectory kernel, so a lane agrees with
@@ -43,18 +45,33 @@ so no kernel allocates.
 from __future__ import annotations
 
 from .jit import kernel
+from .signature import NO_RESET, in_block, signature
 
-from ..conventions import N_AUG, N_X, N_Z, OUT_NX, OUT_NZ, OUT_Q  # noqa: F401
+from ..conventions import N_AUG, N_B0, N_B1, N_U, N_X, RESIDUAL_OUTPUTS
 from ..conventions import N_FAULT as N_F
+
+# Lane-invariant rows are read into tuples of a fixed length (_row_x, _row_b0,
+# _row_b, _neg_row_b): a tuple's length must be written out, so these helpers are the
+# one place that spells the plant's dimensions, checked here.
+assert (N_X, N_B0, N_B1, N_U) == (9, 2, 3, 3), "update the _row_* helpers"
 
 GROUP = 6
 """Unit rows of ``C`` updated per pass (longer runs are split, shorter padded)."""
 
 UPDATE_ROWS = 2 * GROUP + 1
-"""First dimension of the update's work array ``h[UPDATE_ROWS, 14, L]``."""
+"""First dimension of the update's work array ``h[UPDATE_ROWS, n, L]``."""
 
-STEP_ROWS = N_AUG + UPDATE_ROWS + 1
-"""First dimension of the step's work array ``work[STEP_ROWS, 14, L]``."""
+
+@kernel
+def step_rows(n_aug):
+    """First dimension of :func:`filter_step_lanes`' work array
+    ``work[step_rows(n), n, L]``: the prediction (``n`` rows), the update's
+    gains (``UPDATE_ROWS``) and ``x_{k|k}`` (one row)."""
+    return n_aug + UPDATE_ROWS + 1
+
+
+STEP_ROWS = step_rows.py_func(N_AUG)
+"""``step_rows`` of the paper's filter (``N_AUG = 14`` states)."""
 
 SERIAL_REPREDICT = 8
 """Up to this many reset lanes are re-predicted one run of lanes at a time;
@@ -63,29 +80,36 @@ more re-predict every lane (identical results for the lanes without a reset)."""
 
 # ------------------------------------------------------------------ helpers
 @kernel
-def _row9(M, i):
-    """Row ``i`` of a ``(n, 9)`` matrix as a tuple (lane-invariant coefficients)."""
+def _row_x(M, i):
+    """Row ``i`` of a ``(m, N_X)`` matrix as a tuple (lane-invariant coefficients)."""
     return (M[i, 0], M[i, 1], M[i, 2], M[i, 3], M[i, 4], M[i, 5], M[i, 6], M[i, 7],
             M[i, 8])
 
 
 @kernel
-def _row2(M, i):
-    """Row ``i`` of a ``(n, 2)`` matrix as a tuple."""
+def _row_b0(M, i):
+    """Row ``i`` of a ``(m, N_B0)`` matrix as a tuple (``B_b0``, eq. 4)."""
     return (M[i, 0], M[i, 1])
 
 
 @kernel
-def _neg_row3(M, i):
-    """Negated row ``i`` of a ``(n, 3)`` matrix as a tuple (``-B_i``, eq. 4)."""
+def _row_b(M, i):
+    """Row ``i`` of a ``(m, N_U)`` matrix as a tuple (``B_i``, eq. 1)."""
+    return (M[i, 0], M[i, 1], M[i, 2])
+
+
+@kernel
+def _neg_row_b(M, i):
+    """Negated row ``i`` of a ``(m, N_U)`` matrix as a tuple (``-B_i``, eq. 4)."""
     return (-M[i, 0], -M[i, 1], -M[i, 2])
 
 
 @kernel
 def _mirror(P, l0, l1):
     """Copy the upper triangle of ``P[:, :, l0:l1]`` onto the lower one."""
-    for i in range(N_AUG):
-        for k in range(i + 1, N_AUG):
+    n = P.shape[0]
+    for i in range(n):
+        for k in range(i + 1, n):
             for l in range(l0, l1):
                 P[k, i, l] = P[i, k, l]
 
@@ -102,11 +126,12 @@ def _mirror_x(P, l0, l1):
 @kernel
 def _symmetric_copy(P, Pout, L):
     """``Pout <- P`` from the upper triangle of ``P`` (both triangles written)."""
-    for i in range(N_AUG):
-        for k in range(i, N_AUG):
+    n = P.shape[0]
+    for i in range(n):
+        for k in range(i, n):
             for l in range(L):
                 Pout[i, k, l] = P[i, k, l]
-        for k in range(i + 1, N_AUG):
+        for k in range(i + 1, n):
             for l in range(L):
                 Pout[k, i, l] = P[i, k, l]
 
@@ -120,28 +145,30 @@ def _predict(xa, P, Pn, u, fm, phi, T, l0, l1):
     is advanced in place.  Operation order per lane as in
     :func:`ftc_mc.core.kalman.predict`.
     """
+    n = P.shape[0]
     u00 = fm.u0[0]
     u01 = fm.u0[1]
     u02 = fm.u0[2]
-    # Phi(u) (eqs. 4-5), kept for the caller; the products below recompute it
+    # Phi(u) = [B_b0, B diag(-u - u0)] (eqs. 4-5), kept for the caller; the
+    # products below recompute it
     for i in range(N_X):
-        bb = _row2(fm.Bb0, i)
-        nb = _neg_row3(fm.B, i)
+        bb = _row_b0(fm.Bb0, i)
+        nb = _neg_row_b(fm.B, i)
         for l in range(l0, l1):
             phi[i, 0, l] = bb[0]
             phi[i, 1, l] = bb[1]
-            phi[i, 2, l] = nb[0] * (u[0, l] + u00)
-            phi[i, 3, l] = nb[1] * (u[1, l] + u01)
-            phi[i, 4, l] = nb[2] * (u[2, l] + u02)
+            phi[i, N_B0, l] = nb[0] * (u[0, l] + u00)
+            phi[i, N_B0 + 1, l] = nb[1] * (u[1, l] + u01)
+            phi[i, N_B0 + 2, l] = nb[2] * (u[2, l] + u02)
     # state: x <- A x + B u + Phi b ; b unchanged (random walk, eq. 3)
     for i in range(N_X):
-        a = _row9(fm.A, i)
-        b = (fm.B[i, 0], fm.B[i, 1], fm.B[i, 2])
+        a = _row_x(fm.A, i)
+        b = _row_b(fm.B, i)
         for l in range(l0, l1):
             acc = 0.0
             for j in range(N_X):
                 acc += a[j] * xa[j, l]
-            for j in range(3):
+            for j in range(N_U):
                 acc += b[j] * u[j, l]
             for j in range(N_F):
                 acc += phi[i, j, l] * xa[N_X + j, l]
@@ -151,10 +178,10 @@ def _predict(xa, P, Pn, u, fm, phi, T, l0, l1):
             xa[i, l] = T[i, 0, l]
     # T = [A Phi] P, three rows of A_aug at a time
     for i in range(0, N_X, 3):
-        a0 = _row9(fm.A, i)
-        a1 = _row9(fm.A, i + 1)
-        a2 = _row9(fm.A, i + 2)
-        for c in range(N_AUG):
+        a0 = _row_x(fm.A, i)
+        a1 = _row_x(fm.A, i + 1)
+        a2 = _row_x(fm.A, i + 2)
+        for c in range(n):
             for l in range(l0, l1):
                 acc0 = 0.0
                 acc1 = 0.0
@@ -173,8 +200,8 @@ def _predict(xa, P, Pn, u, fm, phi, T, l0, l1):
                 T[i + 1, c, l] = acc1
                 T[i + 2, c, l] = acc2
     # P_bb unchanged (copied when predicting out of place)
-    for i in range(N_X, N_AUG):
-        for k in range(i, N_AUG):
+    for i in range(N_X, n):
+        for k in range(i, n):
             for l in range(l0, l1):
                 Pn[i, k, l] = P[i, k, l]
     # P_xx = T_x A^T + T_b Phi^T, entry (i, k) stored at [k, i] for three k
@@ -182,9 +209,9 @@ def _predict(xa, P, Pn, u, fm, phi, T, l0, l1):
     # reaches the lower triangle of column i is formed (its entries right of
     # the diagonal are overwritten when the lower triangle is mirrored up)
     for k in range(0, N_X, 3):
-        a0 = _row9(fm.A, k)
-        a1 = _row9(fm.A, k + 1)
-        a2 = _row9(fm.A, k + 2)
+        a0 = _row_x(fm.A, k)
+        a1 = _row_x(fm.A, k + 1)
+        a2 = _row_x(fm.A, k + 2)
         for i in range(k + 3):
             for l in range(l0, l1):
                 acc0 = 0.0
@@ -208,7 +235,7 @@ def _predict(xa, P, Pn, u, fm, phi, T, l0, l1):
         for j in range(N_F):
             for l in range(l0, l1):
                 Pn[i, N_X + j, l] = T[i, N_X + j, l]
-    for i in range(N_AUG):
+    for i in range(n):
         qi = fm.q_diag[i]
         for l in range(l0, l1):
             Pn[i, i, l] += qi
@@ -216,11 +243,11 @@ def _predict(xa, P, Pn, u, fm, phi, T, l0, l1):
         for k in range(i + 1, N_X):
             for l in range(l0, l1):
                 Pn[i, k, l] = Pn[k, i, l]
-        for k in range(N_X, N_AUG):
+        for k in range(N_X, n):
             for l in range(l0, l1):
                 Pn[k, i, l] = Pn[i, k, l]
-    for i in range(N_X, N_AUG):
-        for k in range(i + 1, N_AUG):
+    for i in range(N_X, n):
+        for k in range(i + 1, n):
             for l in range(l0, l1):
                 Pn[k, i, l] = Pn[i, k, l]
 
@@ -235,16 +262,16 @@ def predict_lanes(xa, P, u, fm, phi, T):
 
     Parameters
     ----------
-    xa : ndarray, shape (14, L)
+    xa : ndarray, shape (n, L)
         Augmented estimates, updated in place.
-    P : ndarray, shape (14, 14, L)
+    P : ndarray, shape (n, n, L)
         Covariances, symmetric, updated in place (stay exactly symmetric).
     u : ndarray, shape (3, L)
         Command deviations from trim applied during the step.
     fm : FilterModel
     phi : ndarray, shape (9, 5, L)
         Work array; holds ``Phi(u)`` of each lane on return.
-    T : ndarray, shape (9, 14, L)
+    T : ndarray, shape (9, n, L)
         Work array.
     """
     _predict(xa, P, P, u, fm, phi, T, 0, xa.shape[1])
@@ -260,19 +287,20 @@ def residuals_lanes(xa, P, z, fm, res):
 
     Parameters
     ----------
-    xa : ndarray, shape (14, L)
+    xa : ndarray, shape (n, L)
         Predicted augmented states ``X_{k+1|k}``.
-    P : ndarray, shape (14, 14, L)
+    P : ndarray, shape (n, n, L)
         Predicted covariances ``P_{k+1|k}`` (symmetric).
     z : ndarray, shape (12, L)
         Measurement deviations from the trim outputs.
     fm : FilterModel
     res : ndarray, shape (3, L)
-        Written with ``[r_q, r_nx, r_nz]`` of each lane.
+        Written with ``[r_q, r_nx, r_nz]`` of each lane (outputs
+        :data:`ftc_mc.conventions.RESIDUAL_OUTPUTS`).
     """
     L = xa.shape[1]
-    for o in range(3):
-        r = OUT_Q if o == 0 else (OUT_NX if o == 1 else OUT_NZ)
+    for o in range(len(RESIDUAL_OUTPUTS)):
+        r = RESIDUAL_OUTPUTS[o]
         s_idx = fm.c_ident[r]
         rr = fm.r_diag[r]
         if s_idx >= 0:
@@ -281,7 +309,7 @@ def residuals_lanes(xa, P, z, fm, res):
                 s = P[s_idx, s_idx, l] + rr
                 res[o, l] = mu * mu / s
         else:
-            c = _row9(fm.C, r)
+            c = _row_x(fm.C, r)
             for l in range(L):
                 pred = 0.0
                 s = 0.0
@@ -315,20 +343,9 @@ def signature_lanes(res, det, block):
     L = res.shape[1]
     t_q = det.t_q
     t_nx = det.t_nx
-    swapped = det.swapped != 0
+    swapped = det.swapped
     for l in range(L):
-        r_nx = res[1, l]
-        nx_hit = r_nx >= t_nx
-        q_hit = res[0, l] >= t_q
-        nz_big = (res[2, l] >= r_nx) != swapped
-        b = 0
-        if nx_hit and q_hit:
-            b = 1 if nz_big else 2
-        elif nx_hit:
-            b = 1
-        elif q_hit:
-            b = 2
-        block[l] = b
+        block[l] = signature(res[0, l], res[1, l], res[2, l], t_q, t_nx, swapped)
 
 
 @kernel
@@ -341,26 +358,23 @@ def reset_lanes(P, block, reset_var):
 
     Parameters
     ----------
-    P : ndarray, shape (14, 14, L)
+    P : ndarray, shape (n, n, L)
         Covariances, updated in place.
     block : ndarray of int64, shape (L,)
-        Block per lane: 0 no reset, 1 thrust ``{b0_T, b1_T}``, 2 elevons
-        ``{b0_e, b1_L, b1_R}``.
+        Block per lane: ``NO_RESET``, ``RESET_THRUST`` (``{b0_T, b1_T}``) or
+        ``RESET_ELEVONS`` (``{b0_e, b1_L, b1_R}``); other codes reset nothing.
     reset_var : ndarray, shape (5,)
         Variance of each fault parameter after its block is reset.
     """
+    n = P.shape[0]
     L = P.shape[2]
     for l in range(L):
         b = block[l]
-        if b == 1 or b == 2:
+        if b != NO_RESET:
             for j in range(N_F):
-                if b == 1:
-                    hit = j == 0 or j == 2
-                else:
-                    hit = j == 1 or j == 3 or j == 4
-                if hit:
+                if in_block(j, b):
                     i = N_X + j
-                    for k in range(N_AUG):
+                    for k in range(n):
                         P[i, k, l] = 0.0
                         P[k, i, l] = 0.0
                     P[i, i, l] = reset_var[j]
@@ -378,13 +392,15 @@ def _unit_group(xa, P, z, fm, hk, vk, gs, r0, q_max):
     state is advanced the same way.  Then one pass over the upper triangle
     subtracts all rank-one terms in order.  Returns ``q``.
     """
+    n = xa.shape[0]
     L = xa.shape[1]
+    n_z = z.shape[0]
     q = 0
-    while q < q_max and r0 + q < N_Z and fm.c_ident[r0 + q] >= 0:
+    while q < q_max and r0 + q < n_z and fm.c_ident[r0 + q] >= 0:
         r = r0 + q
         s = fm.c_ident[r]
         rr = fm.r_diag[r]
-        for a in range(N_AUG):
+        for a in range(n):
             lo = min(a, s)
             hi = max(a, s)
             for l in range(L):
@@ -402,21 +418,21 @@ def _unit_group(xa, P, z, fm, hk, vk, gs, r0, q_max):
             sv = rr + hk[q, s, l]
             gs[q, l] = (z[r, l] - gs[q, l]) / sv
             gs[GROUP + q, l] = 1.0 / sv
-        for a in range(N_AUG):
+        for a in range(n):
             for l in range(L):
                 vk[q, a, l] = hk[q, a, l] * gs[GROUP + q, l]
         q += 1
     for k in range(q, GROUP):
-        for a in range(N_AUG):
+        for a in range(n):
             for l in range(L):
                 vk[k, a, l] = 0.0
                 hk[k, a, l] = 0.0
     for k in range(q):
-        for a in range(N_AUG):
+        for a in range(n):
             for l in range(L):
                 xa[a, l] += hk[k, a, l] * gs[k, l]
-    for a in range(N_AUG):
-        for b in range(a, N_AUG):
+    for a in range(n):
+        for b in range(a, n):
             for l in range(L):
                 acc = P[a, b, l]
                 for k in range(GROUP):
@@ -428,9 +444,10 @@ def _unit_group(xa, P, z, fm, hk, vk, gs, r0, q_max):
 @kernel
 def _dense_row(xa, P, z, fm, h, v, gs, r):
     """Scalar update with a dense row ``r`` of ``C`` (upper triangle of ``P`` kept)."""
+    n = xa.shape[0]
     L = xa.shape[1]
     rr = fm.r_diag[r]
-    c = _row9(fm.C, r)
+    c = _row_x(fm.C, r)
     _mirror_x(P, 0, L)
     for a in range(N_X):
         for l in range(L):
@@ -438,7 +455,7 @@ def _dense_row(xa, P, z, fm, h, v, gs, r):
             for j in range(N_X):
                 acc += P[a, j, l] * c[j]
             h[a, l] = acc
-    for a in range(N_X, N_AUG):
+    for a in range(N_X, n):
         for l in range(L):
             acc = 0.0
             for j in range(N_X):
@@ -453,26 +470,27 @@ def _dense_row(xa, P, z, fm, h, v, gs, r):
             sv += c[j] * h[j, l]
         gs[0, l] = (z[r, l] - pred) / sv
         gs[1, l] = 1.0 / sv
-    for a in range(N_AUG):
+    for a in range(n):
         for l in range(L):
             xa[a, l] += h[a, l] * gs[0, l]
-    for a in range(N_AUG):
+    for a in range(n):
         for l in range(L):
             v[a, l] = h[a, l] * gs[1, l]
-    for a in range(N_AUG):
-        for b in range(a, N_AUG):
+    for a in range(n):
+        for b in range(a, n):
             for l in range(L):
                 P[a, b, l] -= v[a, l] * h[b, l]
 
 
 @kernel
 def _update(xa, P, z, fm, h):
-    """The 12 sequential scalar updates on the upper triangle of ``P`` (no mirror)."""
+    """The sequential scalar updates, one per output, on the upper triangle of
+    ``P`` (no mirror)."""
     hk = h[0:GROUP]
     vk = h[GROUP:2 * GROUP]
     gs = h[2 * GROUP]
     r = 0
-    while r < N_Z:
+    while r < z.shape[0]:
         if fm.c_ident[r] >= 0:
             r += _unit_group(xa, P, z, fm, hk, vk, gs, r, GROUP)
         else:
@@ -491,14 +509,14 @@ def update_lanes(xa, P, z, fm, h):
 
     Parameters
     ----------
-    xa : ndarray, shape (14, L)
+    xa : ndarray, shape (n, L)
         Updated in place.
-    P : ndarray, shape (14, 14, L)
+    P : ndarray, shape (n, n, L)
         Updated in place.
     z : ndarray, shape (12, L)
         Measurement deviations from the trim outputs.
     fm : FilterModel
-    h : ndarray, shape (UPDATE_ROWS, 14, L)
+    h : ndarray, shape (UPDATE_ROWS, n, L)
         Work array (``UPDATE_ROWS = 13``).
     """
     _update(xa, P, z, fm, h)
@@ -516,7 +534,7 @@ def project_lanes(xa, fm):
 
     Parameters
     ----------
-    xa : ndarray, shape (14, L)
+    xa : ndarray, shape (n, L)
         Updated in place.
     fm : FilterModel
     """
@@ -539,16 +557,16 @@ def filter_step_lanes(xa, P, u, z, fm, det, phi, T, work, res, block):
     reset, reset the block of ``P_{k|k}`` (section 3.2.2) and predict again from
     it; measurement update; projection of the fault parameters (eqs. 6-8).
 
-    ``P_{k|k}`` stays in ``P`` while the prediction goes to ``work[:14]``, so
+    ``P_{k|k}`` stays in ``P`` while the prediction goes to ``work[:n]``, so
     the lanes that reset are re-predicted without a copy of ``P``: up to
     ``SERIAL_REPREDICT`` of them run by run of adjacent lanes, more by
     predicting every lane again (bit-identical for the others).
 
     Parameters
     ----------
-    xa : ndarray, shape (14, L)
-        Augmented estimates, updated in place.
-    P : ndarray, shape (14, 14, L)
+    xa : ndarray, shape (n, L)
+        Augmented estimates, updated in place (``n = 14`` in the paper).
+    P : ndarray, shape (n, n, L)
         Covariances, updated in place (exactly symmetric).
     u : ndarray, shape (3, L)
         Command deviations applied during the step.
@@ -557,18 +575,19 @@ def filter_step_lanes(xa, P, u, z, fm, det, phi, T, work, res, block):
     fm : FilterModel
     det : Detection
     phi, T : ndarray
-        Work arrays of shapes (9, 5, L) and (9, 14, L).
-    work : ndarray, shape (STEP_ROWS, 14, L)
-        Work array (``STEP_ROWS = 28``).
+        Work arrays of shapes (9, 5, L) and (9, n, L).
+    work : ndarray, shape (step_rows(n), n, L)
+        Work array (``STEP_ROWS = 28`` rows for the paper's filter).
     res : ndarray, shape (3, L)
         Written with ``[r_q, r_nx, r_nz]`` on the first prediction.
     block : ndarray of int64, shape (L,)
         Written with the block reset this step per lane (0 if none).
     """
+    n = xa.shape[0]
     L = xa.shape[1]
-    Pn = work[0:N_AUG]
-    h = work[N_AUG:N_AUG + UPDATE_ROWS]
-    x_prev = work[N_AUG + UPDATE_ROWS]
+    Pn = work[0:n]
+    h = work[n:n + UPDATE_ROWS]
+    x_prev = work[n + UPDATE_ROWS]
     for i in range(N_X):
         for l in range(L):
             x_prev[i, l] = xa[i, l]

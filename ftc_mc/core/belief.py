@@ -1,6 +1,7 @@
 """Mode observation likelihood (eq. 12) and Bayes belief update (eqs. 13-14).
 
-Modes: 0 nominal, 1 engine faulty, 2 left elevon faulty, 3 right elevon faulty.
+Modes: 0 nominal, 1 engine faulty, 2 left elevon faulty, 3 right elevon faulty
+(:data:`ftc_mc.conventions.MODE_NAMES`).
 Each mode's prior ``f_m`` over the five fault parameters is uniform on a box
 ``[lo[m], hi[m]]`` (independent parameters, section 3.3.2), and the filter's
 estimate is Gaussian with mean ``b_hat`` and the marginal variances of ``P``.
@@ -16,9 +17,9 @@ from __future__ import annotations
 
 import math
 
+from ..conventions import N_MODES  # noqa: F401
 from .jit import kernel
 
-N_MODES = 4
 LOG_TINY = -745.0  # log of the smallest subnormal float64
 
 
@@ -85,7 +86,7 @@ def belief_update(belief, bs, bhat, var, work):
         Transition matrix and mode boxes.
     bhat, var : ndarray, shape (5,)
         Fault-parameter estimate and marginal variances.
-    work : ndarray, shape (8,)
+    work : ndarray, shape (2 N_MODES,)
         Work array.
 
     Returns

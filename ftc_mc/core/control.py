@@ -16,6 +16,10 @@ follows the model), giving the short-horizon cost ``I(a)`` (eq. 45) and
 ``P_{k+H|k+H}``; the belief is updated with it (eqs. 13-14) and the controller
 minimising ``I(a) + sum_m b_{k+H}(m) (J^N(m, a) + P(c, a))`` (eqs. 46-47) is
 chosen.
+
+Plain-NumPy twins: ``tests/naive.py`` (``controller_command_ref``,
+``horizon_cost_ref``, ``controller_objectives_ref``), compared in
+``tests/test_stages.py``.
 """
 
 from __future__ import annotations
@@ -30,7 +34,14 @@ from .interp import engine_controller
 from .jit import kernel
 from .kalman import predict, project, update
 
-from ..conventions import C_ELEVON, C_ENGINE, C_NOMINAL  # noqa: E402,F401
+from ..conventions import (C_ELEVON, C_ENGINE, C_NOMINAL, I_B0_ELEVONS,  # noqa: F401
+                           I_B0_THRUST, I_B1_LEFT, I_B1_RIGHT, I_B1_THRUST, INPUT_NAMES,
+                           N_AUG, N_CONTROLLERS, N_FAULT, N_MODES, N_U, N_X)
+
+U_THRUST = INPUT_NAMES.index("throttle")
+U_LEFT = INPUT_NAMES.index("elevon_left")
+U_RIGHT = INPUT_NAMES.index("elevon_right")
+"""Rows of the command vector ``u`` (:data:`ftc_mc.conventions.INPUT_NAMES`)."""
 
 
 @kernel
@@ -70,128 +81,176 @@ def controller_command(c, xa, K, eng, u0, U):
     ----------
     c : int
         ``C_NOMINAL``, ``C_ENGINE`` or ``C_ELEVON``.
-    xa : ndarray, shape (14,)
-        Augmented estimate ``[x, b0_T, b0_e, b1_T, b1_L, b1_R]``.
+    xa : ndarray, shape (n,)
+        Augmented estimate ``[x, b0_T, b0_e, b1_T, b1_L, b1_R, ...]``
+        (:mod:`ftc_mc.conventions`).
     K : ndarray, shape (3, 9)
         Nominal gain.
     eng : EngineTables
     u0 : ndarray, shape (3,)
         Trim commands.
     U : ndarray, shape (3,)
-        Written with the command deviation.
+        Written with the command deviation [throttle, rad, rad].
     """
     if c == C_ENGINE:
-        engine_controller(eng, xa[9], xa[11], xa, U)
+        engine_controller(eng, xa[I_B0_THRUST], xa[I_B1_THRUST], xa, U)
         return
-    for i in range(3):
+    for i in range(N_U):
         acc = 0.0
-        for j in range(9):
+        for j in range(N_X):
             acc -= K[i, j] * xa[j]
         U[i] = acc
     if c == C_ELEVON:
-        U[1], U[2] = elevon_allocation(-U[1], xa[10], xa[12], xa[13], u0[1], u0[2])
+        U[U_LEFT], U[U_RIGHT] = elevon_allocation(
+            -U[U_LEFT], xa[I_B0_ELEVONS], xa[I_B1_LEFT], xa[I_B1_RIGHT], u0[U_LEFT],
+            u0[U_RIGHT])
 
 
 @kernel
-def horizon_cost(c, xs, Ps, fm, rc, eng, K, lo, hi, work, phi, T):
+def horizon_cost(c, xs, Ps, scheme, work):
     """Predict ``H`` steps with controller ``c``; return the discounted cost (eq. 45).
 
-    ``xs`` and ``Ps`` are advanced in place to ``X_{k+H|k}`` and
-    ``P_{k+H|k+H}`` (zero innovations).
+    ``I(c) = sum_{k'=1..H} alpha^k' (x_k'^T Q_lqr x_k' + u_k'^T R_lqr u_k')`` on
+    the predicted state and the saturated commands (eq. 16); ``xs`` and ``Ps``
+    are advanced in place to ``X_{k+H|k}`` and ``P_{k+H|k+H}`` (zero
+    innovations: each step is a prediction, a measurement update with the
+    predicted measurement, and the projection of eqs. 6-8).
 
     Parameters
     ----------
     c : int
-    xs : ndarray, shape (14,)
-    Ps : ndarray, shape (14, 14)
-    fm : FilterModel
-    rc : Reconfig
-    eng : EngineTables
-    K : ndarray, shape (3, 9)
-    lo, hi : ndarray, shape (3,)
-        Command limits as deviations.
-    work : ndarray, shape (4, 14)
-        Work rows (command, predicted measurement, update gain).
-    phi, T : ndarray, shape (9, 5) and (9, 14)
-        Work arrays of :func:`ftc_mc.core.kalman.predict`.
+        Controller (``C_NOMINAL``, ``C_ENGINE``, ``C_ELEVON``).
+    xs : ndarray, shape (n,)
+        Augmented estimate, advanced in place.
+    Ps : ndarray, shape (n, n)
+        Its covariance, advanced in place.
+    scheme : Scheme
+        Reads ``filter``, ``controller`` (gain and limits), ``reconfig``
+        (``horizon``, ``alpha``, ``q_lqr``, ``r_lqr``) and ``engine``.
+    work : SelectionWork
+        Scratch (``U``, ``z``, ``h``, ``phi``, ``T``).
+
+    Returns
+    -------
+    float
+        The discounted short-horizon cost.
     """
-    U = work[0, :3]
-    z = work[1, :12]
-    h = work[2]
+    ctl = scheme.controller
+    return _predicted_cost(c, xs, Ps, scheme.filter, scheme.reconfig, scheme.engine, ctl.K,
+                           ctl.lo_dev, ctl.hi_dev, work.U, work.z, work.h, work.phi, work.T)
+
+
+@kernel
+def _predicted_cost(c, xs, Ps, fm, rc, eng, K, lo, hi, U, z, h, phi, T):
+    """The loop of :func:`horizon_cost` on unpacked settings and scratch.
+
+    The settings are unpacked once, outside the loop: reading them from the
+    whole ``Scheme`` inside it made the reconfiguring trial about 8 % slower
+    (128 lanes of ``configs/paper_tables.yaml``, one core).
+    """
     cost = 0.0
     disc = 1.0
     for _ in range(rc.horizon):
         controller_command(c, xs, K, eng, fm.u0, U)
-        for i in range(3):
+        for i in range(N_U):
             U[i] = saturate(U[i], 0.0, 0.0, lo[i], hi[i])
         predict(xs, Ps, U, fm, phi, T)
-        for r in range(12):
+        for r in range(z.shape[0]):
             s = fm.c_ident[r]
             if s >= 0:
                 z[r] = xs[s]
             else:
                 acc = 0.0
-                for j in range(9):
+                for j in range(N_X):
                     acc += fm.C[r, j] * xs[j]
                 z[r] = acc
         update(xs, Ps, z, fm, h)
         project(xs, fm)
         disc *= rc.alpha
         stage = 0.0
-        for j in range(9):
+        for j in range(N_X):
             stage += rc.q_lqr[j] * xs[j] * xs[j]
-        for i in range(3):
+        for i in range(N_U):
             stage += rc.r_lqr[i] * U[i] * U[i]
         cost += disc * stage
     return cost
 
 
 @kernel
-def select_controller(current, xa, P, belief, fm, bs, rc, eng, K, lo, hi, xs, Ps, bl, work,
-                      phi, T):
+def controller_objectives(current, xa, P, belief, scheme, work):
+    """The objective of eq. (47) for every controller, into ``work.obj``.
+
+    ``obj(a) = I(a) + sum_m b_{k+H|k+H}(m) (J^N(m, a) + P(c, a))``: the
+    short-horizon cost (eq. 45, :func:`horizon_cost`), the belief updated with
+    the predicted fault parameters and their variances (eqs. 12-14), the
+    terminal cost and the switching penalty (eq. 46).
+
+    Parameters
+    ----------
+    current : int
+        Controller in use ``c`` (for the switching penalty ``P(c, a)``).
+    xa : ndarray, shape (n,)
+        Augmented estimate.
+    P : ndarray, shape (n, n)
+        Its covariance.
+    belief : ndarray, shape (4,)
+        Current mode probabilities.
+    scheme : Scheme
+        Reads ``filter``, ``belief``, ``controller``, ``reconfig`` and ``engine``.
+    work : SelectionWork
+        Scratch; ``work.obj`` (3,) is written.
+    """
+    n = xa.shape[0]
+    rc = scheme.reconfig
+    xs = work.xs
+    Ps = work.Ps
+    bl = work.belief
+    bv = work.bvar
+    for a in range(N_CONTROLLERS):
+        for i in range(n):
+            xs[i] = xa[i]
+            for j in range(n):
+                Ps[i, j] = P[i, j]
+        obj = horizon_cost(a, xs, Ps, scheme, work)
+        for m in range(N_MODES):
+            bl[m] = belief[m]
+        for j in range(N_FAULT):
+            bv[j] = Ps[N_X + j, N_X + j]
+        belief_update(bl, scheme.belief, xs[N_X:N_X + N_FAULT], bv, work.bwork)
+        for m in range(N_MODES):
+            obj += bl[m] * (rc.JN[m, a] + rc.penalty[current, a])
+        work.obj[a] = obj
+
+
+@kernel
+def select_controller(current, xa, P, belief, scheme, work):
     """Rolling-horizon choice of the controller (eqs. 45-47) for one trajectory.
+
+    The controller with the smallest objective of :func:`controller_objectives`
+    (the first of equal ones); the current one when no objective is finite.
 
     Parameters
     ----------
     current : int
         Controller in use (for the switching penalty ``P(c, a)``).
-    xa : ndarray, shape (14,)
-    P : ndarray, shape (14, 14)
+    xa : ndarray, shape (n,)
+    P : ndarray, shape (n, n)
     belief : ndarray, shape (4,)
         Current mode probabilities.
-    fm : FilterModel
-    bs : Belief
-    rc : Reconfig
-    eng : EngineTables
-    K : ndarray, shape (3, 9)
-    lo, hi : ndarray, shape (3,)
-    xs, Ps, bl, work, phi, T : ndarray
-        Scratch of shapes (14,), (14, 14), (4,), (4, 14), (9, 5), (9, 14).
+    scheme : Scheme
+    work : SelectionWork
 
     Returns
     -------
     int
         The selected controller.
     """
+    controller_objectives(current, xa, P, belief, scheme, work)
     best = current
     best_obj = math.inf
-    bv = work[3, :5]
-    bw = work[3, 5:13]
-    for a in range(3):
-        for i in range(14):
-            xs[i] = xa[i]
-            for j in range(14):
-                Ps[i, j] = P[i, j]
-        obj = horizon_cost(a, xs, Ps, fm, rc, eng, K, lo, hi, work, phi, T)
-        for m in range(4):
-            bl[m] = belief[m]
-        for j in range(5):
-            bv[j] = Ps[9 + j, 9 + j]
-        belief_update(bl, bs, xs[9:], bv, bw)
-        for m in range(4):
-            obj += bl[m] * (rc.JN[m, a] + rc.penalty[current, a])
-        if obj < best_obj:
-            best_obj = obj
+    for a in range(N_CONTROLLERS):
+        if work.obj[a] < best_obj:
+            best_obj = work.obj[a]
             best = a
     return best
 
@@ -228,35 +287,35 @@ def policy_cost(c, fm, K, eng, lo, hi, b0, b1, best, alpha, q_lqr, r_lqr, n_step
     float
         ``sum_{k<n} alpha^k (x_k' Q x_k + u_k' R u_k)``.
     """
-    xa = np.zeros(14)
-    for j in range(5):
-        xa[9 + j] = best[j]
-    x = np.zeros(9)
-    xn = np.zeros(9)
-    U = np.zeros(3)
-    e = np.zeros(3)
+    xa = np.zeros(N_AUG)
+    for j in range(N_FAULT):
+        xa[N_X + j] = best[j]
+    x = np.zeros(N_X)
+    xn = np.zeros(N_X)
+    U = np.zeros(N_U)
+    e = np.zeros(N_U)
     cost = 0.0
     disc = 1.0
     for _ in range(n_steps):
-        for j in range(9):
+        for j in range(N_X):
             xa[j] = x[j]
         controller_command(c, xa, K, eng, fm.u0, U)
         stage = 0.0
-        for i in range(3):
+        for i in range(N_U):
             U[i] = saturate(U[i], 0.0, 0.0, lo[i], hi[i])
             e[i] = b0[i] + (1.0 - b1[i]) * U[i] - b1[i] * fm.u0[i]
             stage += r_lqr[i] * U[i] * U[i]
-        for j in range(9):
+        for j in range(N_X):
             stage += q_lqr[j] * x[j] * x[j]
         cost += disc * stage
         disc *= alpha
-        for i in range(9):
+        for i in range(N_X):
             acc = 0.0
-            for j in range(9):
+            for j in range(N_X):
                 acc += fm.A[i, j] * x[j]
-            for j in range(3):
+            for j in range(N_U):
                 acc += fm.B[i, j] * e[j]
             xn[i] = acc
-        for i in range(9):
+        for i in range(N_X):
             x[i] = xn[i]
     return cost

@@ -43,13 +43,13 @@ def gust_step(state, eta, Ad, Bd, Cd, out):
     s1 = state[1]
     s2 = state[2]
     s3 = state[3]
-    for i in range(3):
+    for i in range(N_GUST_OUT):
         out[i] = Cd[i, 0] * s0 + Cd[i, 1] * s1 + Cd[i, 2] * s2 + Cd[i, 3] * s3
     e0 = eta[0]
     e1 = eta[1]
     e2 = eta[2]
     e3 = eta[3]
-    for i in range(4):
+    for i in range(N_GUST_STATE):
         state[i] = (Ad[i, 0] * s0 + Ad[i, 1] * s1 + Ad[i, 2] * s2 + Ad[i, 3] * s3
                     + Bd[i, 0] * e0 + Bd[i, 1] * e1 + Bd[i, 2] * e2 + Bd[i, 3] * e3)
 

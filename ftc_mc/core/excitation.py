@@ -9,6 +9,32 @@ from __future__ import annotations
 from .jit import kernel
 
 
+S3211_UNITS = (3, 2, 1, 1)
+"""Durations of the 3211's alternating steps, in units (Fig. 4)."""
+
+
+@kernel
+def doublet_length(half_steps):
+    """Steps a doublet lasts: two halves."""
+    return 2 * half_steps
+
+
+@kernel
+def signal_3211_length(unit_steps):
+    """Steps a 3211 lasts: 3 + 2 + 1 + 1 units."""
+    total = 0
+    for n in S3211_UNITS:
+        total += n
+    return total * unit_steps
+
+
+@kernel
+def running(k, start, length):
+    """Whether a signal started at step ``start`` and lasting ``length`` steps
+    is on at step ``k``."""
+    return 0 <= k - start < length
+
+
 @kernel
 def doublet(k, half_steps, amplitude):
     """Doublet: ``+A`` for ``half_steps`` steps, then ``-A`` for as many (Fig. 4).

@@ -2,9 +2,9 @@
 
 ``FTC_MC_NUMBA_CACHE=0`` in the environment turns Numba's on-disk cache off (for
 example while editing kernels in several files, since the cache does not see
-edits in other modules, DESIGN.md section 8).  ``fastmath`` stays off: it was no
-faster here and breaks bit-for-bit agreement with the NumPy references
-(PERFORMANCE.md, lesson 4).
+edits in other modules).  ``fastmath`` stays off: it was no faster here
+(``scripts/bench_core.py``) and breaks bit-for-bit agreement with the NumPy
+references.
 """
 
 from __future__ import annotations

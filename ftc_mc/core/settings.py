@@ -1,6 +1,6 @@
 """Namedtuples of arrays that carry settings into the kernels.
 
-Built from the linear plant and the configuration by :mod:`ftc_mc.estimator`;
+Built from the linear plant and the configuration by :mod:`ftc_mc.sim.setup`;
 the kernels only read them.
 """
 
@@ -60,7 +60,7 @@ Timing = namedtuple("Timing", [
     "reconf_every",   # steps between belief updates (reconfiguration period)
     "detect_prob",    # belief of the final mode that counts as detected
 ])
-"""Trial timing (DESIGN.md section 6)."""
+"""Trial timing (Tables 2-3; ``docs/paper-map.md``)."""
 
 TrialInputs = namedtuple("TrialInputs", [
     "k_switch",   # (E,) int64 steps at which the truth switches, k_switch[0] == 0

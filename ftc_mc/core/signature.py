@@ -5,28 +5,33 @@ Table 1 as printed (``swapped = 0``)::
     thrust  : (r_nx >= t_nx and r_q <  t_q) or (r_nx >= t_nx and r_q >= t_q and r_nz >= r_nx)
     elevons : (r_nx <  t_nx and r_q >= t_q) or (r_nx >= t_nx and r_q >= t_q and r_nz <  r_nx)
 
-``swapped = 1`` exchanges the ``r_nz`` comparison of the third clause (DESIGN.md
-section 4: an elevon fault drives ``r_q`` and ``r_nz`` far above ``r_nx``, which
-the printed rule sends to the thrust block).
+``swapped = 1`` exchanges the ``r_nz`` comparison of the third clause (an
+elevon fault drives ``r_q`` and ``r_nz`` far above ``r_nx``, which the printed
+rule sends to the thrust block; see ``docs/paper-map.md``).
 """
 
 from __future__ import annotations
 
-from ..conventions import NO_RESET, RESET_ELEVONS, RESET_THRUST  # noqa: F401
+from ..conventions import (ELEVON_BLOCK, N_FAULT, N_X, NO_RESET,  # noqa: F401
+                           RESET_ELEVONS, RESET_THRUST, THRUST_BLOCK)
 from .jit import kernel
-
 
 
 @kernel
 def in_block(j, block):
     """Whether fault parameter ``j`` of ``[b0_T, b0_e, b1_T, b1_L, b1_R]`` is in a block.
 
-    The thrust block is ``{b0_T, b1_T}``; the elevon block ``{b0_e, b1_L, b1_R}``.
+    The thrust block is ``{b0_T, b1_T}``; the elevon block ``{b0_e, b1_L, b1_R}``
+    (:data:`ftc_mc.conventions.THRUST_BLOCK`, :data:`~ftc_mc.conventions.ELEVON_BLOCK`).
     """
     if block == RESET_THRUST:
-        return j == 0 or j == 2
-    if block == RESET_ELEVONS:
-        return j == 1 or j == 3 or j == 4
+        for m in THRUST_BLOCK:
+            if j == m:
+                return True
+    elif block == RESET_ELEVONS:
+        for m in ELEVON_BLOCK:
+            if j == m:
+                return True
     return False
 
 
@@ -64,7 +69,8 @@ def signature(r_q, r_nx, r_nz, t_q, t_nx, swapped):
 
 @kernel
 def reset_covariance(P, block, reset_var):
-    """Reset one fault block of ``P_{k+1|k}`` (section 3.2.2).
+    """Reset one fault block of a covariance (section 3.2.2; the filter step
+    applies it to ``P_{k|k}``, see :mod:`ftc_mc.core.step`).
 
     The rows and columns of the block's fault parameters are zeroed and their
     variances set to ``reset_var``: thrust ``((u_max - u_min)/t_nx)^2`` for b0 and
@@ -72,8 +78,8 @@ def reset_covariance(P, block, reset_var):
 
     Parameters
     ----------
-    P : ndarray, shape (14, 14)
-        Updated in place.
+    P : ndarray, shape (n, n)
+        Updated in place; the fault parameters are entries ``N_X .. N_X + 4``.
     block : int
         ``RESET_THRUST`` or ``RESET_ELEVONS`` (``NO_RESET`` does nothing).
     reset_var : ndarray, shape (5,)
@@ -82,10 +88,9 @@ def reset_covariance(P, block, reset_var):
     if block != RESET_THRUST and block != RESET_ELEVONS:
         return
     n = P.shape[0]
-    nx = n - 5
-    for j in range(5):
+    for j in range(N_FAULT):
         if in_block(j, block):
-            i = nx + j
+            i = N_X + j
             for k in range(n):
                 P[i, k] = 0.0
                 P[k, i] = 0.0

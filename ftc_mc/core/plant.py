@@ -1,0 +1,264 @@
+"""The truth step of a trial, on every lane: what the simulated aircraft does.
+
+Stage 2 of :func:`ftc_mc.core.trial.advance`.  With the commands ``u_k`` of the
+step (deviations from trim, ``TrialWork.u``):
+
+1. the fault schedule's entry in force at step ``k`` gives the truth ``b0``,
+   ``b1`` per actuator, and the actuators' effect is eq. (2)
+   ``e_k = b0 + (1 - b1) u_k - b1 u0`` (:func:`actuator_effect`);
+2. in turbulence the Dryden filter gives the gust ``g_k`` held over the step and
+   advances (:func:`gust_lanes`, :mod:`ftc_mc.core.dryden`);
+3. linear plant (the filter's model, eq. 1):
+   ``x_{k+1} = A x_k + B e_k + B_w g_k + w_k`` and
+   ``z_{k+1} = C x_{k+1} + D_w g_{k+1} + v_k`` (:func:`linear_step`);
+   nonlinear X8 (:mod:`ftc_mc.core.nonlinear`, RK4 with ``n_sub`` sub-steps):
+   ``x_{k+1} = RK4(x0 + x_k, u0 + e_k, g_k) - x0 + w_k`` and
+   ``z_{k+1} = h(x0 + x_{k+1}, g_{k+1}) - y0 + v_k`` (:func:`nonlinear_step`);
+4. the true air-relative airspeed and angle of attack, for the validity check
+   (``TrialWork.va``, ``TrialWork.alpha``).
+
+Plain-NumPy twin: ``tests/naive.py::truth_step_ref``.
+"""
+
+from __future__ import annotations
+
+from ..conventions import N_U, N_X, N_Z, OUT_ALPHA, OUT_VA
+from .dryden import N_GUST_OUT, N_GUST_STATE, gust_step
+from .jit import kernel
+from .nonlinear import outputs_nb, propagate
+
+
+@kernel
+def schedule_entry(k_switch, k):
+    """Index of the fault-schedule entry in force during step ``k``.
+
+    Parameters
+    ----------
+    k_switch : ndarray of int64, shape (E,)
+        Non-decreasing steps at which the truth switches, ``k_switch[0] == 0``.
+    k : int
+        Step.
+
+    Returns
+    -------
+    int
+        The last ``e`` with ``k_switch[e] <= k``.
+    """
+    ev = 0
+    while ev + 1 < k_switch.shape[0] and k >= k_switch[ev + 1]:
+        ev += 1
+    return ev
+
+
+@kernel(inline="always")
+def actuator_effect(u0, b0, b1, u, e):
+    """Effect of the actuators on every lane (eq. 2): ``e = b0 + (1 - b1) u - b1 u0``.
+
+    Parameters
+    ----------
+    u0 : ndarray, shape (3,)
+        Trim commands (absolute).
+    b0, b1 : ndarray, shape (3, L)
+        Truth fault parameters per actuator (``b0`` the absolute lock position
+        when locked).
+    u : ndarray, shape (3, L)
+        Command deviations from trim.
+    e : ndarray, shape (3, L)
+        Written with the effect (deviation from trim).
+    """
+    L = u.shape[1]
+    for i in range(N_U):
+        u0i = u0[i]
+        for l in range(L):
+            b1il = b1[i, l]
+            e[i, l] = b0[i, l] + (1.0 - b1il) * u[i, l] - b1il * u0i
+
+
+@kernel(inline="always")
+def gust_lanes(plant, eta, gust, wind, wind_next, work):
+    """Dryden gusts of every lane: the gust held over the step and the next one.
+
+    Parameters
+    ----------
+    plant : TruthPlant
+        ``Ad``, ``Bd``, ``Cd`` of the discrete Dryden model.
+    eta : ndarray, shape (4, L)
+        Standard normal draws of this step.
+    gust : ndarray, shape (4, L)
+        Gust filter states ``s_k``, advanced in place to ``s_{k+1}``.
+    wind, wind_next : ndarray, shape (3, L)
+        Written with ``Cd s_k`` and ``Cd s_{k+1}`` (``u_g``, ``w_g`` [m/s],
+        ``q_g`` [rad/s]).
+    work : TrialWork
+        One-lane buffers ``gust``, ``eta``, ``wl``.
+    """
+    L = gust.shape[1]
+    gs = work.gust
+    et = work.eta
+    wl = work.wl
+    for l in range(L):
+        for i in range(N_GUST_STATE):
+            gs[i] = gust[i, l]
+            et[i] = eta[i, l]
+        gust_step(gs, et, plant.Ad, plant.Bd, plant.Cd, wl)
+        for i in range(N_GUST_STATE):
+            gust[i, l] = gs[i]
+        for i in range(N_GUST_OUT):
+            wind[i, l] = wl[i]
+            acc = 0.0
+            for j in range(N_GUST_STATE):
+                acc += plant.Cd[i, j] * gs[j]
+            wind_next[i, l] = acc
+
+
+@kernel(inline="always")
+def linear_step(model, flight, w, v, x, work):
+    """Linear plant of eq. (1) on every lane, with gusts when ``flight.plant.turb``.
+
+    Parameters
+    ----------
+    model : FilterModel
+        ``A``, ``B``, ``C`` (the truth uses the filter's own linear model).
+    flight : Flight
+        ``plant`` (gust matrices ``Bw``, ``Dw``) and ``validity`` (trim airspeed
+        and angle of attack).
+    w : ndarray, shape (9, L)
+        Process noise of the step.
+    v : ndarray, shape (12, L)
+        Measurement noise of the step.
+    x : ndarray, shape (9, L)
+        True state (deviation from trim), advanced in place.
+    work : TrialWork
+        Reads ``e``, ``wind``, ``wind_next``; writes ``x_next``, ``z``, ``va``,
+        ``alpha``.
+    """
+    pl = flight.plant
+    val = flight.validity
+    turb = pl.turb != 0
+    L = x.shape[1]
+    xn = work.x_next
+    e = work.e
+    wind = work.wind
+    wind_next = work.wind_next
+    z = work.z
+    for i in range(N_X):
+        for l in range(L):
+            xn[i, l] = w[i, l]
+        for j in range(N_X):
+            aij = model.A[i, j]
+            for l in range(L):
+                xn[i, l] += aij * x[j, l]
+        for j in range(N_U):
+            bij = model.B[i, j]
+            for l in range(L):
+                xn[i, l] += bij * e[j, l]
+        if turb:
+            for j in range(N_GUST_OUT):
+                bij = pl.Bw[i, j]
+                for l in range(L):
+                    xn[i, l] += bij * wind[j, l]
+    for i in range(N_X):
+        for l in range(L):
+            x[i, l] = xn[i, l]
+    for r in range(N_Z):
+        for l in range(L):
+            z[r, l] = v[r, l]
+        for j in range(N_X):
+            crj = model.C[r, j]
+            if crj != 0.0:
+                for l in range(L):
+                    z[r, l] += crj * x[j, l]
+        if turb:
+            for j in range(N_GUST_OUT):
+                drj = pl.Dw[r, j]
+                for l in range(L):
+                    z[r, l] += drj * wind_next[j, l]
+    # airspeed and angle of attack, air-relative, for the validity check
+    for l in range(L):
+        va = val.va_trim
+        al = val.alpha_trim
+        for j in range(N_X):
+            va += model.C[OUT_VA, j] * x[j, l]
+            al += model.C[OUT_ALPHA, j] * x[j, l]
+        if turb:
+            for j in range(N_GUST_OUT):
+                va += pl.Dw[OUT_VA, j] * wind_next[j, l]
+                al += pl.Dw[OUT_ALPHA, j] * wind_next[j, l]
+        work.va[l] = va
+        work.alpha[l] = al
+
+
+@kernel(inline="always")
+def nonlinear_step(u0, plant, w, v, x, work):
+    """Nonlinear X8 on every lane, one lane at a time (RK4, ``plant.n_sub`` steps).
+
+    Parameters
+    ----------
+    u0 : ndarray, shape (3,)
+        Trim commands (absolute).
+    plant : TruthPlant
+        ``p``, ``x0``, ``y0``, ``dt``, ``n_sub``.
+    w, v : ndarray, shapes (9, L) and (12, L)
+        Process and measurement noise of the step.
+    x : ndarray, shape (9, L)
+        True state (deviation from trim ``plant.x0``), advanced in place.
+    work : TrialWork
+        Reads ``e``, ``wind``, ``wind_next``; writes ``z``, ``va``, ``alpha``;
+        one-lane buffers ``xabs``, ``cmd``, ``wl``, ``y``, ``rk4``.
+    """
+    L = x.shape[1]
+    xabs = work.xabs
+    cmd = work.cmd
+    wl = work.wl
+    y = work.y
+    for l in range(L):
+        for i in range(N_X):
+            xabs[i] = plant.x0[i] + x[i, l]
+        for i in range(N_U):
+            cmd[i] = u0[i] + work.e[i, l]
+        for i in range(N_GUST_OUT):
+            wl[i] = work.wind[i, l]
+        propagate(xabs, cmd, plant.p, wl, plant.dt, plant.n_sub, work.rk4)
+        for i in range(N_X):
+            xabs[i] += w[i, l]
+            x[i, l] = xabs[i] - plant.x0[i]
+        for i in range(N_GUST_OUT):
+            wl[i] = work.wind_next[i, l]
+        outputs_nb(xabs, plant.p, wl, y)
+        for r in range(N_Z):
+            work.z[r, l] = v[r, l] + (y[r] - plant.y0[r])
+        work.va[l] = y[OUT_VA]
+        work.alpha[l] = y[OUT_ALPHA]
+
+
+@kernel(inline="always")
+def truth_step(model, flight, inp, k, st, work):
+    """Stage 2: the truth plant over step ``k -> k+1`` on every lane (module docstring).
+
+    Parameters
+    ----------
+    model : FilterModel
+        The linear model (``A``, ``B``, ``C``) and the trim commands ``u0``.
+    flight : Flight
+        ``plant`` (TruthPlant) and ``validity`` (trim air data).
+    inp : TrialInputs
+        Fault schedule (``k_switch``, ``b0``, ``b1``) and the noise and gust
+        draws of step ``k``.
+    k : int
+        Step.
+    st : LaneState
+        ``x`` (true state, deviation from trim) and ``gust`` (gust filter
+        states; untouched in still air) advanced in place.
+    work : TrialWork
+        Reads ``u``; writes ``e``, ``wind``, ``wind_next``, ``z``, ``va``,
+        ``alpha`` (and ``x_next`` on the linear plant).
+    """
+    pl = flight.plant
+    ev = schedule_entry(inp.k_switch, k)
+    actuator_effect(model.u0, inp.b0[ev], inp.b1[ev], work.u, work.e)
+    if pl.turb != 0:
+        gust_lanes(pl, inp.eta[k], st.gust, work.wind, work.wind_next, work)
+    if pl.kind == 0:
+        linear_step(model, flight, inp.w[k], inp.v[k], st.x, work)
+    else:
+        nonlinear_step(model.u0, pl, inp.w[k], inp.v[k], st.x, work)

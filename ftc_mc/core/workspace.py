@@ -1,0 +1,116 @@
+"""Scratch arrays of the trial kernels, two namedtuples built once per call.
+
+:class:`TrialWork` holds everything :func:`ftc_mc.core.trial.advance` and its
+stages (:mod:`ftc_mc.core.stages`, :mod:`ftc_mc.core.plant`) need between the
+state of a trial (:class:`~ftc_mc.core.settings.LaneState`) and its record:
+lane arrays (lane index last, see :mod:`ftc_mc.core.batch`) that one stage
+writes and the next reads, and small one-lane buffers for the kernels that run
+a lane at a time (nonlinear plant, belief, controller selection).
+:class:`SelectionWork` is the scratch of :func:`ftc_mc.core.control.select_controller`.
+
+Every size comes from :mod:`ftc_mc.conventions` or from the augmented dimension
+``n`` passed in (taken from the state's arrays), never from a literal.  The
+builders are kernels, so ``advance`` allocates its workspace once per call.
+"""
+
+from __future__ import annotations
+
+from collections import namedtuple
+
+import numpy as np
+
+from ..conventions import N_CONTROLLERS, N_FAULT, N_MODES, N_U, N_X, N_Z, RESIDUAL_NAMES
+from .batch import step_rows
+from .dryden import N_GUST_NOISE, N_GUST_OUT, N_GUST_STATE
+from .jit import kernel
+from .nonlinear import N_WORK
+
+N_RES = len(RESIDUAL_NAMES)
+
+EXC_DOUBLET, EXC_3211, EXC_DOUBLET_START, EXC_3211_START = range(4)
+"""Rows of :attr:`TrialWork.exc` and of the record's ``hist_exc``: the doublet
+value on the engine, the 3211 value on the left elevon (minus on the right),
+then 1.0 on the step where each signal started."""
+N_EXC = 4
+
+SelectionWork = namedtuple("SelectionWork", [
+    "xs",      # (n,) estimate predicted over the horizon
+    "Ps",      # (n, n) its covariance
+    "belief",  # (N_MODES,) belief updated with the prediction (eq. 47)
+    "U",       # (N_U,) command of the controller under test
+    "z",       # (N_Z,) predicted measurement (zero innovation)
+    "h",       # (n,) gain of one scalar update (kalman.update)
+    "bvar",    # (N_FAULT,) predicted variances of the fault parameters
+    "bwork",   # (2 N_MODES,) work of belief.belief_update
+    "phi",     # (N_X, N_FAULT) Phi(u) (kalman.predict)
+    "T",       # (N_X, n) [A Phi] P (kalman.predict)
+    "obj",     # (N_CONTROLLERS,) objective of each controller (eq. 47)
+])
+"""Scratch of the rolling-horizon controller selection (paper eqs. 45-47)."""
+
+TrialWork = namedtuple("TrialWork", [
+    # lane arrays, written by one stage and read by the next
+    "u",          # (N_U, L) commands applied during the step (eq. 15)
+    "exc",        # (N_EXC, L) excitation values and starts (EXC_* rows)
+    "e",          # (N_U, L) actuator effects (eq. 2)
+    "wind",       # (3, L) gust u_g, w_g [m/s], q_g [rad/s] held over the step
+    "wind_next",  # (3, L) gust at the next sample, seen by its measurement
+    "x_next",     # (N_X, L) next state of the linear plant
+    "z",          # (N_Z, L) measurements (deviations from the trim outputs)
+    "va",         # (L,) true airspeed [m/s] (air-relative)
+    "alpha",      # (L,) true angle of attack [rad] (air-relative)
+    "phi",        # (N_X, N_FAULT, L) filter work (batch.filter_step_lanes)
+    "T",          # (N_X, n, L) filter work
+    "fwork",      # (step_rows(n), n, L) filter work
+    "res",        # (N_RES, L) residuals r_q, r_nx, r_nz (eqs. 9-11)
+    "block",      # (L,) int64 block reset this step (Table 1)
+    "finite",     # (L,) bool: the lane's estimate, variances and air data are finite
+    # one lane at a time
+    "xl",         # (n,) a lane's estimate
+    "Pl",         # (n, n) a lane's covariance
+    "Ul",         # (N_U,) a lane's command
+    "chol",       # (n, n) Cholesky factor of the positive-definiteness test
+    "gust",       # (N_GUST_STATE,) a lane's gust filter state
+    "eta",        # (N_GUST_NOISE,) a lane's gust draws
+    "wl",         # (N_GUST_OUT,) a lane's gust
+    "xabs",       # (N_X,) a lane's absolute state (nonlinear plant)
+    "cmd",        # (N_U,) a lane's absolute effective commands
+    "y",          # (N_Z,) a lane's absolute outputs
+    "rk4",        # (N_WORK, N_X) RK4 work (nonlinear.propagate)
+    "bl",         # (N_MODES,) a lane's belief
+    "bhat",       # (N_FAULT,) a lane's fault-parameter estimate
+    "bvar",       # (N_FAULT,) its marginal variances
+    "bwork",      # (2 N_MODES,) work of belief.belief_update
+    "sel",        # SelectionWork
+])
+"""Scratch of one :func:`ftc_mc.core.trial.advance` call (see module docstring)."""
+
+
+@kernel
+def new_selection_work(n):
+    """Zeroed :class:`SelectionWork` for an augmented dimension ``n``."""
+    return SelectionWork(xs=np.zeros(n), Ps=np.zeros((n, n)), belief=np.zeros(N_MODES),
+                         U=np.zeros(N_U), z=np.zeros(N_Z), h=np.zeros(n),
+                         bvar=np.zeros(N_FAULT), bwork=np.zeros(2 * N_MODES),
+                         phi=np.zeros((N_X, N_FAULT)), T=np.zeros((N_X, n)),
+                         obj=np.zeros(N_CONTROLLERS))
+
+
+@kernel
+def new_trial_work(L, n):
+    """Zeroed :class:`TrialWork` for ``L`` lanes and augmented dimension ``n``.
+
+    The gust arrays stay zero in still air (nothing writes them then).
+    """
+    return TrialWork(
+        u=np.zeros((N_U, L)), exc=np.zeros((N_EXC, L)), e=np.zeros((N_U, L)),
+        wind=np.zeros((N_GUST_OUT, L)), wind_next=np.zeros((N_GUST_OUT, L)),
+        x_next=np.zeros((N_X, L)), z=np.zeros((N_Z, L)), va=np.zeros(L),
+        alpha=np.zeros(L), phi=np.zeros((N_X, N_FAULT, L)), T=np.zeros((N_X, n, L)),
+        fwork=np.zeros((step_rows(n), n, L)), res=np.zeros((N_RES, L)),
+        block=np.zeros(L, dtype=np.int64), finite=np.zeros(L, dtype=np.bool_),
+        xl=np.zeros(n), Pl=np.zeros((n, n)), Ul=np.zeros(N_U), chol=np.zeros((n, n)),
+        gust=np.zeros(N_GUST_STATE), eta=np.zeros(N_GUST_NOISE), wl=np.zeros(N_GUST_OUT),
+        xabs=np.zeros(N_X), cmd=np.zeros(N_U), y=np.zeros(N_Z),
+        rk4=np.zeros((N_WORK, N_X)), bl=np.zeros(N_MODES), bhat=np.zeros(N_FAULT),
+        bvar=np.zeros(N_FAULT), bwork=np.zeros(2 * N_MODES), sel=new_selection_work(n))
