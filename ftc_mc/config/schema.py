@@ -282,7 +282,7 @@ class CampaignConfig(_Strict):
 
     transitions: list[Literal[TRANSITIONS]] = Field(default_factory=lambda: ["elevon_lock"],
                                                     min_length=1)
-    """Transitions to run (names of docs/paper-map.md)."""
+    """Transitions to run (elevon or engine x lock, unlock, loss, loss_recover)."""
     trials: Annotated[int, NoBool, Field(gt=0, le=10_000_000)] = 1000
     """Trials per transition."""
     seed: Annotated[int, NoBool, Field(ge=0, lt=2 ** 63)] = 2026
