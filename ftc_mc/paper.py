@@ -21,4 +21,4 @@ engine recovers.  Times [s] from the start of the Table 4 schedule."""
 
 PAPER_EXCITATIONS = {"doublet": (10.0, 12.6, 15.6, 30.0, 50.0, 70.0), "3211": (90.0,)}
 """Excitations the paper reports in section 5.2, by signal: start times [s]
-(the same text as ``summary_markdown`` in ``ftc_mc/scenario.py``)."""
+(the same text as ``summary_markdown`` in ``ftc_mc/scenario/timeline.py``)."""
