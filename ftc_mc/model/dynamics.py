@@ -21,10 +21,6 @@ import numpy as np
 
 from .airframe import Airframe
 
-from ..conventions import INPUT_NAMES, OUTPUT_NAMES, STATE_NAMES  # noqa: F401
-from ..conventions import N_U as N_INPUT
-from ..conventions import N_X as N_STATE
-from ..conventions import N_Z as N_OUTPUT
 from ..core.nonlinear import (N_PARAM, P_C, P_CD0, P_CDA, P_CDA2,  # noqa: F401
                               P_CDDE2, P_CL0, P_CLA, P_CLDE, P_CLQ, P_CM0, P_CMA,
                               P_CMDE, P_CMQ, P_CPROP, P_G, P_GAMMA0, P_JY, P_KMOTOR,

@@ -26,10 +26,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..conventions import (I_B0_ELEVONS, I_B0_THRUST, I_B1_LEFT,  # noqa: F401
-                           I_B1_RIGHT, I_B1_THRUST, MODE_ENGINE, MODE_LEFT_ELEVON,
-                           MODE_NOMINAL, MODE_RIGHT_ELEVON, N_AUG, N_B0, N_B1, N_FAULT)
-from ..conventions import ACTUATOR_NAMES as ACTUATORS
+from ..conventions import (MODE_ENGINE, MODE_LEFT_ELEVON, MODE_NOMINAL,
+                           MODE_RIGHT_ELEVON, N_B0, N_FAULT)
 
 
 def effect(u, u0, b0, b1):

@@ -16,10 +16,12 @@ import scipy.differentiate
 import scipy.optimize
 import scipy.signal
 
+from ..conventions import N_U as N_INPUT
+from ..conventions import N_X as N_STATE
+from ..conventions import N_Z as N_OUTPUT
 from ..errors import UserError
 from .airframe import X8, Airframe
-from .dynamics import (N_INPUT, N_OUTPUT, N_STATE, derivatives, outputs,
-                       pack_parameters)
+from .dynamics import derivatives, outputs, pack_parameters
 
 
 @dataclasses.dataclass(frozen=True)

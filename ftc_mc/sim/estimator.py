@@ -21,7 +21,8 @@ import numpy as np
 from ..config.schema import EstimatorConfig
 from ..conventions import VARIANTS
 from ..core.settings import Belief, Detection, FilterModel
-from ..model.faults import N_AUG, bias_matrix, fault_bounds
+from ..conventions import N_AUG
+from ..model.faults import bias_matrix, fault_bounds
 from ..model.linear import LinearPlant
 
 DEG = math.pi / 180.0
