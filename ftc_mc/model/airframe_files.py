@@ -31,6 +31,7 @@ import scipy.io
 import yaml
 
 from ..errors import UserError
+from ..io.yamlfile import read_yaml
 from .airframe import Airframe
 from .linear import LinearPlant, TrimPoint
 
@@ -213,31 +214,6 @@ def parse_airframe(data, source: str = "airframe") -> Airframe:
         raise UserError(f"airframe: {exc}{tail}") from None
 
 
-def _read_yaml(path: Path, source: str):
-    tail = f" ({source})"
-    try:
-        raw = path.read_bytes()
-    except FileNotFoundError:
-        raise UserError(f"airframe: no such file{tail}") from None
-    except IsADirectoryError:
-        raise UserError(f"airframe: not a regular file{tail}") from None
-    except OSError as exc:
-        raise UserError(f"airframe: cannot read ({exc.strerror}){tail}") from None
-    try:
-        text = raw.decode("utf-8")
-    except UnicodeDecodeError as exc:
-        raise UserError(f"airframe: not UTF-8 text (byte {exc.start}){tail}") from None
-    try:
-        return yaml.safe_load(text)
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        at = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
-        problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
-        raise UserError(f"airframe: malformed YAML{at}: {problem}{tail}") from None
-    except RecursionError:
-        raise UserError(f"airframe: malformed YAML, nested too deeply{tail}") from None
-
-
 def load_airframe_yaml(path) -> Airframe:
     """Read an airframe YAML file (as written by :func:`export_airframe`).
 
@@ -256,7 +232,7 @@ def load_airframe_yaml(path) -> Airframe:
         is not a mapping, or a field problem (:func:`parse_airframe`).
     """
     path = Path(path)
-    return parse_airframe(_read_yaml(path, str(path)), str(path))
+    return parse_airframe(read_yaml(path), str(path))
 
 
 # ----------------------------------------------------------------------------
