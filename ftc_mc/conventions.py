@@ -113,3 +113,19 @@ DEFAULT_AIRFRAME = AIRFRAME_PRESETS[0]
 PLANT_KINDS = ("linear", "nonlinear")
 TURBULENCE_LEVELS = ("none", "light", "moderate", "severe")
 """Truth plants and MIL-F-8785C turbulence levels (W20 = 0, 15, 30, 45 kt)."""
+
+# ------------------------------------------------------------------ sensor faults
+OUTPUT_UNITS = ("m/s", "m/s", "rad/s", "m", "m", "rad", "g", "g", "rad", "rad", "m/s",
+                "m/s")
+"""Units of the outputs (:data:`OUTPUT_NAMES`) and so of a sensor bias on them
+(a drift: the unit per second)."""
+
+SENSOR_FAULT_KINDS = ("bias", "stuck", "drift", "noise")
+"""Sensor faults on one output (issue 14): ``bias`` a step of ``size``, ``stuck``
+frozen at its last healthy value, ``drift`` a ramp of ``size`` per second,
+``noise`` the measurement noise multiplied by ``size``."""
+SENSOR_BIAS, SENSOR_STUCK, SENSOR_DRIFT, SENSOR_NOISE = range(len(SENSOR_FAULT_KINDS))
+NO_SENSOR_FAULT = -1
+"""``TrialInputs.sensor_out`` of a lane without a sensor fault."""
+SENSOR_PREFIX = "sensor_"
+"""Campaign transitions ``sensor_<kind>:<output>``, e.g. ``sensor_bias:q``."""

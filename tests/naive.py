@@ -578,8 +578,36 @@ def truth_step_ref(scheme, flight, inp, k, st, u):
             y = x8_outputs_ref(xabs, pl.p, wind_next[:, l])
             z[:, l] = y - pl.y0 + inp.v[k][:, l]
             va[l], alpha[l] = y[OUT_VA], y[OUT_ALPHA]
+    zhold = st.zhold.copy()
+    for l in range(L):
+        z[:, l], zhold[l] = sensor_fault_ref(
+            z[:, l], inp.v[k][:, l], zhold[l], k, pl.dt, int(inp.sensor_out[l]),
+            int(inp.sensor_kind[l]), float(inp.sensor_size[l]), int(inp.sensor_k[l]))
     return dict(x=x, gust=gust, e=e, wind=wind, wind_next=wind_next, z=z, va=va,
-                alpha=alpha)
+                alpha=alpha, zhold=zhold)
+
+
+def sensor_fault_ref(z, v, zhold, k, dt, out, kind, size, k_onset):
+    """One lane's measurement ``z_{k+1}`` (12,) with its sensor fault on output
+    ``out`` (-1: none), and the updated last healthy value: before the onset the
+    output passes and is remembered; from it on, bias adds ``size``, drift
+    ``size * (k + 1 - k_onset) * dt``, stuck holds the remembered value, noise
+    scales the output's noise ``v`` by ``size``.  Returns ``(z, zhold)``."""
+    z = np.array(z, dtype=float, copy=True)
+    if out < 0:
+        return z, zhold
+    if k < k_onset:
+        return z, float(z[out])
+    name = ("bias", "stuck", "drift", "noise")[kind]
+    if name == "bias":
+        z[out] = z[out] + size
+    elif name == "drift":
+        z[out] = z[out] + size * ((k + 1 - k_onset) * dt)
+    elif name == "stuck":
+        z[out] = zhold
+    else:
+        z[out] = z[out] - v[out] + size * v[out]
+    return z, zhold
 
 
 def filter_update_ref(scheme, st, u, z):
@@ -703,7 +731,7 @@ def advance_ref(scheme, flight, inp, rec, st, k0, k1):
         kn = k + 1
         u, exc = commands_ref(scheme, st, k)
         tr = truth_step_ref(scheme, flight, inp, k, st, u)
-        st.x[:], st.gust[:] = tr["x"], tr["gust"]
+        st.x[:], st.gust[:], st.zhold[:] = tr["x"], tr["gust"], tr["zhold"]
         xa, P, res, block, rmax = filter_update_ref(scheme, st, u, tr["z"])
         st.xa[:], st.P[:], st.rmax[:] = xa, P, rmax
         alive, status, stop_k = check_validity_ref(flight.validity, st, kn, tr["va"],

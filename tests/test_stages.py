@@ -129,7 +129,8 @@ def random_lanes(setup, rng, k, L=L):
                      s_start=s_start.astype(np.int64), recheck=recheck.astype(np.int64),
                      belief=np.ascontiguousarray(rng.dirichlet(np.ones(4), L).T),
                      alive=alive, cur=(np.arange(L) % N_CONTROLLERS).astype(np.int64),
-                     rmax=rng.uniform(0.0, 50.0, (2, L)), gust=gust)
+                     rmax=rng.uniform(0.0, 50.0, (2, L)), gust=gust,
+                     zhold=rng.standard_normal(L))
 
 
 def copy_nt(nt):
@@ -157,7 +158,19 @@ def random_inputs(setup, rng, n_steps, L=L):
         P0=setup.P0, w=setup.q_std[None, :, None] * rng.standard_normal((n_steps, 9, L)),
         v=setup.r_std[None, :, None] * rng.standard_normal((n_steps, 12, L)),
         eta=rng.standard_normal((n_steps if turb else 0, 4, L)),
-        g0=np.zeros((4, L)))
+        g0=np.zeros((4, L)), **random_sensor_faults(rng, L))
+
+
+def random_sensor_faults(rng, L):
+    """Sensor faults on most lanes: every kind, random outputs, onsets at steps
+    0-6, sizes of either sign (noise: factor 0-5); a few lanes without."""
+    out = rng.integers(0, 12, L)
+    out[rng.random(L) < 0.2] = -1
+    kind = rng.integers(0, 4, L)
+    size = rng.uniform(-0.5, 0.5, L)
+    size[kind == 3] = rng.uniform(0.0, 5.0, int((kind == 3).sum()))
+    return dict(sensor_out=out.astype(np.int64), sensor_kind=kind.astype(np.int64),
+                sensor_size=size, sensor_k=rng.integers(0, 7, L).astype(np.int64))
 
 
 def new_rec(tim, L=L, max_resets=4, history=True):
@@ -331,7 +344,7 @@ def test_truth_step(fixture, request):
         x0, g0 = st.x.copy(), st.gust.copy()
         kplant.truth_step(setup.fm, flight, inp, k, st, work)
         assert np.array_equal(work.e, want["e"])
-        for name, got in (("x", st.x), ("z", work.z), ("gust", st.gust),
+        for name, got in (("x", st.x), ("z", work.z), ("gust", st.gust), ("zhold", st.zhold),
                           ("wind", work.wind), ("wind_next", work.wind_next)):
             assert_lanes(got, want[name], 1e-12, name)
         assert_lanes(work.va[None], want["va"][None], 1e-12, "va")

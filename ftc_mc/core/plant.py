@@ -15,14 +15,21 @@ step (deviations from trim, ``TrialWork.u``):
    ``x_{k+1} = RK4(x0 + x_k, u0 + e_k, g_k) - x0 + w_k`` and
    ``z_{k+1} = h(x0 + x_{k+1}, g_{k+1}) - y0 + v_k`` (:func:`nonlinear_step`);
 4. the true air-relative airspeed and angle of attack, for the validity check
-   (``TrialWork.va``, ``TrialWork.alpha``).
+   (``TrialWork.va``, ``TrialWork.alpha``);
+5. the lane's sensor fault, if any, on its one output ``o`` from the onset step
+   ``k_s`` on (:func:`sensor_fault`, issue 14): bias ``z_o += size``; drift
+   ``z_o += size (k + 1 - k_s) dt``; stuck ``z_o = `` the last healthy ``z_o``
+   (``LaneState.zhold``); noise ``z_o += (size - 1) v_o`` (the noise scaled by
+   ``size``).  The air data of step 4 stay true: a sensor fault misleads the
+   estimator, not the validity check.
 
-Plain-NumPy twin: ``tests/naive.py::truth_step_ref``.
+Plain-NumPy twins: ``tests/naive.py::truth_step_ref``, ``sensor_fault_ref``.
 """
 
 from __future__ import annotations
 
-from ..conventions import N_U, N_X, N_Z, OUT_ALPHA, OUT_VA
+from ..conventions import (N_U, N_X, N_Z, OUT_ALPHA, OUT_VA, SENSOR_BIAS, SENSOR_DRIFT,
+                           SENSOR_NOISE, SENSOR_STUCK)
 from .dryden import N_GUST_OUT, N_GUST_STATE, gust_step
 from .jit import kernel
 from .nonlinear import outputs_nb, propagate
@@ -232,6 +239,47 @@ def nonlinear_step(u0, plant, w, v, x, work):
 
 
 @kernel(inline="always")
+def sensor_fault(inp, k, dt, v, zhold, z):
+    """Apply each lane's sensor fault to the measurement ``z_{k+1}`` (module docstring).
+
+    Parameters
+    ----------
+    inp : TrialInputs
+        ``sensor_out`` (output index or -1), ``sensor_kind``, ``sensor_size``,
+        ``sensor_k`` (onset step).
+    k : int
+        Step (the measurement is ``z_{k+1}``).
+    dt : float
+        Control period [s].
+    v : ndarray, shape (12, L)
+        Measurement noise of the step (already in ``z``).
+    zhold : ndarray, shape (L,)
+        Last healthy value of the faulty output: written before the onset, read
+        by a stuck fault after it.
+    z : ndarray, shape (12, L)
+        Measurements, modified in place on the faulty output of each lane.
+    """
+    for l in range(z.shape[1]):
+        o = inp.sensor_out[l]
+        if o < 0:
+            continue
+        ks = inp.sensor_k[l]
+        if k < ks:
+            zhold[l] = z[o, l]
+            continue
+        kind = inp.sensor_kind[l]
+        size = inp.sensor_size[l]
+        if kind == SENSOR_BIAS:
+            z[o, l] += size
+        elif kind == SENSOR_DRIFT:
+            z[o, l] += size * (k + 1 - ks) * dt
+        elif kind == SENSOR_STUCK:
+            z[o, l] = zhold[l]
+        elif kind == SENSOR_NOISE:
+            z[o, l] += (size - 1.0) * v[o, l]
+
+
+@kernel(inline="always")
 def truth_step(model, flight, inp, k, st, work):
     """Stage 2: the truth plant over step ``k -> k+1`` on every lane (module docstring).
 
@@ -242,13 +290,14 @@ def truth_step(model, flight, inp, k, st, work):
     flight : Flight
         ``plant`` (TruthPlant) and ``validity`` (trim air data).
     inp : TrialInputs
-        Fault schedule (``k_switch``, ``b0``, ``b1``) and the noise and gust
-        draws of step ``k``.
+        Fault schedule (``k_switch``, ``b0``, ``b1``), the noise and gust
+        draws of step ``k`` and the lanes' sensor faults.
     k : int
         Step.
     st : LaneState
         ``x`` (true state, deviation from trim) and ``gust`` (gust filter
-        states; untouched in still air) advanced in place.
+        states; untouched in still air) advanced in place; ``zhold`` (the last
+        healthy value of a faulty output) kept up to the onset.
     work : TrialWork
         Reads ``u``; writes ``e``, ``wind``, ``wind_next``, ``z``, ``va``,
         ``alpha`` (and ``x_next`` on the linear plant).
@@ -262,3 +311,4 @@ def truth_step(model, flight, inp, k, st, work):
         linear_step(model, flight, inp.w[k], inp.v[k], st.x, work)
     else:
         nonlinear_step(model.u0, pl, inp.w[k], inp.v[k], st.x, work)
+    sensor_fault(inp, k, pl.dt, inp.v[k], st.zhold, work.z)

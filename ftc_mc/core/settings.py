@@ -76,6 +76,10 @@ TrialInputs = namedtuple("TrialInputs", [
     "eta",        # (n_steps, 4, L) standard normal gust draws, or (0, 4, L) without
                   #           turbulence (core/dryden.py)
     "g0",         # (4, L) initial gust filter state (stationary draw, or zeros)
+    "sensor_out",   # (L,) int64 output index of the lane's sensor fault, or -1 (none)
+    "sensor_kind",  # (L,) int64 conventions.SENSOR_* kind (bias, stuck, drift, noise)
+    "sensor_size",  # (L,) bias [unit], drift [unit/s] or noise factor [-]; stuck: unused
+    "sensor_k",     # (L,) int64 onset step: z_{k+1} is faulty from truth step k on
 ])
 """Per-lane inputs of :func:`ftc_mc.core.trial.run_trials` (a fault schedule)."""
 
@@ -158,6 +162,7 @@ LaneState = namedtuple("LaneState", [
     "cur",      # (L,) int64 controller in use
     "rmax",     # (2, L) largest r_q and r_nx seen so far (threshold sharing)
     "gust",     # (4, L) Dryden gust filter state (zeros without turbulence)
+    "zhold",    # (L,) last healthy measurement of the lane's faulty output (stuck)
 ])
 """Everything a trial carries from one step to the next (core/trial.py)."""
 

@@ -120,6 +120,7 @@ def init_state(inp, st, rec):
         rec.status[l] = STATUS_OK
         for i in range(st.gust.shape[0]):
             st.gust[i, l] = inp.g0[i, l]
+        st.zhold[l] = 0.0
 
 
 @kernel
@@ -132,7 +133,8 @@ def new_state(L):
                      s_start=np.zeros(L, dtype=np.int64),
                      recheck=np.zeros(L, dtype=np.int64), belief=np.zeros((N_MODES, L)),
                      alive=np.zeros(L, dtype=np.bool_), cur=np.zeros(L, dtype=np.int64),
-                     rmax=np.zeros((N_RMAX, L)), gust=np.zeros((N_GUST_STATE, L)))
+                     rmax=np.zeros((N_RMAX, L)), gust=np.zeros((N_GUST_STATE, L)),
+                     zhold=np.zeros(L))
 
 
 @kernel

@@ -13,7 +13,9 @@ Each lane owns its stream, ``numpy.random.default_rng([trial_id, root_seed])``,
 and draws from it in this order (:func:`draw_lane`):
 
 1. the fault value, uniform over the transition's range (lock position or
-   effectiveness loss ``b1``); a fault-free flight draws it too and ignores it,
+   effectiveness loss ``b1``; for a sensor transition the sensor fault's size,
+   and a stuck sensor draws it over [0, 1] and ignores it, so that the other
+   draws stay those of the actuator transitions); a fault-free flight draws it too and ignores it,
    so flight ``i`` flies the noise of trial ``i``; a scenario draws none;
 2. the process noise, ``n_steps x 9``, scaled by ``setup.q_std``;
 3. the measurement noise, ``n_steps x 12``, scaled by ``setup.r_std``;
@@ -33,7 +35,7 @@ from collections import namedtuple
 
 import numpy as np
 
-from ..conventions import ACTUATOR_NAMES
+from ..conventions import ACTUATOR_NAMES, NO_SENSOR_FAULT
 from ..core.settings import TrialInputs
 from ..model.faults import estimator_params, mode_of
 
@@ -52,6 +54,14 @@ LaneDraws = namedtuple("LaneDraws", [
     "g0",     # (4, L) initial gust states (zeros in still air)
 ])
 """Every random number of a chunk of lanes (module docstring)."""
+
+SensorFaults = namedtuple("SensorFaults", [
+    "out",   # (L,) int64 output index, or conventions.NO_SENSOR_FAULT
+    "kind",  # (L,) int64 conventions.SENSOR_* kind
+    "size",  # (L,) bias [unit], drift [unit/s], noise factor [-]; unused when stuck
+    "k",     # (L,) int64 onset step
+])
+"""Per-lane sensor faults (``TrialInputs.sensor_*``, ``core/plant.py``)."""
 
 FLIGHT_FAULT_RANGE = (0.0, 1.0)
 """Range of the fault value a fault-free flight draws and ignores."""
@@ -139,7 +149,8 @@ def entry_modes(schedule: Schedule, beta) -> np.ndarray:
     return np.stack([mode_of(b1, *beta) for b1 in schedule.b1])
 
 
-def build_inputs(setup, schedule: Schedule, draws: LaneDraws) -> TrialInputs:
+def build_inputs(setup, schedule: Schedule, draws: LaneDraws,
+                 sensor: "SensorFaults | None" = None) -> TrialInputs:
     """The kernels' inputs of lanes flying ``schedule`` with ``draws``.
 
     Each lane starts with its initial mode identified: the belief is one-hot on
@@ -150,6 +161,8 @@ def build_inputs(setup, schedule: Schedule, draws: LaneDraws) -> TrialInputs:
     setup : SimSetup
     schedule : Schedule
     draws : LaneDraws
+    sensor : SensorFaults, optional
+        Each lane's sensor fault; ``None``: no lane has one.
 
     Returns
     -------
@@ -161,9 +174,29 @@ def build_inputs(setup, schedule: Schedule, draws: LaneDraws) -> TrialInputs:
     modes = entry_modes(schedule, setup.beta)
     xa0 = np.zeros((14, L))
     xa0[9:] = estimator_params(schedule.b0[0], schedule.b1[0])
+    sensor = no_sensor_faults(L) if sensor is None else sensor
     return TrialInputs(k_switch=schedule.k_switch, b0=schedule.b0, b1=schedule.b1,
                        mode_pre=modes[0].copy(), mode_post=modes[-1].copy(), xa0=xa0,
-                       P0=setup.P0, w=draws.w, v=draws.v, eta=draws.eta, g0=draws.g0)
+                       P0=setup.P0, w=draws.w, v=draws.v, eta=draws.eta, g0=draws.g0,
+                       sensor_out=sensor.out, sensor_kind=sensor.kind,
+                       sensor_size=sensor.size, sensor_k=sensor.k)
+
+
+def no_sensor_faults(L: int) -> "SensorFaults":
+    """Sensor faults of ``L`` healthy lanes (output -1: the kernel skips them)."""
+    return SensorFaults(out=np.full(L, NO_SENSOR_FAULT, dtype=np.int64),
+                        kind=np.zeros(L, dtype=np.int64), size=np.zeros(L),
+                        k=np.zeros(L, dtype=np.int64))
+
+
+def sensor_faults(out: int, kind: int, sizes, k_onset: int) -> "SensorFaults":
+    """The same sensor fault (output and kind indices, onset step) on every lane,
+    with per-lane ``sizes``."""
+    sizes = np.asarray(sizes, dtype=float)
+    L = len(sizes)
+    return SensorFaults(out=np.full(L, out, dtype=np.int64),
+                        kind=np.full(L, kind, dtype=np.int64), size=sizes.copy(),
+                        k=np.full(L, k_onset, dtype=np.int64))
 
 
 def flight_schedule(L: int) -> Schedule:
