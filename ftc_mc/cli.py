@@ -264,7 +264,14 @@ def run(config, trials, seed, jobs, out, signature, controller, overwrite, resum
     if result is None:
         click.echo(f"{out_dir}: the run is already complete; nothing to resume")
         return
-    click.echo(terminal_table(result.summary))
+    from .campaign.summary import actuator_rows, sensor_markdown_table
+    acts = actuator_rows(result.summary)
+    if len(acts):
+        click.echo(terminal_table(acts))
+    sensor = sensor_markdown_table(result.summary, intervals=False)
+    if sensor:
+        click.echo(("\n" if len(acts) else "") + "Sensor faults: what the FTC scheme "
+                   "does with them (% of judged trials)\n" + sensor)
     click.echo(f"\nwrote {out_dir}/: trials.parquet, resets.parquet, summary.parquet, "
                "summary.md (the full table)")
 

@@ -16,23 +16,36 @@ from ftc_mc.campaign.transitions import TRANSITION_TABLE  # noqa: E402
 from ftc_mc.config import Config, ScenarioConfig, render_yaml  # noqa: E402
 
 
+SENSOR_OUTPUTS = ("q", "n_x", "n_z", "alpha", "theta", "Va")
+"""Outputs of configs/sensor_faults.yaml: the three the residuals use, and three others."""
+SENSOR_KINDS = ("bias", "stuck", "drift")
+
+
 def campaign_configs() -> dict:
     """File name -> YAML text of every shipped campaign config."""
     files = {}
+    no_sensor = ("sensor_draws",)
     for name, tr in TRANSITION_TABLE.items():
         cfg = Config.model_validate({"campaign": {"transitions": [name]}})
         files[f"{name}.yaml"] = render_yaml(
             cfg, f"ftc-mc run configs/{name}.yaml -- one row of the paper's Tables 2-3: "
-                 f"{tr.label}")
+                 f"{tr.label}", omit=no_sensor)
     cfg = Config.model_validate({"campaign": {"transitions": list(TRANSITION_TABLE)}})
     files["paper_tables.yaml"] = render_yaml(
-        cfg, "ftc-mc run configs/paper_tables.yaml -- all eight rows of Tables 2-3")
+        cfg, "ftc-mc run configs/paper_tables.yaml -- all eight rows of Tables 2-3",
+        omit=no_sensor)
     cfg = Config.model_validate({"campaign": {"transitions": list(TRANSITION_TABLE)},
                                  "controller": {"kind": "nominal"}})
     files["sweep.yaml"] = render_yaml(
         cfg, "ftc-mc sweep configs/sweep.yaml --thresholds 5:100:5 -- the threshold "
              "trade-off over all eight rows of Tables 2-3 (nominal controller: the "
-             "thresholds act on the estimator)")
+             "thresholds act on the estimator)", omit=no_sensor)
+    cfg = Config.model_validate({"campaign": {"transitions": [
+        f"sensor_{k}:{o}" for o in SENSOR_OUTPUTS for k in SENSOR_KINDS]}})
+    files["sensor_faults.yaml"] = render_yaml(
+        cfg, "ftc-mc run configs/sensor_faults.yaml -- what the actuator FDI does with "
+             "sensor faults (issue 14): bias, stuck, drift on q, n_x, n_z, alpha, theta, "
+             "Va; default airframe, the paper's design")
     files["paper_scenario.yaml"] = render_yaml(
         ScenarioConfig(), "ftc-mc scenario configs/paper_scenario.yaml -- the paper's 100 s "
                           "landing approach (Table 4) with the full reconfiguring loop")

@@ -602,11 +602,11 @@ def sensor_fault_ref(z, v, zhold, k, dt, out, kind, size, k_onset):
     if name == "bias":
         z[out] = z[out] + size
     elif name == "drift":
-        z[out] = z[out] + size * ((k + 1 - k_onset) * dt)
+        z[out] = z[out] + size * (k + 1 - k_onset) * dt
     elif name == "stuck":
         z[out] = zhold
     else:
-        z[out] = z[out] - v[out] + size * v[out]
+        z[out] = z[out] + (size - 1.0) * v[out]
     return z, zhold
 
 

@@ -17,13 +17,14 @@ import numpy as np
 import pandas as pd
 
 from ..config.schema import Config
-from ..conventions import (BLOCK_NAMES, MODE_NAMES, STATUS_NAMES, STATUS_NONFINITE,
-                           STATUS_NOT_PSD)
+from ..conventions import (BLOCK_NAMES, C_NOMINAL, MODE_NAMES, MODE_NOMINAL, STATUS_AIRSPEED,
+                           STATUS_ALPHA, STATUS_NAMES, STATUS_NONFINITE, STATUS_NOT_PSD)
 from ..core.settings import TrialInputs, TrialRecord
-from ..sim.inputs import build_inputs, draw_lanes, flight_inputs
+from ..sim.inputs import build_inputs, draw_lanes, flight_inputs, sensor_faults
 from ..sim.lanes import simulate
 from ..sim.setup import SimSetup, build_setup, variants_of
-from .transitions import TRANSITION_TABLE, FaultRanges, fault_ranges
+from .transitions import (TRANSITION_TABLE, FaultRanges, SensorTransition, fault_ranges,
+                          is_sensor, transition_of)
 
 FLIGHT = "fault_free"
 """Chunk name of the fault-free flights of a sweep (false resets per flight hour)."""
@@ -51,6 +52,9 @@ class ChunkSpec:
     points : tuple of (float, float) or None
         A sweep's ``(t_q, t_nx)`` threshold points, run sharing each trial's
         start (``ftc_mc/sim/lanes.py``); ``None``: the config's thresholds.
+    sensor_ranges : dict of str to (float, float)
+        Size magnitude range of each sensor transition of the config
+        (``sensor_draws``).
     """
 
     setup: SimSetup
@@ -61,6 +65,7 @@ class ChunkSpec:
     window: int
     max_resets: int
     points: tuple | None = None
+    sensor_ranges: dict = dataclasses.field(default_factory=dict)
 
     @property
     def tables(self) -> tuple:
@@ -87,7 +92,10 @@ def chunk_spec(cfg: Config, setup: SimSetup | None = None, points=None) -> Chunk
                      near_trim=(cfg.explain.engine_lock_near_trim,
                                 cfg.explain.elevon_lock_near_trim_rad),
                      window=cfg.steps(cfg.timing.window_s), max_resets=cfg.resets_stored(),
-                     points=None if points is None else tuple(map(tuple, points)))
+                     points=None if points is None else tuple(map(tuple, points)),
+                     sensor_ranges={name: cfg.sensor_draws.size_range(tr.kind, tr.output)
+                                    for name in cfg.campaign.transitions if is_sensor(name)
+                                    for tr in [transition_of(name)]})
 
 
 def trial_inputs(spec: ChunkSpec, tr_name: str, trial_ids):
@@ -97,10 +105,18 @@ def trial_inputs(spec: ChunkSpec, tr_name: str, trial_ids):
     -------
     inp : TrialInputs
     values : ndarray, shape (L,)
-        The fault value of each trial (lock position or b1).
+        The fault value of each trial (lock position or b1; for a sensor
+        transition the sensor fault's size, NaN when stuck).
     """
-    tr = TRANSITION_TABLE[tr_name]
+    tr = transition_of(tr_name)
     setup = spec.setup
+    if isinstance(tr, SensorTransition):
+        draws = draw_lanes(setup, trial_ids, spec.seed, tr.DRAW_RANGE)
+        sizes = tr.sizes(draws.fault, spec.sensor_ranges[tr_name])
+        sensor = sensor_faults(tr.out_index, tr.kind_index, np.nan_to_num(sizes),
+                               setup.tim.k_fault)
+        return (build_inputs(setup, tr.schedule(draws.fault, setup.tim.k_fault), draws,
+                             sensor), sizes)
     draws = draw_lanes(setup, trial_ids, spec.seed, spec.ranges.of(tr))
     return build_inputs(setup, tr.schedule(draws.fault, setup.tim.k_fault), draws), draws.fault
 
@@ -142,6 +158,8 @@ def classify(spec: ChunkSpec, tr_name: str, variant: str, trial_ids, values,
     trials : dict of str to ndarray
     resets : dict of str to ndarray
     """
+    if is_sensor(tr_name):
+        return classify_sensor(spec, tr_name, variant, trial_ids, values, inp, rec)
     setup = spec.setup
     window_steps = spec.window
     tr = TRANSITION_TABLE[tr_name]
@@ -222,6 +240,138 @@ def classify(spec: ChunkSpec, tr_name: str, variant: str, trial_ids, values,
         "r_nz": rec.reset_res[slot, 2, lane],
         "in_window": in_win[slot, lane],
         "before_fault": before[slot, lane],
+    }
+    return trials, resets
+
+
+def _reset_columns(tr_name, variant, trial_ids, rec, kf, window_steps, dt):
+    """Resets of a chunk: the ``resets`` table, and the masks of stored resets in
+    the window and before the switch."""
+    R = rec.reset_k.shape[0]
+    stored = np.minimum(rec.n_resets, R)
+    valid = np.arange(R)[:, None] < stored[None, :]
+    k, blk = rec.reset_k, rec.reset_block
+    in_win = valid & (k > kf) & (k <= kf + window_steps)
+    before = valid & (k <= kf)
+    lane, slot = np.nonzero(valid.T)
+    kk = k[slot, lane]
+    resets = {
+        "transition": np.full(len(lane), tr_name, dtype=object),
+        "variant": np.full(len(lane), variant, dtype=object),
+        "trial_id": np.asarray(trial_ids, dtype=np.int64)[lane],
+        "time_s": kk * dt,
+        "time_from_fault_s": (kk - kf) * dt,
+        "block": np.array([BLOCK_NAMES[b] for b in blk[slot, lane]], dtype=object),
+        "r_q": rec.reset_res[slot, 0, lane],
+        "r_nx": rec.reset_res[slot, 1, lane],
+        "r_nz": rec.reset_res[slot, 2, lane],
+        "in_window": in_win[slot, lane],
+        "before_fault": before[slot, lane],
+    }
+    return resets, valid, in_win, before
+
+
+def _first_after(mask, steps, kf, dt):
+    """Per lane: whether ``mask`` (rows x lanes) holds anywhere, and the time from
+    the switch of its first row (``steps`` per row), NaN when never."""
+    any_ = mask.any(axis=0)
+    first = np.argmax(mask, axis=0)
+    st = steps[first] if steps.ndim == 1 else steps[first, np.arange(mask.shape[1])]
+    return any_, np.where(any_, (st - kf) * dt, np.nan)
+
+
+def classify_sensor(spec: ChunkSpec, tr_name: str, variant: str, trial_ids, sizes,
+                    inp: TrialInputs, rec: TrialRecord):
+    """Per-trial and per-reset columns of a sensor transition (issue 14).
+
+    The actuators stay healthy, so the correct block is ``none`` and every
+    action of the FTC scheme after the sensor fault (step ``k_f``) up to the end
+    of the trial (or its stop) is a misattribution:
+
+    * ``actuator_reset``: any covariance-block reset after ``k_f``
+      (``actuator_reset_s``: time from the fault to the first);
+    * ``wrong_mode``: at some belief update after ``k_f`` the most probable mode
+      is an actuator fault with probability at least 0.5 (``wrong_mode_s``);
+    * ``controller_switch``: the controller differs from the one in use at
+      ``k_f`` after some update (``controller_switch_s``);
+    * ``first_action_s``: the earliest of the three;
+    * ``envelope_exit``: the aircraft left the airspeed or angle-of-attack
+      envelope (the trial stopped there).
+
+    The actuator-row columns keep their definitions with the correct block
+    ``none``: ``correct`` is True for no reset in the window, ``inappropriate``
+    for any, and ``no_reset`` equals ``correct``; the summary does not report
+    them for sensor rows.  ``judged``: no numerical failure and every reset
+    stored (an envelope exit is an outcome here, not an exclusion).
+    """
+    setup = spec.setup
+    tr = transition_of(tr_name)
+    dt = setup.plant.dt
+    kf = setup.tim.k_fault
+    every = setup.tim.reconf_every
+    L = len(trial_ids)
+    resets, valid, in_win, before = _reset_columns(tr_name, variant, trial_ids, rec, kf,
+                                                   spec.window, dt)
+    after = valid & (rec.reset_k > kf)
+    act_reset, act_reset_s = _first_after(after, rec.reset_k, kf, dt)
+    n_per = rec.belief.shape[0]
+    kn = (np.arange(n_per) + 1) * every
+    alive = (rec.stop_k[None, :] < 0) | (kn[:, None] < rec.stop_k[None, :])
+    watch = (kn[:, None] > kf) & alive
+    best = np.argmax(rec.belief, axis=1)
+    pbest = np.max(rec.belief, axis=1)
+    wrong = watch & (best != MODE_NOMINAL) & (pbest >= 0.5)
+    wrong_mode, wrong_mode_s = _first_after(wrong, kn, kf, dt)
+    p_f = kf // every - 1
+    cur0 = rec.controller[p_f] if p_f >= 0 else np.full(L, C_NOMINAL)
+    switched = watch & (rec.controller != cur0[None, :])
+    switch, switch_s = _first_after(switched, kn, kf, dt)
+    first_action = np.fmin(np.fmin(act_reset_s, wrong_mode_s), switch_s)
+    n_win = in_win.sum(axis=0)
+    first = np.where(n_win > 0, np.argmax(in_win, axis=0), 0)
+    first_k = rec.reset_k[first, np.arange(L)]
+    first_block = rec.reset_block[first, np.arange(L)]
+    truncated = rec.n_resets > rec.reset_k.shape[0]
+    numeric_fail = (rec.status == STATUS_NONFINITE) | (rec.status == STATUS_NOT_PSD)
+    trials = {
+        "transition": np.full(L, tr_name, dtype=object),
+        "variant": np.full(L, variant, dtype=object),
+        "trial_id": np.asarray(trial_ids, dtype=np.int64),
+        "lock_position": np.full(L, np.nan),
+        "loss_b1": np.full(L, np.nan),
+        "mode_pre": np.array([MODE_NAMES[m] for m in inp.mode_pre], dtype=object),
+        "mode_post": np.array([MODE_NAMES[m] for m in inp.mode_post], dtype=object),
+        "correct": n_win == 0,
+        "inappropriate": n_win > 0,
+        "no_reset": n_win == 0,
+        "first_reset_s": np.where(n_win > 0, (first_k - kf) * dt, np.nan),
+        "first_reset_block": np.array([BLOCK_NAMES[b] if n else "none"
+                                       for b, n in zip(first_block, n_win)], dtype=object),
+        "resets_in_window": n_win.astype(np.int64),
+        "false_resets": before.sum(axis=0).astype(np.int64),
+        "resets_total": rec.n_resets.copy(),
+        "detection_s": np.full(L, np.nan),
+        "mode_changed": np.zeros(L, dtype=bool),
+        "detected": np.zeros(L, dtype=bool),
+        "small_b1": np.zeros(L, dtype=bool),
+        "lock_near_trim": np.zeros(L, dtype=bool),
+        "b0_hat_end": np.full(L, np.nan),
+        "b1_hat_end": np.full(L, np.nan),
+        "resets_truncated": truncated,
+        "judged": ~numeric_fail & ~truncated,
+        "status": np.array([STATUS_NAMES[s] for s in rec.status], dtype=object),
+        "stop_s": np.where(rec.stop_k >= 0, rec.stop_k * dt, np.nan),
+        "sensor_output": np.full(L, tr.output, dtype=object),
+        "sensor_kind": np.full(L, tr.kind, dtype=object),
+        "sensor_size": np.asarray(sizes, dtype=float),
+        "actuator_reset": act_reset,
+        "actuator_reset_s": act_reset_s,
+        "wrong_mode": wrong_mode,
+        "wrong_mode_s": wrong_mode_s,
+        "controller_switch": switch,
+        "controller_switch_s": switch_s,
+        "first_action_s": first_action,
+        "envelope_exit": (rec.status == STATUS_AIRSPEED) | (rec.status == STATUS_ALPHA),
     }
     return trials, resets
 

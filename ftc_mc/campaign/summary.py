@@ -2,6 +2,11 @@
 
 Rates carry 95 % Wilson score intervals (:func:`ftc_mc.stats.wilson`).  The
 paper's own counts stand beside ours.
+
+A sensor transition (``sensor_<kind>:<output>``, issue 14) has no correct
+actuator block, so its row has no Tables 2-3 columns (inappropriate, no reset,
+correct, delay, detection, the paper's counts: NaN in a run that mixes both
+kinds); it has the misattribution columns instead (:func:`sensor_row`).
 """
 
 from __future__ import annotations
@@ -11,7 +16,13 @@ import pandas as pd
 
 from ..core.trial import STATUS_NAMES
 from ..stats import median_p95, wilson
-from .transitions import PAPER_TABLES, TRANSITION_TABLE
+from .transitions import PAPER_TABLES, TRANSITION_TABLE, is_sensor, transition_of
+
+SENSOR_RATES = ("actuator_reset", "wrong_mode", "controller_switch", "misattributed",
+                "envelope_exit")
+"""Rates of a sensor row: any actuator-block reset after the fault, the belief's
+most probable mode an actuator fault (>= 0.5), a controller switch, any of the
+three (``misattributed``), and a departure from the validity envelope."""
 
 
 def _rate(prefix: str, k: int, n: int) -> dict:
@@ -45,7 +56,12 @@ def summarize(trials: pd.DataFrame) -> pd.DataFrame:
     """
     rows = []
     order = {name: i for i, name in enumerate(TRANSITION_TABLE)}
+    for name in trials["transition"].unique():
+        order.setdefault(name, len(order))
     for (name, variant), g in trials.groupby(["transition", "variant"], sort=False):
+        if is_sensor(name):
+            rows.append(sensor_row(name, variant, g))
+            continue
         ok = g[g["judged"]]
         n = len(ok)
         no_reset = ok["no_reset"].to_numpy()
@@ -80,6 +96,84 @@ def summarize(trials: pd.DataFrame) -> pd.DataFrame:
     return out
 
 
+def sensor_row(name: str, variant: str, g: pd.DataFrame) -> dict:
+    """The summary row of the trials ``g`` of sensor transition ``name``.
+
+    Over the judged trials (no numerical failure, every reset stored): the rates
+    of :data:`SENSOR_RATES` with Wilson intervals, and the median / p95 time
+    from the sensor fault to each first action and to the first of any.
+    """
+    tr = transition_of(name)
+    ok = g[g["judged"].astype(bool)]
+    n = len(ok)
+    row = {"transition": name, "label": tr.label, "variant": variant, "trials": n,
+           "excluded": len(g) - n, "sensor_output": tr.output, "sensor_kind": tr.kind}
+    for reason in STATUS_NAMES[1:]:
+        row[f"stopped_{reason}"] = int((g["status"] == reason).sum())
+    row["resets_truncated"] = int(g["resets_truncated"].astype(bool).sum())
+    any_action = (ok["actuator_reset"].astype(bool) | ok["wrong_mode"].astype(bool)
+                  | ok["controller_switch"].astype(bool))
+    flags = {"actuator_reset": ok["actuator_reset"].astype(bool),
+             "wrong_mode": ok["wrong_mode"].astype(bool),
+             "controller_switch": ok["controller_switch"].astype(bool),
+             "misattributed": any_action,
+             "envelope_exit": ok["envelope_exit"].astype(bool)}
+    for key in SENSOR_RATES:
+        row.update(_rate(key, int(flags[key].sum()), n))
+    for key in ("actuator_reset", "wrong_mode", "controller_switch"):
+        row.update(_quantiles(key, ok[f"{key}_s"].to_numpy(dtype=float)))
+    row.update(_quantiles("first_action", ok["first_action_s"].to_numpy(dtype=float)))
+    row["false_resets"] = int(ok["false_resets"].sum())
+    return row
+
+
+def sensor_markdown_table(summary: pd.DataFrame, intervals: bool = True) -> str:
+    """The misattribution table of the sensor rows of a summary (issue 14).
+
+    Per sensor transition and variant: judged trials, the share with an
+    actuator-block reset, a wrong mode (an actuator fault most probable with
+    >= 0.5), a controller switch, any of them, and an envelope exit (95 % Wilson
+    intervals when ``intervals``), and the median time from the fault to the first
+    action.  Empty string without sensor rows.
+    """
+    if "transition" not in summary or not summary["transition"].map(is_sensor).any():
+        return ""
+    rows = []
+    for _, r in summary[summary["transition"].map(is_sensor)].iterrows():
+        def pct(p):
+            if not np.isfinite(r[p + "_rate"]):
+                return "-"
+            if not intervals:
+                return f"{100 * r[p + '_rate']:.1f}"
+            return (f"{100 * r[p + '_rate']:.1f} ({100 * r[p + '_ci_low']:.1f}-"
+                    f"{100 * r[p + '_ci_high']:.1f})")
+        med = r["first_action_median_s"]
+        rows.append({
+            "sensor fault": r["transition"], "signature": r["variant"],
+            "judged": int(r["trials"]),
+            "actuator reset %": pct("actuator_reset"),
+            "wrong mode %": pct("wrong_mode"),
+            "ctrl switch %": pct("controller_switch"),
+            "any %": pct("misattributed"),
+            "envelope exit %": pct("envelope_exit"),
+            "1st action med [s]": "-" if not np.isfinite(med) else f"{med:.1f}",
+        })
+    return pd.DataFrame(rows).to_markdown(index=False)
+
+
+_COUNTS = ("inappropriate", "no_reset", "no_reset_explained", "correct", "false_alarm_trials",
+           "mode_changes", "detected", "paper_trials", "paper_inappropriate", "paper_no_reset")
+
+
+def actuator_rows(summary: pd.DataFrame) -> pd.DataFrame:
+    """The rows of actuator transitions (Tables 2-3), without the sensor columns and
+    with their counts as integers again (a run mixing both kinds has NaN there)."""
+    if "transition" not in summary or not summary["transition"].map(is_sensor).any():
+        return summary
+    sub = summary[~summary["transition"].map(is_sensor)].dropna(axis=1, how="all")
+    return sub.astype({c: "int64" for c in _COUNTS if c in sub})
+
+
 def markdown_table(summary: pd.DataFrame) -> str:
     """The summary as the paper's columns plus ours, in Markdown.
 
@@ -94,6 +188,10 @@ def markdown_table(summary: pd.DataFrame) -> str:
     def num(x, fmt="{:.1f}"):
         return "-" if not np.isfinite(x) else fmt.format(x)
 
+    sensor = sensor_markdown_table(summary)
+    summary = actuator_rows(summary)
+    if not len(summary):
+        return sensor
     rows = []
     for _, r in summary.iterrows():
         rows.append({
@@ -109,4 +207,5 @@ def markdown_table(summary: pd.DataFrame) -> str:
             "paper: inappropriate / no reset": f"{r['paper_inappropriate']} / "
                                                f"{r['paper_no_reset']} of {r['paper_trials']}",
         })
-    return pd.DataFrame(rows).to_markdown(index=False)
+    table = pd.DataFrame(rows).to_markdown(index=False)
+    return table + ("\n\n" + sensor if sensor else "")

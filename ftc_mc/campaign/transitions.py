@@ -15,6 +15,8 @@ import dataclasses
 
 import numpy as np
 
+from ..config.schema import parse_sensor_transition
+from ..conventions import OUTPUT_NAMES, SENSOR_FAULT_KINDS, SENSOR_PREFIX
 from ..sim.inputs import Schedule
 
 ENGINE, LEFT, RIGHT = 0, 1, 2
@@ -145,3 +147,73 @@ def fault_ranges(draws, u_lower, u_upper) -> FaultRanges:
     for a, (lo, hi) in lock.items():
         assert u_lower[a] <= lo < hi <= u_upper[a], (a, lo, hi)
     return FaultRanges(lock=lock, loss=tuple(draws.loss_b1_range))
+
+
+@dataclasses.dataclass(frozen=True)
+class SensorTransition:
+    """A sensor fault from nominal (issue 14): ``sensor_<kind>:<output>``.
+
+    The actuators stay healthy throughout, so the correct covariance block is
+    ``none``: any reset after the fault step is a misattribution.  The trial's
+    first draw is the fault's size (:meth:`sizes`).
+
+    Attributes
+    ----------
+    name : str
+    kind : str
+        One of :data:`~ftc_mc.conventions.SENSOR_FAULT_KINDS`.
+    output : str
+        One of :data:`~ftc_mc.conventions.OUTPUT_NAMES`.
+    """
+
+    name: str
+    kind: str
+    output: str
+
+    @property
+    def label(self) -> str:
+        return f"{self.output} sensor {self.kind}"
+
+    @property
+    def out_index(self) -> int:
+        return OUTPUT_NAMES.index(self.output)
+
+    @property
+    def kind_index(self) -> int:
+        return SENSOR_FAULT_KINDS.index(self.kind)
+
+    DRAW_RANGE = (-1.0, 1.0)
+    """Range of the trial's first draw: its sign is the fault's, its magnitude
+    places the size in the configured range (one uniform draw, as an actuator
+    transition's)."""
+
+    def sizes(self, draws: np.ndarray, size_range) -> np.ndarray:
+        """Fault sizes from the first draws ``draws`` (uniform over
+        :attr:`DRAW_RANGE`): bias and drift ``sign(d) (low + |d| (high - low))``;
+        a noise factor ``low + |d| (high - low)``; stuck: NaN (no size)."""
+        lo, hi = size_range
+        mag = lo + np.abs(draws) * (hi - lo)
+        if self.kind == "stuck":
+            return np.full(len(draws), np.nan)
+        if self.kind == "noise":
+            return mag
+        return np.where(draws < 0, -mag, mag)
+
+    def schedule(self, values: np.ndarray, k_fault: int) -> Schedule:
+        """Every actuator healthy throughout (one nominal entry)."""
+        L = len(values)
+        return Schedule(k_switch=np.zeros(1, dtype=np.int64), b0=np.zeros((1, 3, L)),
+                        b1=np.zeros((1, 3, L)))
+
+
+def transition_of(name: str):
+    """The :class:`Transition` or :class:`SensorTransition` named ``name`` (validated)."""
+    if name in TRANSITION_TABLE:
+        return TRANSITION_TABLE[name]
+    kind, output = parse_sensor_transition(name)
+    return SensorTransition(name, kind, output)
+
+
+def is_sensor(name: str) -> bool:
+    """Whether ``name`` is a sensor transition."""
+    return name.startswith(SENSOR_PREFIX)

@@ -13,10 +13,11 @@ from __future__ import annotations
 import math
 from typing import Annotated, Literal
 
-from pydantic import (BaseModel, BeforeValidator, ConfigDict, Field, field_validator,
-                      model_validator)
+from pydantic import (AfterValidator, BaseModel, BeforeValidator, ConfigDict, Field,
+                      field_validator, model_validator)
 
-from ..conventions import ACTUATOR_NAMES, PLANT_KINDS, TRANSITIONS, TURBULENCE_LEVELS
+from ..conventions import (ACTUATOR_NAMES, OUTPUT_NAMES, PLANT_KINDS, SENSOR_FAULT_KINDS,
+                           SENSOR_PREFIX, TRANSITIONS, TURBULENCE_LEVELS)
 from ..errors import UserError
 from ..model.source import (DEFAULT_AIRFRAME, check_airframe, check_condition,
                             command_limits, is_linear_model)
@@ -277,12 +278,114 @@ class ValidityConfig(_Strict):
         return self
 
 
+def parse_sensor_transition(name: str):
+    """``(kind, output)`` of a transition named ``sensor_<kind>:<output>``, or None
+    when ``name`` is not a sensor transition; ValueError when it is a malformed one."""
+    if not name.startswith(SENSOR_PREFIX):
+        return None
+    kind, sep, output = name[len(SENSOR_PREFIX):].partition(":")
+    if not sep or kind not in SENSOR_FAULT_KINDS:
+        raise ValueError(f"{name!r} is not sensor_<kind>:<output> with kind one of "
+                         f"{list(SENSOR_FAULT_KINDS)}")
+    if output not in OUTPUT_NAMES:
+        raise ValueError(f"{name!r}: unknown output {output!r}; outputs are "
+                         f"{list(OUTPUT_NAMES)}")
+    return kind, output
+
+
+def _transition_name(name: str) -> str:
+    if name in TRANSITIONS or parse_sensor_transition(name) is not None:
+        return name
+    raise ValueError(f"unknown transition {name!r}: one of {list(TRANSITIONS)} or "
+                     f"sensor_<kind>:<output> (kinds {list(SENSOR_FAULT_KINDS)})")
+
+
+TransitionName = Annotated[str, AfterValidator(_transition_name)]
+
+SizeRange = tuple[NonNeg, NonNeg]
+
+_DEG = math.pi / 180.0
+DEFAULT_SENSOR_BIAS = {
+    "u": (0.2, 1.0), "w": (0.2, 1.0),
+    "q": (round(1 * _DEG, 6), round(5 * _DEG, 6)),
+    "x": (1.0, 5.0), "z": (1.0, 5.0),
+    "theta": (round(1 * _DEG, 6), round(3 * _DEG, 6)),
+    "n_x": (0.02, 0.08), "n_z": (0.02, 0.08),
+    "alpha": (round(1 * _DEG, 6), round(3 * _DEG, 6)),
+    "gamma": (round(0.5 * _DEG, 6), round(2 * _DEG, 6)),
+    "CAS": (0.5, 2.0), "Va": (0.5, 2.0),
+}
+"""Default bias magnitudes per output, in the output's unit (module docs of
+:class:`SensorDrawsConfig`)."""
+
+
+class SensorDrawsConfig(_Strict):
+    """Sizes of the sensor faults of ``sensor_<kind>:<output>`` transitions (issue 14).
+
+    Each trial's size is the first draw of its stream: a magnitude uniform in
+    ``[low, high]`` with a random sign (one uniform draw over (-1, 1): its sign
+    and its magnitude), so the later draws (noise, gusts) are those of the actuator
+    transitions.  A stuck sensor holds its last healthy value and has no size.
+    """
+
+    bias: dict[str, SizeRange] = Field(default_factory=lambda: dict(DEFAULT_SENSOR_BIAS))
+    """Bias magnitude range per output, in its unit (rad/s, g, rad, m/s, m); outputs
+    left out keep their default.  Defaults from typical small-UAV sensors: gyro
+    1-5 deg/s (InvenSense MPU-6000 datasheet: initial zero-rate output +-20 deg/s;
+    ICM-20602: +-1 deg/s), accelerometer 20-80 mg (MPU-6000 zero-g offset +-50 mg
+    x/y, +-80 mg z), pitot airspeed 0.5-2 m/s (TE Connectivity MS4525DO, 1 psi:
+    +-0.25 % full scale, about 1 m/s at 20 m/s after calibration), vane angle of
+    attack 1-3 deg (typical vane alignment error), attitude 1-3 deg and flight
+    path 0.5-2 deg (AHRS/INS error of a MEMS unit, e.g. Analog Devices ADIS16470
+    class), GNSS position 1-5 m and velocities 0.2-1 m/s (u-blox NEO-M8: 2.5 m CEP,
+    0.05 m/s speed; wind makes body velocities worse)."""
+    drift_per_s: Pos = 0.1
+    """Drift rate range = this x the bias range, per second [1/s]: the drift
+    reaches the bias range after 10 s, the judging window (MEMS temperature drift
+    over a flight, MPU-6000: +-20 deg/s over -40..85 C)."""
+    noise_factor: SizeRange = (2.0, 10.0)
+    """Range of the factor on the output's measurement noise standard deviation
+    (a vibrating mount or a failing sensor; factor >= 0)."""
+
+    @field_validator("bias")
+    @classmethod
+    def _bias(cls, ranges: dict) -> dict:
+        for out, (lo, hi) in ranges.items():
+            if out not in OUTPUT_NAMES:
+                raise ValueError(f"unknown output {out!r}; outputs are {list(OUTPUT_NAMES)}")
+            if not lo < hi:
+                raise ValueError(f"{out}: must be [low, high] with low < high, "
+                                 f"got {[lo, hi]}")
+        return {**DEFAULT_SENSOR_BIAS, **ranges}
+
+    @model_validator(mode="after")
+    def _ordered(self):
+        lo, hi = self.noise_factor
+        if not lo < hi:
+            raise ValueError(f"noise_factor: must be [low, high] with low < high, "
+                             f"got {[lo, hi]}")
+        return self
+
+    def size_range(self, kind: str, output: str) -> tuple:
+        """``(low, high)`` of the size magnitude of ``kind`` on ``output``."""
+        if kind == "bias":
+            return tuple(self.bias[output])
+        if kind == "drift":
+            lo, hi = self.bias[output]
+            return (lo * self.drift_per_s, hi * self.drift_per_s)
+        if kind == "noise":
+            return tuple(self.noise_factor)
+        return (0.0, 1.0)
+
+
 class CampaignConfig(_Strict):
     """What to run."""
 
-    transitions: list[Literal[TRANSITIONS]] = Field(default_factory=lambda: ["elevon_lock"],
-                                                    min_length=1)
-    """Transitions to run (elevon or engine x lock, unlock, loss, loss_recover)."""
+    transitions: list[TransitionName] = Field(default_factory=lambda: ["elevon_lock"],
+                                              min_length=1)
+    """Transitions to run (elevon or engine x lock, unlock, loss, loss_recover), or
+    sensor faults ``sensor_<kind>:<output>`` (kind bias, stuck, drift, noise; output
+    one of the 12, e.g. ``sensor_bias:q``) from nominal at timing.fault_time_s."""
     trials: Annotated[int, NoBool, Field(gt=0, le=10_000_000)] = 1000
     """Trials per transition."""
     seed: Annotated[int, NoBool, Field(ge=0, lt=2 ** 63)] = 2026
@@ -315,6 +418,7 @@ class Config(_Sampled):
     timing: TimingConfig = Field(default_factory=TimingConfig)
     explain: ExplainConfig = Field(default_factory=ExplainConfig)
     validity: ValidityConfig = Field(default_factory=ValidityConfig)
+    sensor_draws: SensorDrawsConfig = Field(default_factory=SensorDrawsConfig)
 
     @model_validator(mode="after")
     def _steps(self):
@@ -336,6 +440,11 @@ class Config(_Sampled):
             if r is not None and (r[0] < lower[a] or r[1] > upper[a]):
                 raise ValueError(f"draws.{name}: must lie within the command range "
                                  f"[{lower[a]:g}, {upper[a]:g}], got {list(r)}")
+        for i, name in enumerate(self.campaign.transitions):
+            sensor = parse_sensor_transition(name)
+            if sensor and sensor[0] == "noise" and self.noise.measurement_scale == 0:
+                raise ValueError(f"campaign.transitions.{i}: {name} scales the measurement "
+                                 "noise, but noise.measurement_scale is 0 (none is simulated)")
         return self
 
     def resets_stored(self) -> int:

@@ -310,12 +310,18 @@ def run_section(r: ResultDir, fig_dir: Path, slug: str, report: Path) -> list:
     """
     from ..plots.campaign import delay_figure  # matplotlib only when drawing
 
-    summary, trials = r.tables["summary"], r.tables["trials"]
+    from .sensors import actuator_part, misattribution_table
+
+    full_summary = r.tables["summary"]
+    summary, trials = actuator_part(full_summary, r.tables["trials"])
     cfg = r.meta.get("config", {})
+    head = [f"## Run `{r.path}`", "", _run_header(cfg), ""]
+    sensor = misattribution_table(full_summary)
+    if not len(summary):
+        return head + sensor
     fig = delay_figure(trials, fig_dir / f"{slug}_delays.png", LABELS)
-    return ([f"## Run `{r.path}`", "", _run_header(cfg), "",
-             "### Tables 2-3: ours beside the paper", ""] + paper_tables(summary)
+    return (head + ["### Tables 2-3: ours beside the paper", ""] + paper_tables(summary)
             + ["### Excluded trials", ""] + exclusion_table(summary, trials, cfg)
             + ["### Which signature variant is better", ""] + variant_comparison(trials)
             + ["### Delay distributions", "", f"![delays of {slug}]({rel_link(fig, report)})",
-               ""])
+               ""] + sensor)
