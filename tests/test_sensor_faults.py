@@ -216,3 +216,54 @@ def test_cli_bad_sensor_name_exit_2_nothing_written(tmp_path, bad):
     assert res.exit_code == 2, res.output
     assert len(res.output.strip().splitlines()) == 1 and "campaign.transitions.0" in res.output
     assert not out.exists()
+
+
+# ------------------------------------------------------------------ scenarios
+def _scenario_with(sensor_fault, duration_s=20.0):
+    from ftc_mc.config import ScenarioConfig
+
+    return ScenarioConfig.model_validate({"scenario": {
+        "duration_s": duration_s, "schedule": [{"time_s": 0.0, "fault": "nominal"}],
+        "sensor_fault": sensor_fault}})
+
+
+def test_scenario_sensor_fault_acts_on_its_output_from_its_onset():
+    # the same flight without and with a pitch-gyro bias from 10 s: identical
+    # before the onset, then the filter sees the bias (its q residual jumps)
+    from ftc_mc.scenario import run_scenario
+
+    calm = run_scenario(_scenario_with(None)).timeseries
+    res = run_scenario(_scenario_with({"time_s": 10.0, "kind": "bias", "output": "q",
+                                       "size": 0.05}))
+    ts = res.timeseries
+    before = ts.time_s <= 10.0 + 1e-9
+    pd.testing.assert_frame_equal(ts[before], calm[before], check_exact=True)
+    after = np.isclose(ts.time_s, 10.1)
+    assert ts.r_q[after].iloc[0] > 100 * calm.r_q[after].iloc[0]
+    ev = res.events
+    assert ((ev.kind == "sensor_fault") & (ev.detail == "q bias 0.05")
+            & (ev.time_s == 10.0)).sum() == 1
+
+
+@pytest.mark.parametrize("fault, message", [
+    ({"time_s": 5.0, "kind": "bias", "output": "pitch", "size": 0.1}, "output"),
+    ({"time_s": 5.0, "kind": "bias", "output": "q"}, "needs a size"),
+    ({"time_s": 5.0, "kind": "stuck", "output": "q", "size": 1.0}, "takes no size"),
+    ({"time_s": 5.0, "kind": "noise", "output": "q", "size": -2.0}, "must be > 0"),
+    ({"time_s": 5.0, "kind": "drift", "output": "q", "size": float("nan")}, "size"),
+    ({"time_s": 5.05, "kind": "bias", "output": "q", "size": 0.1}, "multiple"),
+    ({"time_s": 30.0, "kind": "bias", "output": "q", "size": 0.1}, "before"),
+])
+def test_scenario_sensor_fault_errors_name_the_field(fault, message, tmp_path):
+    from ftc_mc.cli import cli
+
+    path = tmp_path / "sc.yaml"
+    path.write_text(yaml.safe_dump({"scenario": {
+        "duration_s": 20.0, "schedule": [{"time_s": 0.0, "fault": "nominal"}],
+        "sensor_fault": fault}}))
+    res = CliRunner().invoke(cli, ["scenario", str(path), "--out", str(tmp_path / "o")])
+    assert res.exit_code == 2, res.output
+    line = res.output.strip().splitlines()
+    assert len(line) == 1 and "scenario.sensor_fault" in line[0] and message in line[0], \
+        res.output
+    assert not (tmp_path / "o").exists()

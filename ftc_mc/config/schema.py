@@ -483,6 +483,30 @@ class FaultEvent(_Strict):
         return self
 
 
+class SensorFaultEvent(_Strict):
+    """A sensor fault of a scenario: on one output, from ``time_s`` to the end."""
+
+    time_s: NonNeg
+    """Onset [s] (a multiple of model.dt_s)."""
+    kind: Literal[SENSOR_FAULT_KINDS]
+    """``bias`` (a step), ``stuck`` (frozen at its last healthy value), ``drift`` (a ramp) or ``noise`` (the noise multiplied)."""
+    output: Literal[OUTPUT_NAMES]
+    """Faulty output (u, w, q, x, z, theta, n_x, n_z, alpha, gamma, CAS, Va)."""
+    size: Finite | None = None
+    """Bias [output unit], drift [unit/s] (either sign), noise factor (> 0); none for stuck."""
+
+    @model_validator(mode="after")
+    def _size(self):
+        if self.kind == "stuck":
+            if self.size is not None:
+                raise ValueError("size: a stuck sensor takes no size")
+        elif self.size is None:
+            raise ValueError(f"size: a {self.kind} fault needs a size")
+        elif self.kind == "noise" and not self.size > 0:
+            raise ValueError(f"size: a noise factor must be > 0, got {self.size:g}")
+        return self
+
+
 class ScenarioSpec(_Strict):
     """The closed-loop scenario: fault schedule, length, seed, signature."""
 
@@ -505,6 +529,8 @@ class ScenarioSpec(_Strict):
         FaultEvent(time_s=90.0, fault="lock", actuator="left_elevon", position="trim"),
     ], min_length=1)
     """Fault schedule, sorted by time, first entry at 0 s (default: paper Table 4)."""
+    sensor_fault: SensorFaultEvent | None = None
+    """A sensor fault from its onset to the end (null: healthy sensors)."""
 
     @model_validator(mode="after")
     def _sorted(self):
@@ -556,6 +582,16 @@ class ScenarioConfig(_Sampled):
             if not math.isfinite(n) or abs(n - round(n)) > 1e-9 * max(1.0, n):
                 raise ValueError(f"scenario.schedule.{i}.time_s: must be a multiple of "
                                  f"model.dt_s ({dt:g} s), got {e.time_s:g}")
+        sf = sc.sensor_fault
+        if sf is not None:
+            n = sf.time_s / dt
+            if not math.isfinite(n) or abs(n - round(n)) > 1e-9 * max(1.0, n):
+                raise ValueError(f"scenario.sensor_fault.time_s: must be a multiple of "
+                                 f"model.dt_s ({dt:g} s), got {sf.time_s:g}")
+            if not sf.time_s < sc.duration_s:
+                raise ValueError(f"scenario.sensor_fault.time_s: must be before "
+                                 f"scenario.duration_s ({sc.duration_s:g} s), got "
+                                 f"{sf.time_s:g}")
         _check_periods(dt, _shared_periods(self))
         _check_length("scenario.duration_s", sc.duration_s, dt)
         return self

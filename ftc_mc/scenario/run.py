@@ -149,6 +149,10 @@ def _events(ts: pd.DataFrame, sc: ScenarioConfig, rec, setup) -> pd.DataFrame:
                 f"{e.actuator} {e.fault} " + (f"at {e.position}" if e.fault == "lock"
                                                else f"b1={e.b1:g}"))
         rows.append((e.time_s, "fault_switch", what))
+    sf = sc.scenario.sensor_fault
+    if sf is not None:
+        size = "" if sf.size is None else f" {sf.size:g}"
+        rows.append((sf.time_s, "sensor_fault", f"{sf.output} {sf.kind}{size}"))
     blocks = ts["reset_block"].to_numpy()
     for k in np.flatnonzero(blocks):
         r = ts.iloc[k]

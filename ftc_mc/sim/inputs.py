@@ -35,7 +35,7 @@ from collections import namedtuple
 
 import numpy as np
 
-from ..conventions import ACTUATOR_NAMES, NO_SENSOR_FAULT
+from ..conventions import ACTUATOR_NAMES, NO_SENSOR_FAULT, OUTPUT_NAMES, SENSOR_FAULT_KINDS
 from ..core.settings import TrialInputs
 from ..model.faults import estimator_params, mode_of
 
@@ -245,8 +245,12 @@ def scenario_inputs(setup, spec) -> TrialInputs:
     ----------
     setup : SimSetup
     spec : ScenarioSpec
-        The validated ``scenario`` section (schedule and seed).
+        The validated ``scenario`` section (schedule, sensor fault and seed).
     """
     plant = setup.plant
+    sf = spec.sensor_fault
+    sensor = None if sf is None else sensor_faults(
+        OUTPUT_NAMES.index(sf.output), SENSOR_FAULT_KINDS.index(sf.kind),
+        [0.0 if sf.size is None else sf.size], int(round(sf.time_s / plant.dt)))
     return build_inputs(setup, scenario_schedule(spec.schedule, plant.u0, plant.dt),
-                        draw_lanes(setup, [0], spec.seed))
+                        draw_lanes(setup, [0], spec.seed), sensor)
