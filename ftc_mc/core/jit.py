@@ -66,30 +66,37 @@ def index_has_overload(index_keys, magic, code_hash) -> bool:
     return False
 
 
-def needs_compile(dispatcher) -> bool | None:
-    """Whether calling ``dispatcher`` will compile it (no overload in this
-    process, none in the on-disk cache for this machine and source).
+def in_disk_cache(dispatcher) -> bool | None:
+    """Whether Numba's on-disk cache holds an overload of ``dispatcher`` for this
+    machine and source (so calling it loads instead of compiling).
 
     Reads the cache index the way Numba's ``FunctionCache`` does (the source
     stamp of the function's file, then the key's target and bytecode hash); the
     signature itself is not checked, since the campaign, sweep and scenario
     paths call the trial kernel with one and the same signature.  Returns
     ``None`` when the cache's layout is not the expected one (a Numba version
-    that changed it): then nothing is announced.
+    that changed it).
     """
-    if dispatcher.signatures:
-        return False
-    if not CACHE:
-        return True
     import hashlib
     try:
-        cache_file = dispatcher._cache._cache_file
-        index = cache_file._load_index()
+        index = dispatcher._cache._cache_file._load_index()
         magic = dispatcher.targetctx.codegen().magic_tuple()
     except Exception:  # noqa: BLE001 -- numba internals; the notice is optional
         return None
     code_hash = hashlib.sha256(dispatcher.py_func.__code__.co_code).hexdigest()
-    return not index_has_overload(index.keys(), magic, code_hash)
+    return index_has_overload(index.keys(), magic, code_hash)
+
+
+def needs_compile(dispatcher) -> bool | None:
+    """Whether calling ``dispatcher`` will compile it: no overload in this
+    process and none in the on-disk cache (:func:`in_disk_cache`).  ``None``
+    when that cannot be told (then nothing is announced)."""
+    if dispatcher.signatures:
+        return False
+    if not CACHE:
+        return True
+    cached = in_disk_cache(dispatcher)
+    return None if cached is None else not cached
 
 
 def announce_compile(dispatcher, duration="1 min", stream=None) -> bool:
