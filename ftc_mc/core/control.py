@@ -17,6 +17,15 @@ follows the model), giving the short-horizon cost ``I(a)`` (eq. 45) and
 minimising ``I(a) + sum_m b_{k+H}(m) (J^N(m, a) + P(c, a))`` (eqs. 46-47) is
 chosen.
 
+The trial loop selects for all its lanes at once
+(:func:`select_controllers_lanes`): each controller's horizon is predicted for
+every lane with the lane-interleaved filter kernels of :mod:`ftc_mc.core.batch`,
+then belief and objective follow per lane.  Per lane this is
+:func:`select_controller` bit for bit (``tests/test_stages.py``); measured on a
+chunk of 128 lanes of ``configs/paper_tables.yaml``, one core: 2.9 ms per
+selection against 9.3 ms one lane at a time (of which the measurement updates
+take about 60 %, the predictions 35 %).
+
 Plain-NumPy twins: ``tests/naive.py`` (``controller_command_ref``,
 ``horizon_cost_ref``, ``controller_objectives_ref``), compared in
 ``tests/test_stages.py``.
