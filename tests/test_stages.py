@@ -40,7 +40,8 @@ from ftc_mc.conventions import (C_ELEVON, C_ENGINE, C_NOMINAL, I_B0_ELEVONS,
                                 STATUS_NOT_PSD, STATUS_OK)
 from ftc_mc.core import control, plant as kplant, stages, trial
 from ftc_mc.core.settings import LaneState, TrialInputs, TrialRecord
-from ftc_mc.core.workspace import new_selection_work, new_trial_work
+from ftc_mc.core.workspace import (new_lane_selection_work, new_selection_work,
+                                   new_trial_work)
 from ftc_mc.config import Config
 
 L = 7  # not a multiple of the vector width: remainders run too
@@ -295,6 +296,50 @@ def test_select_controller(linear):
         gap = np.sort(obj)[1] - np.sort(obj)[0]
         assert got == want or gap <= 1e-12 * np.abs(obj).max()
         chosen.add(got)
+    assert len(chosen) >= 2, chosen
+
+
+@pytest.mark.parametrize("n_lanes", [L, 24])
+def test_select_controllers_lanes_is_the_single_lane_kernel(linear, n_lanes):
+    """The lane-interleaved selection (used by the reconfigure stage) gives every
+    lane's objectives and choice bit for bit as :func:`control.select_controller`
+    on that lane alone: same operations in the same order, zero-innovation
+    updates included.  Lanes far from trim (saturating), in every mode's box,
+    with every controller in use, and one non-finite (stopped) lane that must
+    not disturb the others."""
+    rng = np.random.default_rng(31)
+    scheme = scheme_of(linear)
+    work = new_selection_work(N_AUG)
+    lw = new_lane_selection_work(n_lanes, N_AUG)
+    chosen = set()
+    for rep in range(3):
+        xa = np.zeros((N_AUG, n_lanes))
+        P = np.zeros((N_AUG, N_AUG, n_lanes))
+        belief = np.zeros((4, n_lanes))
+        for l in range(n_lanes):
+            xa[:, l], P[:, :, l] = selection_case(linear, rng)
+            belief[:, l] = np.full(4, 1e-6)
+            belief[(l + rep) % 4, l] = 1.0
+            belief[:, l] /= belief[:, l].sum()
+        xa[:N_X, 0] *= 40.0  # far from trim: the commands saturate
+        xa[:, -1] = np.nan   # a stopped lane gone non-finite
+        cur = (np.arange(n_lanes) + rep) % N_CONTROLLERS
+        want_cur = cur.copy()
+        want_obj = np.zeros((N_CONTROLLERS, n_lanes))
+        for l in range(n_lanes):
+            want_cur[l] = control.select_controller(int(cur[l]), xa[:, l].copy(),
+                                                    P[:, :, l].copy(), belief[:, l].copy(),
+                                                    scheme, work)
+            want_obj[:, l] = work.obj
+        got = cur.copy()
+        xa0, P0, b0 = xa.copy(), P.copy(), belief.copy()
+        control.select_controllers_lanes(got, xa, P, belief, scheme, lw)
+        assert np.array_equal(lw.obj, want_obj, equal_nan=True)
+        assert np.array_equal(got, want_cur)
+        assert np.array_equal(xa, xa0, equal_nan=True) and np.array_equal(P, P0)
+        assert np.array_equal(belief, b0)
+        assert np.all(np.isfinite(lw.obj[:, :-1]))
+        chosen.update(got[:-1].tolist())
     assert len(chosen) >= 2, chosen
 
 

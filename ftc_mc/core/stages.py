@@ -40,7 +40,8 @@ from ..conventions import (C_ELEVON, I_B1_LEFT, I_B1_THRUST, N_FAULT, N_MODES, N
                            STATUS_ALPHA, STATUS_NONFINITE, STATUS_NOT_PSD, STATUS_OK)
 from .batch import filter_step_lanes
 from .belief import belief_update
-from .control import U_LEFT, U_RIGHT, U_THRUST, controller_command, select_controller
+from .control import (U_LEFT, U_RIGHT, U_THRUST, controller_command,
+                      select_controllers_lanes)
 from .excitation import (doublet, doublet_length, running, saturate, signal_3211,
                          signal_3211_length)
 from .jit import kernel
@@ -351,8 +352,11 @@ def reconfigure(scheme, timing, inp, st, kn, period, work, rec):
 
     Per lane: the belief update (eqs. 13-14) with the fault-parameter estimate
     and its marginal variances (eq. 12); for the reconfiguring scheme
-    (``reconfig.kind != 0``) the controller selection (eqs. 45-47,
-    :func:`ftc_mc.core.control.select_controller`); and the detection time: the
+    (``reconfig.kind != 0``) the controller selection (eqs. 45-47), for every
+    lane at once (:func:`ftc_mc.core.control.select_controllers_lanes`, per
+    lane bit-identical to :func:`~ftc_mc.core.control.select_controller`; the
+    horizon predictions run lane-interleaved, about 4x faster than one lane at
+    a time); and the detection time: the
     first period end after the switch ``k_fault`` where the final mode is the
     most probable with at least ``detect_prob`` (live lanes only).
 
@@ -372,19 +376,19 @@ def reconfigure(scheme, timing, inp, st, kn, period, work, rec):
     period : int
         Index of the period that ends at ``kn`` (row of the record).
     work : TrialWork
-        One-lane buffers ``bl``, ``bhat``, ``bvar``, ``bwork``, ``xl``, ``Pl``,
-        ``sel``.
+        One-lane buffers ``bl``, ``bhat``, ``bvar``, ``bwork``; the selection's
+        scratch ``lsel``.
     rec : TrialRecord
         ``belief``, ``bhat``, ``controller`` rows ``period`` written;
         ``detect_k`` set once.
     """
     xa = st.xa
     P = st.P
-    n = xa.shape[0]
+    L = xa.shape[1]
     bl = work.bl
     bh = work.bhat
     bv = work.bvar
-    for l in range(xa.shape[1]):
+    for l in range(L):
         for m in range(N_MODES):
             bl[m] = st.belief[m, l]
         for j in range(N_FAULT):
@@ -396,19 +400,14 @@ def reconfigure(scheme, timing, inp, st, kn, period, work, rec):
             rec.belief[period, m, l] = bl[m]
         for j in range(N_FAULT):
             rec.bhat[period, j, l] = bh[j]
-        if scheme.reconfig.kind != 0:
-            xl = work.xl
-            Pl = work.Pl
-            for i in range(n):
-                xl[i] = xa[i, l]
-                for j in range(n):
-                    Pl[i, j] = P[i, j, l]
-            st.cur[l] = select_controller(st.cur[l], xl, Pl, bl, scheme, work.sel)
-        rec.controller[period, l] = st.cur[l]
         mp = inp.mode_post[l]
         if (st.alive[l] and kn > timing.k_fault and rec.detect_k[l] < 0 and best == mp
                 and bl[mp] >= timing.detect_prob):
             rec.detect_k[l] = kn
+    if scheme.reconfig.kind != 0:
+        select_controllers_lanes(st.cur, xa, P, st.belief, scheme, work.lsel)
+    for l in range(L):
+        rec.controller[period, l] = st.cur[l]
 
 
 # ------------------------------------------------------------------ end

@@ -20,7 +20,7 @@ from collections import namedtuple
 import numpy as np
 
 from ..conventions import N_CONTROLLERS, N_FAULT, N_MODES, N_U, N_X, N_Z, RESIDUAL_NAMES
-from .batch import step_rows
+from .batch import UPDATE_ROWS, step_rows
 from .dryden import N_GUST_NOISE, N_GUST_OUT, N_GUST_STATE
 from .jit import kernel
 from .nonlinear import N_WORK
@@ -47,6 +47,28 @@ SelectionWork = namedtuple("SelectionWork", [
     "obj",     # (N_CONTROLLERS,) objective of each controller (eq. 47)
 ])
 """Scratch of the rolling-horizon controller selection (paper eqs. 45-47)."""
+
+LaneSelectionWork = namedtuple("LaneSelectionWork", [
+    # lane arrays (lane index last)
+    "xs",      # (n, L) estimates predicted over the horizon
+    "Ps",      # (n, n, L) their covariances
+    "U",       # (N_U, L) commands of the controller under test
+    "z",       # (N_Z, L) predicted measurements (zero innovation)
+    "phi",     # (N_X, N_FAULT, L) Phi(u) (batch._predict)
+    "T",       # (N_X, n, L) [A Phi] P (batch._predict)
+    "h",       # (UPDATE_ROWS, n, L) gains of the update (batch._update)
+    "cost",    # (L,) discounted short-horizon cost (eq. 45)
+    "obj",     # (N_CONTROLLERS, L) objective of each controller (eq. 47)
+    # one lane at a time
+    "xl",      # (n,) a lane's predicted estimate (engine controller c1)
+    "Ul",      # (N_U,) its command
+    "bl",      # (N_MODES,) a lane's belief updated with the prediction
+    "bhat",    # (N_FAULT,) its predicted fault parameters
+    "bvar",    # (N_FAULT,) their predicted variances
+    "bwork",   # (2 N_MODES,) work of belief.belief_update
+])
+"""Scratch of the lane-interleaved controller selection
+(:func:`ftc_mc.core.control.select_controllers_lanes`)."""
 
 TrialWork = namedtuple("TrialWork", [
     # lane arrays, written by one stage and read by the next
@@ -82,6 +104,7 @@ TrialWork = namedtuple("TrialWork", [
     "bvar",       # (N_FAULT,) its marginal variances
     "bwork",      # (2 N_MODES,) work of belief.belief_update
     "sel",        # SelectionWork
+    "lsel",       # LaneSelectionWork
 ])
 """Scratch of one :func:`ftc_mc.core.trial.advance` call (see module docstring)."""
 
@@ -94,6 +117,17 @@ def new_selection_work(n):
                          bvar=np.zeros(N_FAULT), bwork=np.zeros(2 * N_MODES),
                          phi=np.zeros((N_X, N_FAULT)), T=np.zeros((N_X, n)),
                          obj=np.zeros(N_CONTROLLERS))
+
+
+@kernel
+def new_lane_selection_work(L, n):
+    """Zeroed :class:`LaneSelectionWork` for ``L`` lanes and augmented dimension ``n``."""
+    return LaneSelectionWork(
+        xs=np.zeros((n, L)), Ps=np.zeros((n, n, L)), U=np.zeros((N_U, L)),
+        z=np.zeros((N_Z, L)), phi=np.zeros((N_X, N_FAULT, L)), T=np.zeros((N_X, n, L)),
+        h=np.zeros((UPDATE_ROWS, n, L)), cost=np.zeros(L), obj=np.zeros((N_CONTROLLERS, L)),
+        xl=np.zeros(n), Ul=np.zeros(N_U), bl=np.zeros(N_MODES), bhat=np.zeros(N_FAULT),
+        bvar=np.zeros(N_FAULT), bwork=np.zeros(2 * N_MODES))
 
 
 @kernel
@@ -113,4 +147,5 @@ def new_trial_work(L, n):
         gust=np.zeros(N_GUST_STATE), eta=np.zeros(N_GUST_NOISE), wl=np.zeros(N_GUST_OUT),
         xabs=np.zeros(N_X), cmd=np.zeros(N_U), y=np.zeros(N_Z),
         rk4=np.zeros((N_WORK, N_X)), bl=np.zeros(N_MODES), bhat=np.zeros(N_FAULT),
-        bvar=np.zeros(N_FAULT), bwork=np.zeros(2 * N_MODES), sel=new_selection_work(n))
+        bvar=np.zeros(N_FAULT), bwork=np.zeros(2 * N_MODES), sel=new_selection_work(n),
+        lsel=new_lane_selection_work(L, n))

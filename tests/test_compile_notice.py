@@ -1,0 +1,93 @@
+"""The one-line notice before the first run that compiles the trial kernel
+(core/jit.py: ``needs_compile``, ``announce_compile``).
+
+A real cold compile takes about a minute, so the decision is tested on fake
+cache indexes and on the real trial kernel's cache pointed at an empty folder.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import io
+
+import numba
+import pytest
+
+from ftc_mc.core import jit
+from ftc_mc.core.trial import run_trials
+
+MAGIC = ("x86_64-unknown-linux-gnu", "znver4", "+avx512f")
+CODE = hashlib.sha256(b"code").hexdigest()
+
+
+def test_index_decision_on_fake_indexes():
+    sig = (numba.float64,)
+    assert not jit.index_has_overload([], MAGIC, CODE)  # missing or stale index
+    assert jit.index_has_overload([(sig, MAGIC, (CODE, "c"))], MAGIC, CODE)
+    # compiled for another CPU, or from other bytecode: not usable here
+    assert not jit.index_has_overload([(sig, ("x", "other", ""), (CODE, "c"))], MAGIC, CODE)
+    assert not jit.index_has_overload([(sig, MAGIC, ("other", "c"))], MAGIC, CODE)
+    assert not jit.index_has_overload(["junk", (1, 2)], MAGIC, CODE)
+
+
+class _FakeCacheFile:
+    def __init__(self, index):
+        self.index = index
+
+    def _load_index(self):
+        return self.index
+
+
+class _FakeDispatcher:
+    """What needs_compile reads of a Numba dispatcher."""
+
+    def __init__(self, index, signatures=()):
+        self.signatures = list(signatures)
+        self._cache = type("C", (), {"_cache_file": _FakeCacheFile(index)})()
+        self.targetctx = run_trials.targetctx
+        self.py_func = run_trials.py_func
+
+
+def _key(dispatcher):
+    magic = run_trials.targetctx.codegen().magic_tuple()
+    code = hashlib.sha256(dispatcher.py_func.__code__.co_code).hexdigest()
+    return ((numba.float64,), magic, (code, ""))
+
+
+def test_cold_then_warm(monkeypatch):
+    monkeypatch.setattr(jit, "CACHE", True)
+    cold = _FakeDispatcher({})
+    out = io.StringIO()
+    assert jit.needs_compile(cold) is True
+    assert jit.announce_compile(cold, stream=out)
+    assert out.getvalue().startswith("ftc-mc: compiling the simulation kernels once")
+    assert out.getvalue().count("\n") == 1
+    warm = _FakeDispatcher({_key(cold): "file.nbc"})
+    out = io.StringIO()
+    assert jit.needs_compile(warm) is False
+    assert not jit.announce_compile(warm, stream=out) and out.getvalue() == ""
+    # already compiled in this process: nothing to announce
+    assert jit.needs_compile(_FakeDispatcher({}, signatures=["sig"])) is False
+
+
+def test_unknown_cache_layout_announces_nothing(monkeypatch):
+    monkeypatch.setattr(jit, "CACHE", True)
+    odd = _FakeDispatcher({})
+    odd._cache = object()
+    out = io.StringIO()
+    assert jit.needs_compile(odd) is None
+    assert not jit.announce_compile(odd, stream=out) and out.getvalue() == ""
+
+
+@pytest.mark.skipif(not jit.CACHE, reason="FTC_MC_NUMBA_CACHE=0")
+def test_real_trial_kernel_cache(tmp_path, monkeypatch):
+    """Numba's own index reader on the trial kernel: an empty cache folder is
+    cold; after the kernel was compiled or loaded in this process its index
+    is warm."""
+    cache_file = run_trials._cache._cache_file
+    with monkeypatch.context() as m:
+        m.setattr(cache_file, "_index_path", str(tmp_path / "none.nbi"))
+        assert jit.in_disk_cache(run_trials) is False
+    if run_trials.signatures:  # compiled or loaded by an earlier test
+        assert jit.in_disk_cache(run_trials) is True
+        assert jit.needs_compile(run_trials) is False
