@@ -41,7 +41,7 @@ from .belief import belief_update
 from .excitation import saturate
 from .interp import engine_controller
 from .jit import kernel
-from .batch import _mirror, _predict, _update, project_lanes
+from .batch import predict_lanes, project_lanes, update_lanes
 from .kalman import predict, project, update
 
 from ..conventions import (C_ELEVON, C_ENGINE, C_NOMINAL, I_B0_ELEVONS,  # noqa: F401
@@ -322,7 +322,7 @@ def _predicted_cost_lanes(c, xs, Ps, fm, rc, eng, K, lo, hi, sw):
     disc = 1.0
     for _ in range(rc.horizon):
         _lane_commands(c, xs, K, eng, fm.u0, lo, hi, U, sw.xl, sw.Ul)
-        _predict(xs, Ps, Ps, U, fm, sw.phi, sw.T, 0, L)
+        predict_lanes(xs, Ps, U, fm, sw.phi, sw.T)
         for r in range(z.shape[0]):
             s = fm.c_ident[r]
             if s >= 0:
@@ -334,8 +334,7 @@ def _predicted_cost_lanes(c, xs, Ps, fm, rc, eng, K, lo, hi, sw):
                     for j in range(N_X):
                         acc += fm.C[r, j] * xs[j, l]
                     z[r, l] = acc
-        _update(xs, Ps, z, fm, sw.h)
-        _mirror(Ps, 0, L)
+        update_lanes(xs, Ps, z, fm, sw.h)
         project_lanes(xs, fm)
         disc *= rc.alpha
         for l in range(L):

@@ -54,9 +54,9 @@ LaneSelectionWork = namedtuple("LaneSelectionWork", [
     "Ps",      # (n, n, L) their covariances
     "U",       # (N_U, L) commands of the controller under test
     "z",       # (N_Z, L) predicted measurements (zero innovation)
-    "phi",     # (N_X, N_FAULT, L) Phi(u) (batch._predict)
-    "T",       # (N_X, n, L) [A Phi] P (batch._predict)
-    "h",       # (UPDATE_ROWS, n, L) gains of the update (batch._update)
+    "phi",     # (N_X, N_FAULT, L) Phi(u) (batch.predict_lanes)
+    "T",       # (N_X, n, L) [A Phi] P (batch.predict_lanes)
+    "h",       # (UPDATE_ROWS, n, L) gains of the update (batch.update_lanes)
     "cost",    # (L,) discounted short-horizon cost (eq. 45)
     "obj",     # (N_CONTROLLERS, L) objective of each controller (eq. 47)
     # one lane at a time
