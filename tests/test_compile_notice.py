@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import hashlib
 import io
+from pathlib import Path
 
 import numba
 import pytest
@@ -91,3 +92,29 @@ def test_real_trial_kernel_cache(tmp_path, monkeypatch):
     if run_trials.signatures:  # compiled or loaded by an earlier test
         assert jit.in_disk_cache(run_trials) is True
         assert jit.needs_compile(run_trials) is False
+
+
+def test_the_kernel_cache_follows_every_kernel_module(tmp_path, monkeypatch):
+    # Numba checks a cached kernel only against its own file; the cache folder is
+    # named after all of core/ and conventions.py, so an edit of a module that a
+    # kernel inlines (core/stages.py into core/trial.py) starts a new folder
+    import shutil
+
+    from ftc_mc.core import jit
+
+    src = Path(jit.__file__).resolve().parent
+    copy = tmp_path / "ftc_mc"
+    shutil.copytree(src, copy / "core", ignore=shutil.ignore_patterns("__pycache__"))
+    shutil.copy(src.parent / "conventions.py", copy / "conventions.py")
+    same = jit.source_digest(copy / "core")
+    assert same == jit.source_digest()
+    stages = copy / "core" / "stages.py"
+    stages.write_text(stages.read_text() + "\n# an edit\n")
+    assert jit.source_digest(copy / "core") != same
+    conv = copy / "conventions.py"
+    stages.write_text(stages.read_text()[:-len("\n# an edit\n")])
+    assert jit.source_digest(copy / "core") == same
+    conv.write_text(conv.read_text() + "\n")
+    assert jit.source_digest(copy / "core") != same
+    monkeypatch.setenv("FTC_MC_CACHE_DIR", str(tmp_path / "c"))
+    assert jit.cache_dir() == tmp_path / "c" / "numba" / same

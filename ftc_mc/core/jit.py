@@ -1,19 +1,49 @@
 """The one place that sets how every kernel is compiled.
 
-``FTC_MC_NUMBA_CACHE=0`` in the environment turns Numba's on-disk cache off (for
-example while editing kernels in several files, since the cache does not see
-edits in other modules).  ``fastmath`` stays off: it was no faster here
-(``scripts/bench_core.py``) and breaks bit-for-bit agreement with the NumPy
-references.
+Compiled kernels are cached on disk (``docs/performance.md``, lesson 6).  Numba
+checks a cached kernel only against its own file, so a kernel that inlines
+others would be loaded stale after an edit of theirs.  The cache therefore lives
+in a folder named after a digest of every kernel module's source
+(:func:`source_digest`): ``$FTC_MC_CACHE_DIR/numba/<digest>``
+(``~/.cache/ftc-mc/numba/<digest>`` by default); any edit of ``ftc_mc/core/`` or
+``ftc_mc/conventions.py`` starts a new folder.  ``NUMBA_CACHE_DIR`` in the
+environment takes precedence (the benchmarks point it at an empty folder), and
+``FTC_MC_NUMBA_CACHE=0`` turns caching off.  ``fastmath`` stays off: it was no
+faster here (``scripts/bench_core.py``) and breaks bit-for-bit agreement with the
+NumPy references.
 """
 
 from __future__ import annotations
 
+import hashlib
 import os
+from pathlib import Path
 
 import numba
 
 CACHE = os.environ.get("FTC_MC_NUMBA_CACHE", "1") != "0"
+
+
+def source_digest(core: Path | None = None) -> str:
+    """SHA-256 (16 hex digits) of the source of every module kernels compile from:
+    ``core/*.py`` and ``conventions.py`` beside it (``core``: this package's)."""
+    core = Path(__file__).resolve().parent if core is None else Path(core)
+    h = hashlib.sha256()
+    for path in sorted(core.glob("*.py")) + [core.parent / "conventions.py"]:
+        h.update(path.name.encode())
+        h.update(path.read_bytes())
+    return h.hexdigest()[:16]
+
+
+def cache_dir() -> Path:
+    """The folder of the compiled kernels of this source (module docstring)."""
+    root = os.environ.get("FTC_MC_CACHE_DIR") or Path.home() / ".cache" / "ftc-mc"
+    return Path(root) / "numba" / source_digest()
+
+
+if CACHE and not os.environ.get("NUMBA_CACHE_DIR"):
+    # read by Numba when each kernel below is decorated (its cache locator)
+    numba.config.CACHE_DIR = str(cache_dir())
 
 OPTIONS = dict(cache=CACHE, fastmath=False, nogil=True, error_model="numpy")
 
