@@ -169,13 +169,10 @@ def classify(spec: ChunkSpec, tr_name: str, variant: str, trial_ids, values,
     kf = setup.tim.k_fault
     L = len(trial_ids)
     R = rec.reset_k.shape[0]
-    stored = np.minimum(rec.n_resets, R)
-    idx = np.arange(R)[:, None]
-    valid = idx < stored[None, :]
     k = rec.reset_k
     blk = rec.reset_block
-    in_win = valid & (k > kf) & (k <= kf + window_steps)
-    before = valid & (k <= kf)
+    resets, valid, in_win, before = _reset_columns(tr_name, variant, trial_ids, rec, kf,
+                                                   window_steps, dt)
     correct = np.any(in_win & (blk == tr.correct_block), axis=0)
     inappropriate = np.any(in_win & (blk == tr.other_block), axis=0)
     n_win = in_win.sum(axis=0)
@@ -227,21 +224,6 @@ def classify(spec: ChunkSpec, tr_name: str, variant: str, trial_ids, values,
         "judged": judged & ~truncated,
         "status": np.array([STATUS_NAMES[s] for s in rec.status], dtype=object),
         "stop_s": np.where(rec.stop_k >= 0, rec.stop_k * dt, np.nan),
-    }
-    lane, slot = np.nonzero(valid.T)
-    kk = k[slot, lane]
-    resets = {
-        "transition": np.full(len(lane), tr_name, dtype=object),
-        "variant": np.full(len(lane), variant, dtype=object),
-        "trial_id": np.asarray(trial_ids, dtype=np.int64)[lane],
-        "time_s": kk * dt,
-        "time_from_fault_s": (kk - kf) * dt,
-        "block": np.array([BLOCK_NAMES[b] for b in blk[slot, lane]], dtype=object),
-        "r_q": rec.reset_res[slot, 0, lane],
-        "r_nx": rec.reset_res[slot, 1, lane],
-        "r_nz": rec.reset_res[slot, 2, lane],
-        "in_window": in_win[slot, lane],
-        "before_fault": before[slot, lane],
     }
     return trials, resets
 
