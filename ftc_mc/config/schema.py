@@ -20,7 +20,7 @@ from ..conventions import (ACTUATOR_NAMES, OUTPUT_NAMES, PLANT_KINDS, SENSOR_FAU
                            SENSOR_PREFIX, TRANSITIONS, TURBULENCE_LEVELS)
 from ..errors import UserError
 from ..model.source import (DEFAULT_AIRFRAME, check_airframe, check_condition,
-                            command_limits, is_linear_model)
+                            is_linear_model)
 
 
 def _no_bool(value):
@@ -90,10 +90,9 @@ def _check_airframe_use(cfg) -> tuple:
     alpha = (math.radians(cfg.validity.alpha_min_deg),
              math.radians(cfg.validity.alpha_max_deg))
     try:
-        check_condition(m.airframe, m.airspeed_mps, m.gamma_deg, m.dt_s, alpha)
+        return check_condition(m.airframe, m.airspeed_mps, m.gamma_deg, m.dt_s, alpha)
     except UserError as exc:
         raise ValueError(str(exc)) from None
-    return command_limits(m.airframe)
 
 
 class _Sampled(_Strict):

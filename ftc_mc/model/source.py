@@ -52,24 +52,17 @@ def check_airframe(spec: str) -> None:
         resolve_airframe(spec)
 
 
-def command_limits(spec: str) -> tuple:
-    """Absolute command limits ``(lower, upper)`` (throttle [-], elevons [rad]) of
-    the airframe or linear model ``spec`` names."""
+def check_condition(spec: str, V0: float, gamma_deg: float, dt: float,
+                    alpha_range=None) -> tuple:
+    """Refuse, as :func:`load_plant` would, a condition the airframe cannot fly
+    (only the trim is computed, not the linearisation); return the absolute
+    command limits ``(lower, upper)`` (throttle [-], elevons [rad])."""
     if is_linear_model(spec):
-        plant = load_linear_model(spec)
+        plant = load_plant(spec, V0, gamma_deg, dt)
         return tuple(plant.u_lower), tuple(plant.u_upper)
     af = resolve_airframe(spec)
+    trim(af, V0, gamma_deg, alpha_range)
     return af.command_lower, af.command_upper
-
-
-def check_condition(spec: str, V0: float, gamma_deg: float, dt: float,
-                    alpha_range=None) -> None:
-    """Refuse, as :func:`load_plant` would, a condition the airframe cannot fly
-    (only the trim is computed, not the linearisation)."""
-    if is_linear_model(spec):
-        load_plant(spec, V0, gamma_deg, dt)
-    else:
-        trim(resolve_airframe(spec), V0, gamma_deg, alpha_range)
 
 
 def load_plant(spec: str, V0: float, gamma_deg: float, dt: float,
