@@ -100,9 +100,9 @@ def simulate(setup, inp: TrialInputs, runs, max_resets: int, k_share: int | None
         return [run_alone(setup, v, det, inp, max_resets) for v, det in runs], L * n * len(runs)
     assert 0 < k_share <= n
     rec0 = new_record(setup, L, max_resets)
-    st0 = new_state(L)
-    init_state(inp, st0, rec0)
     no_resets = setup.detection(VARIANTS[0], math.inf, math.inf)
+    st0 = new_state(L, inp.xa0.shape[0], no_resets.window)
+    init_state(inp, st0, rec0)
     advance(setup.scheme(VARIANTS[0], no_resets), setup.flight, inp, rec0, st0, 0, k_share)
     simulated = L * k_share
     recs = []
