@@ -87,6 +87,13 @@ class RefModel:
     Qg: np.ndarray | None = None
     test: str = "one_step"
     window: int = 1
+    nl: int = 0
+    p: np.ndarray | None = None
+    x0: np.ndarray | None = None
+    y0: np.ndarray | None = None
+    Cg: np.ndarray | None = None
+    n_sub: int = 2
+    dt: float = 0.1
 
     @property
     def ng(self) -> int:
@@ -169,15 +176,32 @@ def process_noise(model):
 def predict_ref(X, P, u, model):
     """Eq. (5) time update: ``X = A_aug X + B_aug u``, ``P = A_aug P A_aug^T + Q``."""
     A_aug, B_aug, _ = aug(model, u)
-    X = A_aug @ X + B_aug @ u
+    Xn = A_aug @ X + B_aug @ u
+    if model.nl:  # extended filter: the airframe predicts the plant states
+        b0, b1 = X[N_X:N_X + 2], X[N_X + 2:N_AUG]
+        effect = u + np.array([b0[0], b0[1] / 2, b0[1] / 2]) - b1 * (u + model.u0)
+        Xn[:N_X] = rk4_ref(model.x0 + X[:N_X], model.u0 + effect, model.p,
+                           gust_wind(X, model), model.dt, model.n_sub) - model.x0
     P = A_aug @ P @ A_aug.T + process_noise(model)
-    return X, P
+    return Xn, P
+
+
+def gust_wind(X, model):
+    """The estimated gust ``C_d g`` (zero without gust states)."""
+    return model.Cg @ X[N_AUG:] if model.ng else np.zeros(3)
+
+
+def predicted_outputs(X, model):
+    """``C_aug X``, or with the extended filter ``h(x0 + x, C_d g) - y0``."""
+    if model.nl:
+        return x8_outputs_ref(model.x0 + X[:N_X], model.p, gust_wind(X, model)) - model.y0
+    return aug(model, np.zeros(3))[2] @ X
 
 
 def innovation_ref(X, P, z, model):
     """Full innovation ``mu = z - C_aug X`` and ``S = C_aug P C_aug^T + R``."""
     _, _, C_aug = aug(model, np.zeros(3))
-    mu = z - C_aug @ X
+    mu = z - predicted_outputs(X, model)
     S = C_aug @ P @ C_aug.T + np.diag(model.r)
     return mu, S
 
@@ -229,7 +253,7 @@ def update_ref(X, P, z, model):
     R = np.diag(model.r)
     S = C @ P @ C.T + R
     K = np.linalg.solve(S, C @ P).T  # = P C^T S^-1 (S and P symmetric)
-    X = X + K @ (z - C @ X)
+    X = X + K @ (z - predicted_outputs(X, model))
     I_KC = np.eye(P.shape[0]) - K @ C
     P = I_KC @ P @ I_KC.T + K @ R @ K.T
     return X, P
@@ -515,7 +539,9 @@ def ref_of(scheme):
                     variant="swapped" if det.swapped else "paper", reset_var=det.reset_var,
                     G=fm.G if gust else None, Ad=fm.Ad if gust else None,
                     Dg=fm.Dg if gust else None, Qg=fm.Qg if gust else None,
-                    test=("one_step", "glr")[det.test], window=int(det.window))
+                    test=("one_step", "glr")[det.test], window=int(det.window),
+                    nl=int(fm.nl), p=fm.p, x0=fm.x0, y0=fm.y0,
+                    Cg=fm.Cg if gust else None, n_sub=int(fm.n_sub), dt=float(fm.dt))
 
 
 def horizon_cost_ref(c, X, P, scheme):
@@ -525,7 +551,7 @@ def horizon_cost_ref(c, X, P, scheme):
     innovation), projection (eq. 8).  Returns ``I, X_{k+H}, P_{k+H|k+H}``."""
     # the selection predicts with the paper's model (a gust-aware filter's gust
     # states are left out, core/stages.reconfigure)
-    model = dataclasses.replace(ref_of(scheme), G=None, Ad=None, Dg=None, Qg=None)
+    model = dataclasses.replace(ref_of(scheme), G=None, Ad=None, Dg=None, Qg=None, nl=0)
     ctl, rc = scheme.controller, scheme.reconfig
     _, _, C_aug = aug(model, np.zeros(3))
     cost = 0.0

@@ -231,3 +231,80 @@ def test_gust_aware_residuals_are_chi_square(linear_gusts):
         means[name] = rec.hist_res[skip:n][:, :, ok].mean(axis=(0, 2))
     assert np.all((means["gust"] >= 0.9) & (means["gust"] <= 1.1)), means
     assert np.all(means["paper"] > 5.0), means
+
+
+# ------------------------------------------------------------------ extended filter
+@pytest.fixture(scope="module")
+def nonlinear_gusts():
+    return _setup("nonlinear", "moderate")
+
+
+def extended(setup):
+    """The gust-aware filter with the airframe predicting (``nl = 1``)."""
+    fm, P0, d = gust_filter(setup)
+    return fm._replace(nl=1, Cg=np.ascontiguousarray(d.Cd)), P0, d
+
+
+@pytest.mark.parametrize("test", ["one_step", "glr"])
+def test_extended_filter_update(nonlinear_gusts, test):
+    """The extended filter stage (nonlinear prediction of the states and
+    outputs, update linearised about the prediction) against the twin, which
+    predicts with ``naive.rk4_ref`` and ``naive.x8_outputs_ref``."""
+    fm, P0, d = extended(nonlinear_gusts)
+    W = 3 if test == "glr" else 1
+    scheme = gust_scheme(nonlinear_gusts, fm, window=W, test=int(test == "glr"), t_q=3.0,
+                         t_nx=3.0)
+    rng = np.random.default_rng(64)
+    scale = np.array([0.3, 0.5, 1.0, 2.0, 3.0, 5.0, 10.0])  # the airframe stays flyable
+    st = with_gust_states(random_lanes(nonlinear_gusts, rng, 10), rng, d, P0, W)
+    fired = set()
+    for k in range(10, 14):
+        work = new_trial_work(L, N)
+        work.u[:] = 0.05 * rng.standard_normal((3, L))
+        measurements(scheme, st, work, rng, scale)
+        xa, P, res, block, rmax, ebuf, ecount = naive.filter_update_ref(
+            scheme, st, work.u, work.z, k)
+        stages.filter_update(scheme, st, k, work)
+        assert np.array_equal(work.block, block), k
+        assert_lanes(work.res, res, 1e-9, "statistics")
+        for l in range(L):
+            assert rel(st.xa[:, l], xa[:, l]) <= 1e-9, (k, l)
+            assert rel(st.P[:, :, l], P[:, :, l]) <= 1e-9, (k, l)
+        fired.update(block.tolist())
+    assert len(fired) > 1
+
+
+def test_extended_equals_linear_small_signal(nonlinear_gusts):
+    """In the small-signal limit the extended filter is the linear one: from a
+    state ``eps`` times typical deviations, one step of each (same ``u``, ``z``)
+    differs by ``O(eps)`` relative to the step's change, down to the RK4
+    discretisation floor; at trim with zero inputs the prediction stays at trim."""
+    fm_l, P0, d = gust_filter(nonlinear_gusts)
+    fm_n = fm_l._replace(nl=1, Cg=np.ascontiguousarray(d.Cd))
+    det = nonlinear_gusts.det["paper"]._replace(t_q=np.inf, t_nx=np.inf)
+    rng = np.random.default_rng(65)
+    diffs = []
+    for eps in (1e-1, 1e-2, 1e-3, 1e-4):
+        st0 = with_gust_states(random_lanes(nonlinear_gusts, rng, 10), rng, d, P0)
+        xa = np.zeros((N, L))
+        xa[:N_X] = eps * X_SCALE[:, None] * rng.standard_normal((N_X, L))
+        xa[N_AUG:] = eps * d.P0_chol @ rng.standard_normal((NG, L))
+        u = eps * 0.05 * rng.standard_normal((3, L))
+        z = eps * 0.1 * rng.standard_normal((12, L))
+        out = []
+        for fm in (fm_l, fm_n):
+            st = copy_nt(st0._replace(xa=xa))
+            work = new_trial_work(L, N)
+            work.u[:], work.z[:] = u, z
+            stages.filter_update(nonlinear_gusts.scheme("paper", det)._replace(filter=fm),
+                                 st, 10, work)
+            out.append(st.xa.copy())
+        diffs.append(rel(out[1] - xa, out[0] - xa))
+    assert diffs[0] > 10 * diffs[2] and diffs[-1] < 1e-3, diffs
+    # trim is an equilibrium of the prediction
+    st = copy_nt(with_gust_states(random_lanes(nonlinear_gusts, rng, 10), rng, d, P0)
+                 ._replace(xa=np.zeros((N, L))))
+    work = new_trial_work(L, N)
+    stages.filter_update(nonlinear_gusts.scheme("paper", det)._replace(filter=fm_n), st, 10,
+                         work)
+    assert np.abs(work.fwork[N + 5]).max() < 1e-9  # the prediction, before the update

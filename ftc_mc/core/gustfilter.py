@@ -28,10 +28,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..conventions import N_AUG, N_B0, N_U, N_X, RESIDUAL_OUTPUTS
+from ..conventions import N_AUG, N_B0, N_U, N_X, N_Z, RESIDUAL_OUTPUTS
 from ..conventions import N_FAULT as N_F
 from .batch import UPDATE_ROWS, project_lanes, reset_lanes
 from .jit import kernel
+from .nonlinear import outputs_nb, propagate
+
+N_WIND = 3
+"""Gust outputs ``u_g, w_g, q_g`` of the gust states (``FilterModel.Cg``)."""
 
 
 @kernel
@@ -47,14 +51,74 @@ def _c_row(fm, r, crow):
 
 
 @kernel
-def _gpredict(xa, P, Pn, u, fm, phi, T, xn):
+def _nl_state(xa, u, fm, xn, tw):
+    """The extended filter's state prediction: ``x_{k+1|k} = f(x0 + x, u0 + e, C_d g) - x0``.
+
+    ``f`` is the nonlinear airframe over one period (RK4, ``fm.n_sub`` steps,
+    :func:`ftc_mc.core.nonlinear.propagate`), driven by the actuators' effect
+    under the estimated faults (eq. 2 with the estimated ``b``:
+    ``e = u + [b0_T, b0_e / 2, b0_e / 2] - b1 (u + u0)``, the terms ``B_b0 b0``
+    and ``Phi(u) b1`` of eq. 4) and the estimated gust ``C_d g`` held over the
+    period.  Writes ``xn[:9]`` (deviation from trim); one-lane buffers of ``tw``.
+    """
+    ng = xa.shape[0] - N_AUG
+    xabs = tw.xabs
+    cmd = tw.cmd
+    wl = tw.wl
+    for l in range(xa.shape[1]):
+        for i in range(N_X):
+            xabs[i] = fm.x0[i] + xa[i, l]
+        b0t = xa[N_X, l]
+        b0e = 0.5 * xa[N_X + 1, l]
+        for j in range(N_U):
+            bias = b0t if j == 0 else b0e
+            cmd[j] = fm.u0[j] + u[j, l] + bias - xa[N_X + N_B0 + j, l] * (u[j, l] + fm.u0[j])
+        for i in range(N_WIND):
+            acc = 0.0
+            for g in range(ng):
+                acc += fm.Cg[i, g] * xa[N_AUG + g, l]
+            wl[i] = acc
+        propagate(xabs, cmd, fm.p, wl, fm.dt, fm.n_sub, tw.rk4)
+        for i in range(N_X):
+            xn[i, l] = xabs[i] - fm.x0[i]
+
+
+@kernel
+def _nl_outputs(xa, fm, hpred, xp, tw):
+    """The extended filter's predicted outputs ``h(x0 + x, C_d g) - y0`` into
+    ``hpred[:12]`` and the prediction itself into ``xp`` (the update linearises
+    about it: ``z_r - hpred_r - c_r (X - xp)``)."""
+    n = xa.shape[0]
+    ng = n - N_AUG
+    xabs = tw.xabs
+    wl = tw.wl
+    y = tw.y
+    for l in range(xa.shape[1]):
+        for i in range(n):
+            xp[i, l] = xa[i, l]
+        for i in range(N_X):
+            xabs[i] = fm.x0[i] + xa[i, l]
+        for i in range(N_WIND):
+            acc = 0.0
+            for g in range(ng):
+                acc += fm.Cg[i, g] * xa[N_AUG + g, l]
+            wl[i] = acc
+        outputs_nb(xabs, fm.p, wl, y)
+        for r in range(N_Z):
+            hpred[r, l] = y[r] - fm.y0[r]
+
+
+@kernel
+def _gpredict(xa, P, Pn, u, fm, phi, T, xn, tw):
     """Time update of every lane: ``X <- F X + B_aug u``, ``Pn <- F P F^T + Q``.
 
     ``F = [[A, Phi(u), G], [0, I, 0], [0, 0, A_d]]`` and ``Q`` block-diagonal
     (``q_diag`` on ``x`` and ``b``, ``Qg`` on ``g``).  ``P`` is read whole
     (symmetric), ``Pn`` written whole (exactly symmetric; may not be ``P``).
     ``phi`` (9, 5, L) holds ``Phi(u)`` on return; ``T`` (n, n, L) and ``xn``
-    (n, L) are work arrays.
+    (n, L) are work arrays.  With ``fm.nl`` the plant states are predicted by
+    the nonlinear airframe (:func:`_nl_state`); the covariance keeps the
+    Jacobians at trim (``A``, ``Phi``, ``G``).
     """
     n = xa.shape[0]
     L = xa.shape[1]
@@ -84,6 +148,8 @@ def _gpredict(xa, P, Pn, u, fm, phi, T, xn):
             for g in range(ng):
                 acc += fm.Ad[a, g] * xa[N_AUG + g, l]
             xn[N_AUG + a, l] = acc
+    if fm.nl != 0:
+        _nl_state(xa, u, fm, xn, tw)
     for i in range(N_X):
         for l in range(L):
             xa[i, l] = xn[i, l]
@@ -151,12 +217,14 @@ def _gpredict(xa, P, Pn, u, fm, phi, T, xn):
 
 
 @kernel
-def gust_residuals_lanes(xa, P, z, fm, crow, res, innov):
+def gust_residuals_lanes(xa, P, z, fm, crow, hpred, res, innov):
     """Normalised residuals ``r_q, r_nx, r_nz`` (eqs. 9-11) with the gust columns
     of ``C_aug``: ``r_i = mu_i^2 / (c_i P c_i^T + R_ii)``, ``mu_i = z_i - c_i X``.
 
-    ``P`` is the full symmetric prediction; ``crow`` (n,) is work; ``res`` and
-    ``innov`` (3, L) are written with ``r_i`` and ``mu_i / sqrt(S_ii)``.
+    ``P`` is the full symmetric prediction; ``crow`` (n,) is work; with
+    ``fm.nl`` the predicted output is ``hpred`` (12, L) instead of ``c_i X``;
+    ``res`` and ``innov`` (3, L) are written with ``r_i`` and
+    ``mu_i / sqrt(S_ii)``.
     """
     n = xa.shape[0]
     L = xa.shape[1]
@@ -173,6 +241,8 @@ def gust_residuals_lanes(xa, P, z, fm, crow, res, innov):
                 for k in range(n):
                     acc += P[j, k, l] * crow[k]
                 s += crow[j] * acc
+            if fm.nl != 0:
+                pred = hpred[r, l]
             mu = z[r, l] - pred
             s = s + rr
             res[o, l] = mu * mu / s
@@ -180,10 +250,12 @@ def gust_residuals_lanes(xa, P, z, fm, crow, res, innov):
 
 
 @kernel
-def _gupdate(xa, P, z, fm, crow, h, v, gs):
+def _gupdate(xa, P, z, fm, crow, h, v, gs, hpred, xp):
     """Sequential scalar updates with the 12 outputs in order, on the upper
     triangle of ``P`` (mirrored by the caller): ``h = P c^T``, ``s = c h + R``,
-    ``X += h (z - c X) / s``, ``P -= (h / s) h^T``."""
+    ``X += h (z - c X) / s``, ``P -= (h / s) h^T``; with ``fm.nl`` the
+    predicted output is ``hpred_r + c (X - xp)`` (linearised about the
+    prediction ``xp``)."""
     n = xa.shape[0]
     L = xa.shape[1]
     for r in range(z.shape[0]):
@@ -202,9 +274,15 @@ def _gupdate(xa, P, z, fm, crow, h, v, gs):
         for l in range(L):
             pred = 0.0
             sv = rr
-            for j in range(n):
-                pred += crow[j] * xa[j, l]
-                sv += crow[j] * h[j, l]
+            if fm.nl != 0:
+                pred = hpred[r, l]
+                for j in range(n):
+                    pred += crow[j] * (xa[j, l] - xp[j, l])
+                    sv += crow[j] * h[j, l]
+            else:
+                for j in range(n):
+                    pred += crow[j] * xa[j, l]
+                    sv += crow[j] * h[j, l]
             gs[0, l] = (z[r, l] - pred) / sv
             gs[1, l] = 1.0 / sv
         for a in range(n):
@@ -218,9 +296,9 @@ def _gupdate(xa, P, z, fm, crow, h, v, gs):
 
 
 @kernel
-def gust_predict_lanes(xa, P, u, z, fm, phi, T, work, crow, res, innov):
-    """First half of a gust-aware filter step: predict into ``work[:n]`` and the
-    residuals; ``X_{k|k}`` is kept in ``work`` for a re-prediction.
+def gust_predict_lanes(xa, P, fm, tw):
+    """First half of a general filter step: predict into ``tw.fwork[:n]`` and the
+    residuals; ``X_{k|k}`` is kept in ``tw.fwork`` for a re-prediction.
 
     Parameters
     ----------
@@ -228,42 +306,40 @@ def gust_predict_lanes(xa, P, u, z, fm, phi, T, work, crow, res, innov):
         ``X_{k|k}``, replaced by ``X_{k+1|k}``.
     P : ndarray, shape (n, n, L)
         ``P_{k|k}`` (left unchanged).
-    u : ndarray, shape (3, L)
-        Command deviations applied during the step.
-    z : ndarray, shape (12, L)
-        Measurement deviations from the trim outputs at the end of the step.
     fm : FilterModel
-        With the gust fields ``G``, ``Ad``, ``Dg``, ``Qg`` (``ng = n - 14``).
-    phi : ndarray, shape (9, 5, L)
-    T : ndarray, shape (n, n, L)
-    work : ndarray, shape (step_rows(n), n, L)
-        ``work[:n]`` gets ``P_{k+1|k}``; rows ``n .. n + 13`` are the update's.
-    crow : ndarray, shape (n,)
-    res, innov : ndarray, shape (3, L)
-        Residuals ``r_q, r_nx, r_nz`` and signed normalised innovations.
+        With the gust fields ``G``, ``Ad``, ``Dg``, ``Qg`` (``ng = n - 14``,
+        possibly 0) and ``nl`` (nonlinear prediction).
+    tw : TrialWork
+        Reads ``u`` (commands of the step) and ``z`` (measurements ``z_{k+1}``);
+        writes ``res``, ``innov`` (3, L); work ``phi``, ``T`` (n, n, L),
+        ``fwork`` (rows ``n + 3`` .. ``n + 5``: prediction scratch, predicted
+        outputs, the prediction; row ``n + 13``: ``X_{k|k}``), ``crow`` and the
+        one-lane buffers of the nonlinear airframe.
     """
     n = xa.shape[0]
-    Pn = work[0:n]
+    work = tw.fwork
     x_prev = work[n + UPDATE_ROWS]
-    xn = work[n + 3]
     for i in range(n):
         for l in range(xa.shape[1]):
             x_prev[i, l] = xa[i, l]
-    _gpredict(xa, P, Pn, u, fm, phi, T, xn)
-    gust_residuals_lanes(xa, Pn, z, fm, crow, res, innov)
+    _gpredict(xa, P, work[0:n], tw.u, fm, tw.phi, tw.T, work[n + 3], tw)
+    if fm.nl != 0:
+        _nl_outputs(xa, fm, work[n + 4], work[n + 5], tw)
+    gust_residuals_lanes(xa, work[0:n], tw.z, fm, tw.crow, work[n + 4], tw.res, tw.innov)
 
 
 @kernel
-def gust_correct_lanes(xa, P, u, z, fm, det, phi, T, work, crow, block):
-    """Second half, once ``block`` is decided: reset the block of ``P_{k|k}``
+def gust_correct_lanes(xa, P, fm, det, tw):
+    """Second half, once ``tw.block`` is decided: reset the block of ``P_{k|k}``
     (section 3.2.2) of every lane that resets and predict all lanes again from
     ``X_{k|k}`` (identical for the others), update, projection (eqs. 6-8).
     Parameters as :func:`gust_predict_lanes`; ``P`` gets ``P_{k+1|k+1}``."""
     n = xa.shape[0]
     L = xa.shape[1]
+    work = tw.fwork
     Pn = work[0:n]
     x_prev = work[n + UPDATE_ROWS]
-    xn = work[n + 3]
+    block = tw.block
     n_reset = 0
     for l in range(L):
         if block[l] != 0:
@@ -273,8 +349,11 @@ def gust_correct_lanes(xa, P, u, z, fm, det, phi, T, work, crow, block):
         for i in range(n):
             for l in range(L):
                 xa[i, l] = x_prev[i, l]
-        _gpredict(xa, P, Pn, u, fm, phi, T, xn)
-    _gupdate(xa, Pn, z, fm, crow, work[n], work[n + 1], work[n + 2])
+        _gpredict(xa, P, Pn, tw.u, fm, tw.phi, tw.T, work[n + 3], tw)
+        if fm.nl != 0:
+            _nl_outputs(xa, fm, work[n + 4], work[n + 5], tw)
+    _gupdate(xa, Pn, tw.z, fm, tw.crow, work[n], work[n + 1], work[n + 2], work[n + 4],
+             work[n + 5])
     for i in range(n):
         for k in range(i, n):
             for l in range(L):

@@ -23,6 +23,14 @@ FilterModel = namedtuple("FilterModel", [
     "Ad",       # (ng, ng) gust-state transition (Dryden, core/dryden.py)
     "Dg",       # (12, ng) gust states -> outputs (D_w C_d)
     "Qg",       # (ng, ng) gust-state process noise (B_d B_d^T)
+    "nl",       # 0: linear prediction (eq. 5); 1: the nonlinear airframe predicts the
+                #    state and the outputs (extended filter, core/gustfilter.py)
+    "p",        # (25,) packed airframe parameters (nonlinear prediction)
+    "x0",       # (9,)  trim state, absolute
+    "y0",       # (12,) trim outputs, absolute
+    "Cg",       # (3, ng) gust states -> u_g, w_g [m/s], q_g [rad/s] (C_d)
+    "n_sub",    # RK4 sub-steps of the nonlinear prediction per period
+    "dt",       # control period [s]
 ])
 """The augmented Kalman filter's model (paper eqs. 4-6).
 

@@ -142,7 +142,7 @@ def filter_update(scheme, st, k, work):
     Predict with ``u_k`` and the residuals on ``z_{k+1}``
     (:func:`ftc_mc.core.batch.filter_predict_lanes` for the paper's 14-state
     filter, :func:`ftc_mc.core.gustfilter.gust_predict_lanes` when the estimate
-    carries gust states); with the GLR test (``detection.test == TEST_GLR``)
+    carries gust states or the airframe predicts, ``filter.nl``); with the GLR test (``detection.test == TEST_GLR``)
     the statistics of :func:`ftc_mc.core.glr.glr_lanes` replace the one-step
     residuals; Table 1 on them; reset, update and projection (the
     ``*_correct_lanes`` halves); a reset restarts the lane's GLR window.  Then
@@ -165,21 +165,20 @@ def filter_update(scheme, st, k, work):
     fm = scheme.filter
     det = scheme.detection
     res = work.res
-    if st.xa.shape[0] == N_AUG:
+    paper = st.xa.shape[0] == N_AUG and fm.nl == 0
+    if paper:
         filter_predict_lanes(st.xa, st.P, work.u, work.z, fm, work.phi, work.T, work.fwork,
                              res, work.innov)
     else:
-        gust_predict_lanes(st.xa, st.P, work.u, work.z, fm, work.phi, work.T, work.fwork,
-                           work.crow, res, work.innov)
+        gust_predict_lanes(st.xa, st.P, fm, work)
     if det.test == TEST_GLR:
         glr_lanes(work.innov, st.ebuf, st.ecount, k, res)
     signature_lanes(res, det, work.block)
-    if st.xa.shape[0] == N_AUG:
+    if paper:
         filter_correct_lanes(st.xa, st.P, work.u, work.z, fm, det, work.phi, work.T,
                              work.fwork, work.block)
     else:
-        gust_correct_lanes(st.xa, st.P, work.u, work.z, fm, det, work.phi, work.T,
-                           work.fwork, work.crow, work.block)
+        gust_correct_lanes(st.xa, st.P, fm, det, work)
     if det.test == TEST_GLR:
         glr_restart(work.block, st.ecount)
     for l in range(st.xa.shape[1]):

@@ -125,7 +125,13 @@ def filter_model(plant: LinearPlant, s: EstimatorSettings) -> FilterModel:
         r_diag=np.asarray(s.r_diag, dtype=float).copy(), lo=lo, hi=hi,
         # the paper's filter has no gust states (a gust-aware design adds them)
         G=np.zeros((n, 0)), Ad=np.zeros((0, 0)), Dg=np.zeros((C.shape[0], 0)),
-        Qg=np.zeros((0, 0)))
+        Qg=np.zeros((0, 0)),
+        # linear prediction; an extended design switches nl on (sim/designs.py)
+        nl=0, p=(np.zeros(25) if plant.trim.params is None  # a linear-model file
+                 else np.ascontiguousarray(plant.trim.params, dtype=np.float64)),
+        x0=np.ascontiguousarray(plant.trim.x0, dtype=np.float64),
+        y0=np.ascontiguousarray(plant.trim.y0, dtype=np.float64), Cg=np.zeros((3, 0)),
+        n_sub=10, dt=float(plant.dt))
 
 
 def detection(plant: LinearPlant, s: EstimatorSettings) -> Detection:
