@@ -79,6 +79,16 @@ ELEVON_BLOCK = (PARAM_NAMES.index("b0_elevons"), PARAM_NAMES.index("b1_left"),
 VARIANTS = ("paper", "swapped")
 """Table 1 as printed, and with its third clause's r_nz comparison swapped."""
 
+TEST_ONE_STEP, TEST_GLR = 0, 1
+"""Residual tests of a design (``Detection.test``): the paper's one-step test of
+the normalised residuals (eqs. 9-11), or the GLR of a persistent change of their
+mean over a sliding window (``ftc_mc/core/glr.py``)."""
+TEST_NAMES = ("one_step", "glr")
+
+N_GUST_EST = 4
+"""Gust states in a gust-aware filter (the Dryden shaping filter, ``core/dryden.py``),
+appended after the fault parameters: ``[x (9), b (5), g (4)]``."""
+
 # ------------------------------------------------------------------ modes, controllers
 MODE_NAMES = ("nominal", "engine", "left_elevon", "right_elevon")
 """The belief's four modes (section 3.3)."""
