@@ -221,3 +221,23 @@ def test_every_design_flies_the_same_trials():
         assert not di.xa0[14:].any()
         assert di.P0.shape == (di.xa0.shape[0],) * 2
     assert per["gust_glr"].xa0.shape == (18, 3)
+
+
+# ------------------------------------------------------------------ report
+
+def test_report_compares_each_design_with_the_paper():
+    import pandas as pd
+
+    from ftc_mc.plots.campaign import design_styles
+    from ftc_mc.report import variant_comparison
+
+    rows = [{"transition": "elevon_lock", "variant": v, "trial_id": i,
+             "inappropriate": i < k, "no_reset": False, "judged": True}
+            for v, k in (("swapped", 5), ("gust_glr", 0), ("paper", 15)) for i in range(20)]
+    text = "\n".join(variant_comparison(pd.DataFrame(rows)))
+    assert "baseline `paper`" in text
+    assert "#### `swapped` against `paper`" in text
+    assert "#### `gust_glr` against `paper`" in text and "**`gust_glr` is better**" in text
+    st = design_styles(["gust_glr", "swapped", "paper", "x"])
+    assert st["paper"]["linestyle"] == "-" and st["swapped"]["linestyle"] == "--"
+    assert len({(s["linestyle"], s["marker"]) for s in st.values()}) == 4
