@@ -55,6 +55,10 @@ class Design:
         Table 1 settings at the design's thresholds, with its test and window.
     P0 : ndarray, shape (n, n)
         Initial covariance, ``n = 14 + ng`` (``ng`` gust states).
+    test : int
+        ``conventions.TEST_ONE_STEP`` or ``TEST_GLR``.
+    window : int
+        GLR window [steps] (1 with the one-step test).
     key : tuple
         Equal for designs whose runs may share a start (same filter model and
         initial covariance, same test and window; ``ftc_mc/sim/lanes.py``).
@@ -65,6 +69,8 @@ class Design:
     fm: FilterModel
     det: Detection
     P0: np.ndarray
+    test: int
+    window: int
     key: tuple
 
     @property
@@ -81,7 +87,7 @@ class Design:
         if math.isinf(t_q) and math.isinf(t_nx):
             return self.det._replace(t_q=math.inf, t_nx=math.inf)
         det = detection(plant, dataclasses.replace(self.est, t_q=t_q, t_nx=t_nx))
-        return _with_test(det, self.det.test, self.det.window)
+        return _with_test(det, self.test, self.window)
 
 
 def builtin_design(name: str, est: EstimatorConfig) -> DesignConfig:
@@ -142,7 +148,8 @@ def build_design(name: str, dc: DesignConfig, plant: LinearPlant, est: Estimator
     det = _with_test(detection(plant, s), test, window)
     key = (dc.estimator, dc.design_turbulence if dc.estimator == "gust_aware" else None,
            s.sigma_qx, s.sigma_qb, test, window)
-    return Design(name=name, est=s, fm=fm, det=det, P0=_c(P0), key=key)
+    return Design(name=name, est=s, fm=fm, det=det, P0=_c(P0), test=test, window=window,
+                  key=key)
 
 
 def build_designs(names, designs: dict, plant: LinearPlant, est: EstimatorConfig,
