@@ -241,3 +241,16 @@ def test_report_compares_each_design_with_the_paper():
     st = design_styles(["gust_glr", "swapped", "paper", "x"])
     assert st["paper"]["linestyle"] == "-" and st["swapped"]["linestyle"] == "--"
     assert len({(s["linestyle"], s["marker"]) for s in st.values()}) == 4
+
+
+def test_other_design_set_is_never_resumed_or_overwritten(tmp_path):
+    cfg = config(campaign={"trials": 2, "chunk_size": 1})
+    out = tmp_path / "run"
+    res = api.run_campaign(cfg, design=["paper"], out=out, progress=False)
+    assert list(res.summary["variant"].unique()) == ["paper"]
+    with pytest.raises(UserError, match="another configuration"):
+        api.run_campaign(cfg, design=["swapped"], out=out, resume=True, progress=False)
+    with pytest.raises(UserError, match="already holds"):
+        api.run_campaign(cfg, design=["swapped"], out=out, progress=False)
+    assert api.run_campaign(cfg, design=["paper"], out=out, resume=True,
+                            progress=False) is None
