@@ -81,6 +81,17 @@ class RefModel:
     t_nx: float
     variant: str
     reset_var: np.ndarray
+    G: np.ndarray | None = None
+    Ad: np.ndarray | None = None
+    Dg: np.ndarray | None = None
+    Qg: np.ndarray | None = None
+    test: str = "one_step"
+    window: int = 1
+
+    @property
+    def ng(self) -> int:
+        """Gust states carried after the fault parameters (0: the paper's filter)."""
+        return 0 if self.G is None else self.G.shape[1]
 
 
 def paper_q(dt, sigma_qx=0.01, sigma_qb=0.001):
@@ -128,8 +139,30 @@ def ref_model(plant, settings):
 
 
 def aug(model, u):
-    """``A_aug(u)``, ``B_aug``, ``C_aug`` of eq. (5), formed explicitly."""
-    return augmented(model.A, model.B, model.C, u, model.u0)
+    """``A_aug(u)``, ``B_aug``, ``C_aug`` of eq. (5), formed explicitly; with gust
+    states (issue 13) ``F = [[A, B_b0, D(u), G], [0, I, 0], [0, 0, A_d]]``,
+    ``[B; 0; 0]`` and ``[C, 0, D_g]``."""
+    A_aug, B_aug, C_aug = augmented(model.A, model.B, model.C, u, model.u0)
+    ng = model.ng
+    if ng == 0:
+        return A_aug, B_aug, C_aug
+    n0 = A_aug.shape[0]
+    F = np.zeros((n0 + ng, n0 + ng))
+    F[:n0, :n0] = A_aug
+    F[:N_X, n0:] = model.G
+    F[n0:, n0:] = model.Ad
+    Bf = np.vstack([B_aug, np.zeros((ng, B_aug.shape[1]))])
+    Cf = np.hstack([C_aug, model.Dg])
+    return F, Bf, Cf
+
+
+def process_noise(model):
+    """``Q``: the diagonal of eq. (5) on ``x`` and ``b``, ``Qg`` on the gust states."""
+    Q = np.diag(model.q)
+    if model.ng:
+        Q = np.block([[Q, np.zeros((len(model.q), model.ng))],
+                      [np.zeros((model.ng, len(model.q))), model.Qg]])
+    return Q
 
 
 # ------------------------------------------------------------------ filter
@@ -137,7 +170,7 @@ def predict_ref(X, P, u, model):
     """Eq. (5) time update: ``X = A_aug X + B_aug u``, ``P = A_aug P A_aug^T + Q``."""
     A_aug, B_aug, _ = aug(model, u)
     X = A_aug @ X + B_aug @ u
-    P = A_aug @ P @ A_aug.T + np.diag(model.q)
+    P = A_aug @ P @ A_aug.T + process_noise(model)
     return X, P
 
 
@@ -202,9 +235,9 @@ def update_ref(X, P, z, model):
     return X, P
 
 
-def constraints_ref(lo, hi):
+def constraints_ref(lo, hi, n=N_AUG):
     """``D X <= d`` of eq. (6): two rows (upper, lower) per fault parameter."""
-    D = np.zeros((10, N_AUG))
+    D = np.zeros((10, n))
     d = np.zeros(10)
     for j in range(5):
         D[2 * j, N_X + j] = 1.0
@@ -217,7 +250,7 @@ def constraints_ref(lo, hi):
 def project_ref(X, lo, hi):
     """Active-set projection, eq. (8) literally: ``X + L (e - E X)``,
     ``L = E^T (E E^T)^-1`` over the violated rows of eq. (6)."""
-    D, d = constraints_ref(lo, hi)
+    D, d = constraints_ref(lo, hi, len(X))
     violated = D @ X > d
     if not violated.any():
         return np.array(X, dtype=float, copy=True), 0
@@ -227,23 +260,45 @@ def project_ref(X, lo, hi):
     return X + L @ (e - E @ X), int(violated.sum())
 
 
-def filter_step_ref(X, P, u, z, model):
+def innovations_ref(X, P, z, model):
+    """Signed normalised innovations ``mu_i / sqrt(S_ii)`` of q, n_x, n_z."""
+    mu, S = innovation_ref(X, P, z, model)
+    return np.array([mu[i] / np.sqrt(S[i, i]) for i in (OUT_Q, OUT_NX, OUT_NZ)])
+
+
+def glr_ref(newest_first):
+    """GLR of a mean shift over a window (``ftc_mc/core/glr.py``), directly:
+    ``max_m (sum of the m newest e)^2 / m`` per channel; ``newest_first`` is
+    (m, 3).  Zero for an empty window."""
+    e = np.asarray(newest_first, dtype=float)
+    if len(e) == 0:
+        return np.zeros(3)
+    m = np.arange(1, len(e) + 1)[:, None]
+    return np.max(np.cumsum(e, axis=0) ** 2 / m, axis=0)
+
+
+def filter_step_ref(X, P, u, z, model, stat=None):
     """One estimator step in ``ftc_mc.core.step.filter_step``'s order:
     predict, residuals, Table 1; on a reset, reset the block of ``P_{k|k}`` and
-    predict again; update, projection.
+    predict again; update, projection.  ``stat``: a function of the signed
+    innovations giving the decision statistics (the GLR test); ``None`` for
+    the paper's one-step residuals.
 
     Returns
     -------
-    X, P, block, residuals
+    X, P, block, statistics, innovations
     """
     Xp, Pp = predict_ref(X, P, u, model)
     res = residuals_ref(Xp, Pp, z, model)
+    e = innovations_ref(Xp, Pp, z, model)
+    if stat is not None:
+        res = stat(e)
     block = signature_ref(res[0], res[1], res[2], model.t_q, model.t_nx, model.variant)
     if block:
         Xp, Pp = predict_ref(X, reset_ref(P, block, model.reset_var), u, model)
     X, P = update_ref(Xp, Pp, z, model)
     X, _ = project_ref(X, model.lo, model.hi)
-    return X, P, block, res
+    return X, P, block, res, e
 
 
 # ------------------------------------------------------------------ belief
@@ -454,9 +509,13 @@ def ref_of(scheme):
     """A :class:`RefModel` holding the arrays of ``scheme.filter`` and
     ``scheme.detection`` (the builders are checked in test_core_vs_naive)."""
     fm, det = scheme.filter, scheme.detection
+    gust = fm.G.shape[1] > 0
     return RefModel(A=fm.A, B=fm.B, C=fm.C, u0=fm.u0, q=fm.q_diag, r=fm.r_diag, lo=fm.lo,
                     hi=fm.hi, t_q=det.t_q, t_nx=det.t_nx,
-                    variant="swapped" if det.swapped else "paper", reset_var=det.reset_var)
+                    variant="swapped" if det.swapped else "paper", reset_var=det.reset_var,
+                    G=fm.G if gust else None, Ad=fm.Ad if gust else None,
+                    Dg=fm.Dg if gust else None, Qg=fm.Qg if gust else None,
+                    test=("one_step", "glr")[det.test], window=int(det.window))
 
 
 def horizon_cost_ref(c, X, P, scheme):
@@ -464,7 +523,9 @@ def horizon_cost_ref(c, X, P, scheme):
     the prediction with controller ``c`` in the loop: saturated command (eq. 16),
     prediction (eq. 5), update with the predicted measurement (zero
     innovation), projection (eq. 8).  Returns ``I, X_{k+H}, P_{k+H|k+H}``."""
-    model = ref_of(scheme)
+    # the selection predicts with the paper's model (a gust-aware filter's gust
+    # states are left out, core/stages.reconfigure)
+    model = dataclasses.replace(ref_of(scheme), G=None, Ad=None, Dg=None, Qg=None)
     ctl, rc = scheme.controller, scheme.reconfig
     _, _, C_aug = aug(model, np.zeros(3))
     cost = 0.0
@@ -610,18 +671,31 @@ def sensor_fault_ref(z, v, zhold, k, dt, out, kind, size, k_onset):
     return z, zhold
 
 
-def filter_update_ref(scheme, st, u, z):
+def filter_update_ref(scheme, st, u, z, k=0):
     """Every lane's filter step (:func:`filter_step_ref`) and the running maxima
-    of ``r_q``, ``r_nx``.  Returns ``xa, P, res, block, rmax``."""
+    of the decision statistics of ``r_q``, ``r_nx``; with the GLR test the
+    window (``st.ebuf`` row ``k % W``, ``st.ecount``) takes this step's
+    innovations and a reset empties it.  Returns ``xa, P, res, block, rmax,
+    ebuf, ecount``."""
     model = ref_of(scheme)
     L = st.xa.shape[1]
     xa, P = st.xa.copy(), st.P.copy()
+    ebuf, ecount = st.ebuf.copy(), st.ecount.copy()
     res, block = np.zeros((3, L)), np.zeros(L, dtype=np.int64)
+    W = ebuf.shape[0]
     for l in range(L):
-        xa[:, l], P[:, :, l], block[l], res[:, l] = filter_step_ref(
-            st.xa[:, l], st.P[:, :, l], u[:, l], z[:, l], model)
+        stat = None
+        if model.test == "glr":
+            def stat(e, l=l):
+                ebuf[k % W, :, l] = e
+                ecount[l] = min(ecount[l] + 1, W)
+                return glr_ref(ebuf[(k - np.arange(ecount[l])) % W, :, l])
+        xa[:, l], P[:, :, l], block[l], res[:, l], _ = filter_step_ref(
+            st.xa[:, l], st.P[:, :, l], u[:, l], z[:, l], model, stat)
+        if model.test == "glr" and block[l]:
+            ecount[l] = 0
     rmax = np.maximum(st.rmax, res[:2])
-    return xa, P, res, block, rmax
+    return xa, P, res, block, rmax, ebuf, ecount
 
 
 def positive_definite_ref(P):
@@ -687,8 +761,8 @@ def record_step_ref(k, st, u, res, exc, wind, block, hist):
     hist = {f: v.copy() for f, v in hist.items()}
     if k < hist["hist_x"].shape[0]:
         hist["hist_x"][k] = st.x
-        hist["hist_xa"][k] = st.xa
-        hist["hist_pdiag"][k] = np.diagonal(st.P)[:, N_X:].T
+        hist["hist_xa"][k] = st.xa[:N_AUG]
+        hist["hist_pdiag"][k] = np.diagonal(st.P)[:, N_X:N_AUG].T
         hist["hist_u"][k] = u
         hist["hist_res"][k] = res
         hist["hist_exc"][k] = exc
@@ -706,7 +780,8 @@ def reconfigure_ref(scheme, timing, inp, st, kn, period, rec):
                rec_bhat=rec.bhat.copy(), controller=rec.controller.copy(),
                detect_k=rec.detect_k.copy())
     for l in range(st.xa.shape[1]):
-        X, P = st.xa[:, l], st.P[:, :, l]
+        # the paper's 14 states (a gust-aware filter's gust states are not used here)
+        X, P = st.xa[:N_AUG, l], st.P[:N_AUG, :N_AUG, l]
         b, best = belief_update_log_ref(st.belief[:, l], bs.TM, bs.lo, bs.hi, X[N_X:],
                                         np.diag(P)[N_X:])
         out["belief"][:, l] = out["rec_belief"][period, :, l] = b
@@ -732,8 +807,9 @@ def advance_ref(scheme, flight, inp, rec, st, k0, k1):
         u, exc = commands_ref(scheme, st, k)
         tr = truth_step_ref(scheme, flight, inp, k, st, u)
         st.x[:], st.gust[:], st.zhold[:] = tr["x"], tr["gust"], tr["zhold"]
-        xa, P, res, block, rmax = filter_update_ref(scheme, st, u, tr["z"])
+        xa, P, res, block, rmax, ebuf, ecount = filter_update_ref(scheme, st, u, tr["z"], k)
         st.xa[:], st.P[:], st.rmax[:] = xa, P, rmax
+        st.ebuf[:], st.ecount[:] = ebuf, ecount
         alive, status, stop_k = check_validity_ref(flight.validity, st, kn, tr["va"],
                                                    tr["alpha"], rec.status, rec.stop_k)
         st.alive[:], rec.status[:], rec.stop_k[:] = alive, status, stop_k
@@ -754,5 +830,5 @@ def advance_ref(scheme, flight, inp, rec, st, k0, k1):
             st.belief[:], st.cur[:] = out["belief"], out["cur"]
             rec.belief[:], rec.bhat[:] = out["rec_belief"], out["rec_bhat"]
             rec.controller[:], rec.detect_k[:] = out["controller"], out["detect_k"]
-    rec.xa_end[:] = st.xa
+    rec.xa_end[:] = st.xa[:rec.xa_end.shape[0]]
     return rec, st

@@ -163,11 +163,14 @@ def test_residuals_lanes(plant):
     Ps = [random_spd(rng) for _ in range(L)]
     z = rng.normal(0.0, 0.3, (12, L))
     res = np.zeros((3, L))
-    kb.residuals_lanes(X, lanes_of(Ps), z, fm, res)
+    innov = np.zeros((3, L))
+    kb.residuals_lanes(X, lanes_of(Ps), z, fm, res, innov)
     for l in range(L):
         out = np.zeros(3)
         kk.residuals(X[:, l].copy(), Ps[l], z[:, l].copy(), fm, out)
         assert rel_err(res[:, l], out) <= TOL
+        # the signed innovation squares to the residual (eqs. 9-11)
+        assert rel_err(innov[:, l] ** 2, out) <= 1e-13
 
 
 @pytest.mark.parametrize("swapped", [0, 1])

@@ -131,7 +131,8 @@ def random_lanes(setup, rng, k, L=L):
                      belief=np.ascontiguousarray(rng.dirichlet(np.ones(4), L).T),
                      alive=alive, cur=(np.arange(L) % N_CONTROLLERS).astype(np.int64),
                      rmax=rng.uniform(0.0, 50.0, (2, L)), gust=gust,
-                     zhold=rng.standard_normal(L))
+                     zhold=rng.standard_normal(L), ebuf=np.zeros((1, 3, L)),
+                     ecount=np.zeros(L, dtype=np.int64))
 
 
 def copy_nt(nt):
@@ -425,9 +426,9 @@ def test_filter_update(linear, variant):
             Xp, Pp = naive.predict_ref(st.xa[:, l], st.P[:, :, l], work.u[:, l], model)
             mu0, S = naive.innovation_ref(Xp, Pp, np.zeros(12), model)
             work.z[:, l] = -mu0 + scale[l] * np.sqrt(np.diag(S)) * rng.standard_normal(12)
-        xa, P, res, block, rmax = naive.filter_update_ref(scheme, st, work.u, work.z)
+        xa, P, res, block, rmax, _, _ = naive.filter_update_ref(scheme, st, work.u, work.z)
         Pk = st.P.copy()
-        stages.filter_update(scheme, st, work)
+        stages.filter_update(scheme, st, 10, work)
         assert np.array_equal(work.block, block)
         assert_lanes(work.res, res, 1e-12, "residuals")
         assert rel(st.rmax, rmax) <= 1e-12
@@ -585,7 +586,7 @@ def test_advance_matches_the_chained_twins(fixture, request):
     g0 = np.zeros((4, L)) if setup.gust is None else rng.standard_normal((4, L))
     inp = inp._replace(xa0=xa0, g0=g0)
     rec = new_rec(flight.timing, max_resets=16)
-    st = trial.new_state(L)
+    st = trial.new_state(L, N_AUG, 1)
     trial.init_state(inp, st, rec)
     rec_n, st_n = naive.advance_ref(scheme, flight, inp, copy_nt(rec), copy_nt(st), 0, 25)
     trial.advance(scheme, flight, inp, rec, st, 0, 25)

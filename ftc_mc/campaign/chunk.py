@@ -138,6 +138,9 @@ def classify(spec: ChunkSpec, tr_name: str, variant: str, trial_ids, values,
     * ``no_reset``: nothing was reset in the window;
     * ``false_resets``: resets at or before ``k_f``;
     * ``first_reset_s``: delay from the switch to the first reset in the window;
+    * ``correct_reset_s``: delay from the switch to the first reset of the
+      correct block in the window (NaN when it had none), whatever was reset
+      before it; the detection delay of the operating characteristic;
     * ``detection_s``: delay from the switch to the first belief update where
       the final mode is the most probable with at least ``detect_prob``; NaN when
       the final mode equals the initial one (nothing to detect);
@@ -181,6 +184,7 @@ def classify(spec: ChunkSpec, tr_name: str, variant: str, trial_ids, values,
     first = np.where(n_win > 0, np.argmax(in_win, axis=0), 0)
     first_k = k[first, np.arange(L)]
     first_block = blk[first, np.arange(L)]
+    _, correct_reset_s = _first_after(in_win & (blk == tr.correct_block), k, kf, dt)
     changed = inp.mode_pre != inp.mode_post
     detected = changed & (rec.detect_k >= 0)
     a = tr.actuator
@@ -212,6 +216,7 @@ def classify(spec: ChunkSpec, tr_name: str, variant: str, trial_ids, values,
         "first_reset_s": np.where(n_win > 0, (first_k - kf) * dt, np.nan),
         "first_reset_block": np.array([BLOCK_NAMES[b] if n else "none"
                                        for b, n in zip(first_block, n_win)], dtype=object),
+        "correct_reset_s": correct_reset_s,
         "resets_in_window": n_win.astype(np.int64),
         "false_resets": before.sum(axis=0).astype(np.int64),
         "resets_total": rec.n_resets.copy(),
@@ -286,8 +291,8 @@ def classify_sensor(spec: ChunkSpec, tr_name: str, variant: str, trial_ids, size
 
     The actuator-row columns keep their definitions with the correct block
     ``none``: ``correct`` is True for no reset in the window, ``inappropriate``
-    for any, and ``no_reset`` equals ``correct``; the summary does not report
-    them for sensor rows.  ``judged``: no numerical failure and every reset
+    for any, and ``no_reset`` equals ``correct``; ``correct_reset_s`` is NaN
+    (no block is correct); the summary does not report them for sensor rows.  ``judged``: no numerical failure and every reset
     stored (an envelope exit is an outcome here, not an exclusion).
     """
     setup = spec.setup
@@ -333,6 +338,7 @@ def classify_sensor(spec: ChunkSpec, tr_name: str, variant: str, trial_ids, size
         "first_reset_s": np.where(n_win > 0, (first_k - kf) * dt, np.nan),
         "first_reset_block": np.array([BLOCK_NAMES[b] if n else "none"
                                        for b, n in zip(first_block, n_win)], dtype=object),
+        "correct_reset_s": np.full(L, np.nan),
         "resets_in_window": n_win.astype(np.int64),
         "false_resets": before.sum(axis=0).astype(np.int64),
         "resets_total": rec.n_resets.copy(),

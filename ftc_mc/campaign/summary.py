@@ -36,8 +36,29 @@ def _quantiles(prefix: str, values: np.ndarray) -> dict:
     return {f"{prefix}_median_s": median, f"{prefix}_p95_s": p95}
 
 
+def _column(trials: pd.DataFrame, col: str) -> np.ndarray:
+    """``trials[col]`` as floats, all NaN when the column is missing (tables
+    written before it existed)."""
+    if col not in trials:
+        return np.full(len(trials), np.nan)
+    return trials[col].to_numpy(dtype=float)
+
+
 def summarize(trials: pd.DataFrame) -> pd.DataFrame:
     """Summary table of a campaign.
+
+    Columns of an actuator row besides the counts: ``<x>``, ``<x>_rate``,
+    ``<x>_ci_low``, ``<x>_ci_high`` (95 % Wilson) for ``inappropriate``,
+    ``no_reset``, ``correct`` (the correct block was reset in the window) and
+    ``correct_only`` (it was, and the other block was not: the correct-block
+    rate of the operating characteristic); ``delay_median_s`` /
+    ``delay_p95_s``: delay from the switch to the first reset of any block in
+    the window [s], over the trials with one; ``correct_delay_median_s`` /
+    ``correct_delay_p95_s``: delay from the switch to the first reset of the
+    correct block in the window [s] (``correct_reset_s``), over the trials with
+    one, whatever was reset before it (the detection delay of the operating
+    characteristic; NaN for trials tables without that column);
+    ``detection_median_s`` / ``detection_p95_s``: the belief's detection time [s].
 
     Only judged trials (``judged`` column: no numerical failure, inside the
     validity envelope through the judging window, all resets stored) enter the
@@ -79,7 +100,9 @@ def summarize(trials: pd.DataFrame) -> pd.DataFrame:
         row["no_reset_explained_share"] = (explained.sum() / no_reset.sum()
                                            if no_reset.sum() else np.nan)
         row.update(_rate("correct", int(ok["correct"].sum()), n))
+        row.update(_rate("correct_only", int((ok["correct"] & ~ok["inappropriate"]).sum()), n))
         row.update(_quantiles("delay", ok["first_reset_s"].to_numpy()))
+        row.update(_quantiles("correct_delay", _column(ok, "correct_reset_s")))
         row["false_alarm_trials"] = int((ok["false_resets"] > 0).sum())
         row["false_resets"] = int(ok["false_resets"].sum())
         row["mode_changes"] = int(changed.sum())
@@ -164,8 +187,9 @@ def sensor_markdown_table(summary: pd.DataFrame, intervals: bool = True) -> str:
     return pd.DataFrame(rows).to_markdown(index=False)
 
 
-_COUNTS = ("inappropriate", "no_reset", "no_reset_explained", "correct", "false_alarm_trials",
-           "mode_changes", "detected", "paper_trials", "paper_inappropriate", "paper_no_reset")
+_COUNTS = ("inappropriate", "no_reset", "no_reset_explained", "correct", "correct_only",
+           "false_alarm_trials", "mode_changes", "detected", "paper_trials",
+           "paper_inappropriate", "paper_no_reset")
 
 
 def actuator_rows(summary: pd.DataFrame) -> pd.DataFrame:

@@ -86,8 +86,12 @@ class SweepResult:
     ----------
     table : DataFrame
         One row per threshold point, transition and design (``variant``): the summary columns
-        of :func:`~ftc_mc.campaign.summary.summarize` plus the false-reset rate
-        per flight hour with its exact Poisson 95 % interval.
+        of :func:`~ftc_mc.campaign.summary.summarize` (among them the
+        operating characteristic's correct-block rate ``correct_only_rate``
+        with its Wilson interval and the correct-block delay
+        ``correct_delay_median_s`` / ``_p95_s`` [s]) plus the false-reset rate
+        per flight hour with its exact Poisson 95 % interval and the flight
+        hours between false resets (:func:`add_hours_per_false_reset`).
     trials : DataFrame
         Every trial at every point.
     simulated_steps, alone_steps : int
@@ -107,6 +111,40 @@ class SweepResult:
     def saving(self) -> float:
         """Fraction of trial steps saved by sharing trials across thresholds."""
         return 1.0 - self.simulated_steps / self.alone_steps
+
+
+def _reciprocal(rate) -> np.ndarray:
+    """``1 / rate`` with ``1 / 0 = inf`` and NaN kept."""
+    r = np.asarray(rate, dtype=float)
+    with np.errstate(divide="ignore"):
+        return np.where(r == 0, np.inf, 1.0 / r)
+
+
+def add_hours_per_false_reset(table: pd.DataFrame) -> pd.DataFrame:
+    """``table`` with the flight hours between false resets, from its rates.
+
+    ``hours_per_false_reset`` = 1 / ``false_resets_per_hour`` [h]: infinite
+    when no false reset was seen (the hours flown, ``flight_hours``, are then
+    the lower bound a report shows); ``hours_per_false_reset_ci_low`` /
+    ``_ci_high``: the reciprocals of the rate's exact 95 % bounds [h] (the
+    upper one infinite when the rate's lower bound is 0).  NaN where no
+    fault-free flight was judged.
+
+    Parameters
+    ----------
+    table : DataFrame
+        With ``false_resets_per_hour`` and its ``_ci_low`` / ``_ci_high`` [1/h].
+
+    Returns
+    -------
+    DataFrame
+        A copy with the three columns added.
+    """
+    out = table.copy()
+    out["hours_per_false_reset"] = _reciprocal(out["false_resets_per_hour"])
+    out["hours_per_false_reset_ci_low"] = _reciprocal(out["false_resets_per_hour_ci_high"])
+    out["hours_per_false_reset_ci_high"] = _reciprocal(out["false_resets_per_hour_ci_low"])
+    return out
 
 
 def run_sweep(cfg: Config, points, *, flights: int | None = None, jobs: int = 1,
@@ -170,6 +208,7 @@ def run_sweep(cfg: Config, points, *, flights: int | None = None, jobs: int = 1,
                       "false_resets_per_hour_ci_low": lo,
                       "false_resets_per_hour_ci_high": hi})
     table = table.merge(pd.DataFrame(rates), on=["t_q", "t_nx", "variant"], how="left")
+    table = add_hours_per_false_reset(table)
     return SweepResult(table=table, trials=trials, simulated_steps=sim, alone_steps=alone,
                        config=cfg, points=list(points))
 

@@ -44,6 +44,8 @@ so no kernel allocates.
 
 from __future__ import annotations
 
+import numpy as np
+
 from .jit import kernel
 from .signature import NO_RESET, in_block, signature
 
@@ -279,7 +281,7 @@ def predict_lanes(xa, P, u, fm, phi, T):
 
 # ------------------------------------------------------------------ residuals
 @kernel
-def residuals_lanes(xa, P, z, fm, res):
+def residuals_lanes(xa, P, z, fm, res, innov):
     """Normalised residuals ``r_q, r_nx, r_nz`` of every lane (eqs. 9-11).
 
     As :func:`ftc_mc.core.kalman.residuals`: ``r_i = mu_i^2 / (C_i P C_i^T + R_ii)``
@@ -297,6 +299,9 @@ def residuals_lanes(xa, P, z, fm, res):
     res : ndarray, shape (3, L)
         Written with ``[r_q, r_nx, r_nz]`` of each lane (outputs
         :data:`ftc_mc.conventions.RESIDUAL_OUTPUTS`).
+    innov : ndarray, shape (3, L)
+        Written with the signed normalised innovations ``mu_i / sqrt(S_ii)``
+        (``r_i = innov_i^2`` up to rounding; the GLR test reads them).
     """
     L = xa.shape[1]
     for o in range(len(RESIDUAL_OUTPUTS)):
@@ -308,6 +313,7 @@ def residuals_lanes(xa, P, z, fm, res):
                 mu = z[r, l] - xa[s_idx, l]
                 s = P[s_idx, s_idx, l] + rr
                 res[o, l] = mu * mu / s
+                innov[o, l] = mu / np.sqrt(s)
         else:
             c = _row_x(fm.C, r)
             for l in range(L):
@@ -322,6 +328,7 @@ def residuals_lanes(xa, P, z, fm, res):
                 mu = z[r, l] - pred
                 s = s + rr
                 res[o, l] = mu * mu / s
+                innov[o, l] = mu / np.sqrt(s)
 
 
 # ------------------------------------------------------------------ signature
@@ -549,51 +556,35 @@ def project_lanes(xa, fm):
 
 # ------------------------------------------------------------------ step
 @kernel
-def filter_step_lanes(xa, P, u, z, fm, det, phi, T, work, res, block):
-    """Advance every lane's filter by one sampling period, as
-    :func:`ftc_mc.core.step.filter_step`.
+def filter_predict_lanes(xa, P, u, z, fm, phi, T, work, res, innov):
+    """First half of :func:`filter_step_lanes`: predict (eq. 5) into ``work[:n]``
+    and the residuals (eqs. 9-11); ``x_{k|k}`` is kept in ``work`` for a re-prediction.
 
-    Per lane: predict (eq. 5); residuals (eqs. 9-11); Table 1 signature; on a
-    reset, reset the block of ``P_{k|k}`` (section 3.2.2) and predict again from
-    it; measurement update; projection of the fault parameters (eqs. 6-8).
-
-    ``P_{k|k}`` stays in ``P`` while the prediction goes to ``work[:n]``, so
-    the lanes that reset are re-predicted without a copy of ``P``: up to
-    ``SERIAL_REPREDICT`` of them run by run of adjacent lanes, more by
-    predicting every lane again (bit-identical for the others).
-
-    Parameters
-    ----------
-    xa : ndarray, shape (n, L)
-        Augmented estimates, updated in place (``n = 14`` in the paper).
-    P : ndarray, shape (n, n, L)
-        Covariances, updated in place (exactly symmetric).
-    u : ndarray, shape (3, L)
-        Command deviations applied during the step.
-    z : ndarray, shape (12, L)
-        Measurement deviations from trim outputs at the end of the step.
-    fm : FilterModel
-    det : Detection
-    phi, T : ndarray
-        Work arrays of shapes (9, 5, L) and (9, n, L).
-    work : ndarray, shape (step_rows(n), n, L)
-        Work array (``STEP_ROWS = 28`` rows for the paper's filter).
-    res : ndarray, shape (3, L)
-        Written with ``[r_q, r_nx, r_nz]`` on the first prediction.
-    block : ndarray of int64, shape (L,)
-        Written with the block reset this step per lane (0 if none).
+    ``xa`` holds ``X_{k+1|k}`` on return, ``P`` still ``P_{k|k}``.  Parameters
+    as :func:`filter_step_lanes`; ``innov`` (3, L) is written with the signed
+    normalised innovations.
     """
     n = xa.shape[0]
     L = xa.shape[1]
     Pn = work[0:n]
-    h = work[n:n + UPDATE_ROWS]
     x_prev = work[n + UPDATE_ROWS]
     for i in range(N_X):
         for l in range(L):
             x_prev[i, l] = xa[i, l]
     _predict(xa, P, Pn, u, fm, phi, T, 0, L)
-    residuals_lanes(xa, Pn, z, fm, res)
-    signature_lanes(res, det, block)
+    residuals_lanes(xa, Pn, z, fm, res, innov)
+
+
+@kernel
+def filter_correct_lanes(xa, P, u, z, fm, det, phi, T, work, block):
+    """Second half of :func:`filter_step_lanes`, once ``block`` is decided: reset
+    and re-predict the lanes that reset, update, projection.  Parameters as
+    :func:`filter_step_lanes`."""
+    n = xa.shape[0]
+    L = xa.shape[1]
+    Pn = work[0:n]
+    h = work[n:n + UPDATE_ROWS]
+    x_prev = work[n + UPDATE_ROWS]
     n_reset = 0
     for l in range(L):
         if block[l] != 0:
@@ -624,3 +615,47 @@ def filter_step_lanes(xa, P, u, z, fm, det, phi, T, work, res, block):
     _update(xa, Pn, z, fm, h)
     _symmetric_copy(Pn, P, L)
     project_lanes(xa, fm)
+
+
+@kernel
+def filter_step_lanes(xa, P, u, z, fm, det, phi, T, work, res, block, innov):
+    """Advance every lane's filter by one sampling period, as
+    :func:`ftc_mc.core.step.filter_step`.
+
+    Per lane: predict (eq. 5); residuals (eqs. 9-11); Table 1 signature; on a
+    reset, reset the block of ``P_{k|k}`` (section 3.2.2) and predict again from
+    it; measurement update; projection of the fault parameters (eqs. 6-8).
+    The halves :func:`filter_predict_lanes` and :func:`filter_correct_lanes`
+    let a windowed test decide the block in between (``core/stages.py``).
+
+    ``P_{k|k}`` stays in ``P`` while the prediction goes to ``work[:n]``, so
+    the lanes that reset are re-predicted without a copy of ``P``: up to
+    ``SERIAL_REPREDICT`` of them run by run of adjacent lanes, more by
+    predicting every lane again (bit-identical for the others).
+
+    Parameters
+    ----------
+    xa : ndarray, shape (n, L)
+        Augmented estimates, updated in place (``n = 14`` in the paper).
+    P : ndarray, shape (n, n, L)
+        Covariances, updated in place (exactly symmetric).
+    u : ndarray, shape (3, L)
+        Command deviations applied during the step.
+    z : ndarray, shape (12, L)
+        Measurement deviations from trim outputs at the end of the step.
+    fm : FilterModel
+    det : Detection
+    phi, T : ndarray
+        Work arrays of shapes (9, 5, L) and (9, n, L) (more rows allowed).
+    work : ndarray, shape (step_rows(n), n, L)
+        Work array (``STEP_ROWS = 28`` rows for the paper's filter).
+    res : ndarray, shape (3, L)
+        Written with ``[r_q, r_nx, r_nz]`` on the first prediction.
+    block : ndarray of int64, shape (L,)
+        Written with the block reset this step per lane (0 if none).
+    innov : ndarray, shape (3, L)
+        Written with the signed normalised innovations.
+    """
+    filter_predict_lanes(xa, P, u, z, fm, phi, T, work, res, innov)
+    signature_lanes(res, det, block)
+    filter_correct_lanes(xa, P, u, z, fm, det, phi, T, work, block)

@@ -19,14 +19,25 @@ FilterModel = namedtuple("FilterModel", [
     "r_diag",   # (12,) diagonal of R (paper section 5.1)
     "lo",       # (5,)  lower bounds of b0, b1 (eq. 6)
     "hi",       # (5,)  upper bounds of b0, b1 (eq. 6)
+    "G",        # (9, ng)  gust-aware filter: gust states -> plant states (B_w C_d)
+    "Ad",       # (ng, ng) gust-state transition (Dryden, core/dryden.py)
+    "Dg",       # (12, ng) gust states -> outputs (D_w C_d)
+    "Qg",       # (ng, ng) gust-state process noise (B_d B_d^T)
 ])
-"""The augmented Kalman filter's model (paper eqs. 4-6)."""
+"""The augmented Kalman filter's model (paper eqs. 4-6).
+
+The estimate is ``[x (9), b (5), g (ng)]``: the paper's filter has ``ng = 0``
+(the gust arrays are empty, :mod:`ftc_mc.core.batch`); a gust-aware filter
+carries the ``ng = 4`` Dryden states of the longitudinal gusts
+(:mod:`ftc_mc.core.gustfilter`, issue 13)."""
 
 Detection = namedtuple("Detection", [
     "t_q",        # threshold on r_q (Table 1), > 0
     "t_nx",       # threshold on r_nx (Table 1), > 0
     "swapped",    # 0: Table 1 as printed; 1: third clause's r_nz test swapped
     "reset_var",  # (5,) variance of each fault parameter after its block's reset
+    "test",       # conventions.TEST_ONE_STEP (eqs. 9-11) or TEST_GLR (core/glr.py)
+    "window",     # GLR window [steps] (1 with the one-step test)
 ])
 """Residual signature and covariance reset (paper section 3.2.2, Table 1)."""
 
@@ -163,6 +174,8 @@ LaneState = namedtuple("LaneState", [
     "rmax",     # (2, L) largest r_q and r_nx seen so far (threshold sharing)
     "gust",     # (4, L) Dryden gust filter state (zeros without turbulence)
     "zhold",    # (L,) last healthy measurement of the lane's faulty output (stuck)
+    "ebuf",     # (W, 3, L) signed normalised innovations of the GLR window (ring)
+    "ecount",   # (L,) int64 innovations in the window since the start or last reset
 ])
 """Everything a trial carries from one step to the next (core/trial.py)."""
 

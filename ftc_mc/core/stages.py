@@ -35,10 +35,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..conventions import (C_ELEVON, I_B1_LEFT, I_B1_THRUST, N_FAULT, N_MODES, N_U,
-                           N_X, NO_RESET, RESET_THRUST, STATUS_AIRSPEED,
-                           STATUS_ALPHA, STATUS_NONFINITE, STATUS_NOT_PSD, STATUS_OK)
-from .batch import filter_step_lanes
+from ..conventions import (C_ELEVON, I_B1_LEFT, I_B1_THRUST, N_AUG, N_FAULT, N_MODES,
+                           N_U, N_X, NO_RESET, RESET_THRUST, STATUS_AIRSPEED,
+                           STATUS_ALPHA, STATUS_NONFINITE, STATUS_NOT_PSD, STATUS_OK,
+                           TEST_GLR)
+from .batch import filter_correct_lanes, filter_predict_lanes, signature_lanes
+from .glr import glr_lanes, glr_restart
+from .gustfilter import gust_correct_lanes, gust_predict_lanes
 from .belief import belief_update
 from .control import (U_LEFT, U_RIGHT, U_THRUST, controller_command,
                       select_controllers_lanes)
@@ -133,11 +136,16 @@ def commands(scheme, st, k, work):
 
 # ------------------------------------------------------------------ 3. filter
 @kernel(inline="always")
-def filter_update(scheme, st, work):
+def filter_update(scheme, st, k, work):
     """Stage 3: one step of every lane's augmented filter (eqs. 5-11, Table 1).
 
-    Predict with ``u_k``, residuals, signature and reset, update with
-    ``z_{k+1}``, projection (:func:`ftc_mc.core.batch.filter_step_lanes`); then
+    Predict with ``u_k`` and the residuals on ``z_{k+1}``
+    (:func:`ftc_mc.core.batch.filter_predict_lanes` for the paper's 14-state
+    filter, :func:`ftc_mc.core.gustfilter.gust_predict_lanes` when the estimate
+    carries gust states); with the GLR test (``detection.test == TEST_GLR``)
+    the statistics of :func:`ftc_mc.core.glr.glr_lanes` replace the one-step
+    residuals; Table 1 on them; reset, update and projection (the
+    ``*_correct_lanes`` halves); a reset restarts the lane's GLR window.  Then
     the largest ``r_q`` and ``r_nx`` seen so far (threshold sweeps).
 
     Parameters
@@ -145,14 +153,35 @@ def filter_update(scheme, st, work):
     scheme : Scheme
         Reads ``filter`` and ``detection``.
     st : LaneState
-        ``xa``, ``P`` advanced in place; ``rmax`` updated.
+        ``xa``, ``P`` advanced in place; ``rmax`` updated; the GLR window
+        ``ebuf``, ``ecount``.
+    k : int
+        Step (the GLR window's ring position).
     work : TrialWork
-        Reads ``u``, ``z``; writes ``res`` and ``block``; filter work ``phi``,
-        ``T``, ``fwork``.
+        Reads ``u``, ``z``; writes ``res`` (the decision statistics: one-step
+        residuals or GLR), ``innov`` and ``block``; filter work ``phi``, ``T``,
+        ``fwork``, ``crow``.
     """
-    filter_step_lanes(st.xa, st.P, work.u, work.z, scheme.filter, scheme.detection,
-                      work.phi, work.T, work.fwork, work.res, work.block)
+    fm = scheme.filter
+    det = scheme.detection
     res = work.res
+    if st.xa.shape[0] == N_AUG:
+        filter_predict_lanes(st.xa, st.P, work.u, work.z, fm, work.phi, work.T, work.fwork,
+                             res, work.innov)
+    else:
+        gust_predict_lanes(st.xa, st.P, work.u, work.z, fm, work.phi, work.T, work.fwork,
+                           work.crow, res, work.innov)
+    if det.test == TEST_GLR:
+        glr_lanes(work.innov, st.ebuf, st.ecount, k, res)
+    signature_lanes(res, det, work.block)
+    if st.xa.shape[0] == N_AUG:
+        filter_correct_lanes(st.xa, st.P, work.u, work.z, fm, det, work.phi, work.T,
+                             work.fwork, work.block)
+    else:
+        gust_correct_lanes(st.xa, st.P, work.u, work.z, fm, det, work.phi, work.T,
+                           work.fwork, work.crow, work.block)
+    if det.test == TEST_GLR:
+        glr_restart(work.block, st.ecount)
     for l in range(st.xa.shape[1]):
         st.rmax[R_Q, l] = max(st.rmax[R_Q, l], res[R_Q, l])
         st.rmax[R_NX, l] = max(st.rmax[R_NX, l], res[R_NX, l])
@@ -330,7 +359,7 @@ def record_step(k, st, work, rec):
     for l in range(xa.shape[1]):
         for i in range(x.shape[0]):
             rec.hist_x[k, i, l] = x[i, l]
-        for i in range(xa.shape[0]):
+        for i in range(rec.hist_xa.shape[1]):  # the paper's 14 (no gust states)
             rec.hist_xa[k, i, l] = xa[i, l]
         for j in range(N_FAULT):
             rec.hist_pdiag[k, j, l] = P[N_X + j, N_X + j, l]
@@ -405,7 +434,17 @@ def reconfigure(scheme, timing, inp, st, kn, period, work, rec):
                 and bl[mp] >= timing.detect_prob):
             rec.detect_k[l] = kn
     if scheme.reconfig.kind != 0:
-        select_controllers_lanes(st.cur, xa, P, st.belief, scheme, work.lsel)
+        if xa.shape[0] == N_AUG:
+            select_controllers_lanes(st.cur, xa, P, st.belief, scheme, work.lsel)
+        else:  # the selection predicts with the paper's model: the first 14 states
+            for i in range(N_AUG):
+                for l in range(L):
+                    work.xsel[i, l] = xa[i, l]
+                for j in range(N_AUG):
+                    for l in range(L):
+                        work.Psel[i, j, l] = P[i, j, l]
+            select_controllers_lanes(st.cur, work.xsel, work.Psel, st.belief, scheme,
+                                     work.lsel)
     for l in range(L):
         rec.controller[period, l] = st.cur[l]
 
@@ -413,7 +452,8 @@ def reconfigure(scheme, timing, inp, st, kn, period, work, rec):
 # ------------------------------------------------------------------ end
 @kernel(inline="always")
 def record_end(st, rec):
-    """The final augmented estimate of every lane (``rec.xa_end``)."""
-    for i in range(st.xa.shape[0]):
+    """The final augmented estimate of every lane (``rec.xa_end``; its first 14
+    states when the filter carries gust states)."""
+    for i in range(rec.xa_end.shape[0]):
         for l in range(st.xa.shape[1]):
             rec.xa_end[i, l] = st.xa[i, l]

@@ -31,7 +31,7 @@ import numpy as np
 
 from ..conventions import (N_AUG, N_MODES, N_X, STATUS_AIRSPEED,  # noqa: F401
                            STATUS_ALPHA, STATUS_NAMES, STATUS_NONFINITE,
-                           STATUS_NOT_PSD, STATUS_OK, C_NOMINAL)
+                           STATUS_NOT_PSD, STATUS_OK, C_NOMINAL, RESIDUAL_OUTPUTS)
 from .dryden import N_GUST_STATE
 from .jit import kernel
 from .plant import truth_step
@@ -81,7 +81,7 @@ def advance(scheme, flight, inp, rec, st, k0, k1):
         kn = k + 1
         commands(scheme, st, k, work)
         truth_step(scheme.filter, flight, inp, k, st, work)
-        filter_update(scheme, st, work)
+        filter_update(scheme, st, k, work)
         check_validity(flight.validity, st, kn, work, rec)
         handle_resets(scheme.excitation, st, kn, work, rec)
         record_step(k, st, work, rec)
@@ -121,20 +121,23 @@ def init_state(inp, st, rec):
         for i in range(st.gust.shape[0]):
             st.gust[i, l] = inp.g0[i, l]
         st.zhold[l] = 0.0
+        st.ecount[l] = 0
 
 
 @kernel
-def new_state(L):
-    """A :class:`LaneState` of ``L`` lanes of the paper's filter (contents set by
-    :func:`init_state`)."""
-    return LaneState(x=np.zeros((N_X, L)), xa=np.zeros((N_AUG, L)),
-                     P=np.zeros((N_AUG, N_AUG, L)),
+def new_state(L, n, window):
+    """A :class:`LaneState` of ``L`` lanes, an ``n``-state estimate (14: the
+    paper's filter; 18 with gust states) and a GLR window of ``window`` steps
+    (1 for the one-step test); contents set by :func:`init_state`."""
+    return LaneState(x=np.zeros((N_X, L)), xa=np.zeros((n, L)),
+                     P=np.zeros((n, n, L)),
                      d_start=np.zeros(L, dtype=np.int64),
                      s_start=np.zeros(L, dtype=np.int64),
                      recheck=np.zeros(L, dtype=np.int64), belief=np.zeros((N_MODES, L)),
                      alive=np.zeros(L, dtype=np.bool_), cur=np.zeros(L, dtype=np.int64),
                      rmax=np.zeros((N_RMAX, L)), gust=np.zeros((N_GUST_STATE, L)),
-                     zhold=np.zeros(L))
+                     zhold=np.zeros(L), ebuf=np.zeros((window, len(RESIDUAL_OUTPUTS), L)),
+                     ecount=np.zeros(L, dtype=np.int64))
 
 
 @kernel
@@ -144,6 +147,6 @@ def run_trials(scheme, flight, inp, rec):
     Parameters are those of :func:`advance` without the state and step range;
     ``rec`` is overwritten.
     """
-    st = new_state(inp.w.shape[2])
+    st = new_state(inp.w.shape[2], inp.xa0.shape[0], scheme.detection.window)
     init_state(inp, st, rec)
     advance(scheme, flight, inp, rec, st, 0, flight.timing.n_steps)

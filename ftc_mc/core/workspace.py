@@ -19,7 +19,8 @@ from collections import namedtuple
 
 import numpy as np
 
-from ..conventions import N_CONTROLLERS, N_FAULT, N_MODES, N_U, N_X, N_Z, RESIDUAL_NAMES
+from ..conventions import (N_AUG, N_CONTROLLERS, N_FAULT, N_MODES, N_U, N_X, N_Z,
+                           RESIDUAL_NAMES)
 from .batch import UPDATE_ROWS, step_rows
 from .dryden import N_GUST_NOISE, N_GUST_OUT, N_GUST_STATE
 from .jit import kernel
@@ -82,16 +83,20 @@ TrialWork = namedtuple("TrialWork", [
     "va",         # (L,) true airspeed [m/s] (air-relative)
     "alpha",      # (L,) true angle of attack [rad] (air-relative)
     "phi",        # (N_X, N_FAULT, L) filter work (batch.filter_step_lanes)
-    "T",          # (N_X, n, L) filter work
+    "T",          # (n, n, L) filter work (the paper's filter uses N_X rows)
     "fwork",      # (step_rows(n), n, L) filter work
     "res",        # (N_RES, L) residuals r_q, r_nx, r_nz (eqs. 9-11)
     "block",      # (L,) int64 block reset this step (Table 1)
+    "innov",      # (N_RES, L) signed normalised innovations (the GLR test's input)
+    "xsel",       # (N_AUG, L) the paper's part of a gust-aware estimate (selection)
+    "Psel",       # (N_AUG, N_AUG, L) its covariance
     "finite",     # (L,) bool: the lane's estimate, variances and air data are finite
     # one lane at a time
     "xl",         # (n,) a lane's estimate
     "Pl",         # (n, n) a lane's covariance
     "Ul",         # (N_U,) a lane's command
     "chol",       # (n, n) Cholesky factor of the positive-definiteness test
+    "crow",       # (n,) a row of the gust-aware filter's C_aug
     "gust",       # (N_GUST_STATE,) a lane's gust filter state
     "eta",        # (N_GUST_NOISE,) a lane's gust draws
     "wl",         # (N_GUST_OUT,) a lane's gust
@@ -140,12 +145,15 @@ def new_trial_work(L, n):
         u=np.zeros((N_U, L)), exc=np.zeros((N_EXC, L)), e=np.zeros((N_U, L)),
         wind=np.zeros((N_GUST_OUT, L)), wind_next=np.zeros((N_GUST_OUT, L)),
         x_next=np.zeros((N_X, L)), z=np.zeros((N_Z, L)), va=np.zeros(L),
-        alpha=np.zeros(L), phi=np.zeros((N_X, N_FAULT, L)), T=np.zeros((N_X, n, L)),
+        alpha=np.zeros(L), phi=np.zeros((N_X, N_FAULT, L)), T=np.zeros((n, n, L)),
         fwork=np.zeros((step_rows(n), n, L)), res=np.zeros((N_RES, L)),
-        block=np.zeros(L, dtype=np.int64), finite=np.zeros(L, dtype=np.bool_),
+        block=np.zeros(L, dtype=np.int64), innov=np.zeros((N_RES, L)),
+        xsel=np.zeros((N_AUG, L)), Psel=np.zeros((N_AUG, N_AUG, L)),
+        finite=np.zeros(L, dtype=np.bool_),
         xl=np.zeros(n), Pl=np.zeros((n, n)), Ul=np.zeros(N_U), chol=np.zeros((n, n)),
+        crow=np.zeros(n),
         gust=np.zeros(N_GUST_STATE), eta=np.zeros(N_GUST_NOISE), wl=np.zeros(N_GUST_OUT),
         xabs=np.zeros(N_X), cmd=np.zeros(N_U), y=np.zeros(N_Z),
         rk4=np.zeros((N_WORK, N_X)), bl=np.zeros(N_MODES), bhat=np.zeros(N_FAULT),
-        bvar=np.zeros(N_FAULT), bwork=np.zeros(2 * N_MODES), sel=new_selection_work(n),
-        lsel=new_lane_selection_work(L, n))
+        bvar=np.zeros(N_FAULT), bwork=np.zeros(2 * N_MODES), sel=new_selection_work(N_AUG),
+        lsel=new_lane_selection_work(L, N_AUG))

@@ -12,7 +12,10 @@ Markdown file with:
   paper's (section 5.2) and links to the scenario's own figures
   (``scenario.py``);
 * for each sweep (``ftc-mc sweep``): the threshold trade-off and the
-  recommended threshold (``sweep.py``);
+  recommended threshold (``sweep.py``); the operating characteristic of its
+  designs (flight hours between false resets against detection delay and
+  correct-block rate, the paper's design as the baseline) and the design
+  recommended for its truth plant and turbulence (``operating.py``);
 * when at least two runs flew different truth plants or turbulence levels
   (config section ``plant``): their rates side by side per transition, with
   false resets per flight hour and the changes against the reference plant
@@ -45,6 +48,8 @@ from .provenance import (check_provenance, mixed_message, provenance_groups,
                          provenance_section)
 from .runs import (SIGNIFICANCE, exclusion_table, paired_counts, paper_tables,
                    run_section, variant_comparison)
+from .operating import (BASELINE_DESIGNS, operating_points, operating_section,
+                        recommend_design)
 from .scenario import (scenario_section, switches_and_excitations,
                        timeline_table)
 from .sweep import FALSE_RESET_TARGET_PER_H, recommend_threshold, sweep_section
@@ -65,6 +70,8 @@ __all__ = [
     "scenario_section", "switches_and_excitations", "timeline_table",
     # sweep.py
     "FALSE_RESET_TARGET_PER_H", "recommend_threshold", "sweep_section",
+    # operating.py
+    "BASELINE_DESIGNS", "operating_points", "operating_section", "recommend_design",
     # plants.py
     "IGNORED_CAMPAIGN_KEYS", "PLANT_FIGURE", "condition_labels", "condition_order",
     "condition_rates", "config_differences", "plant_conditions_differ", "plant_rates",

@@ -1,7 +1,9 @@
 """The report section of one threshold sweep (``ftc-mc sweep``).
 
-The trade-off figure (``ftc_mc/plots/campaign.py``) and the threshold point
-recommended for each signature variant (:func:`recommend_threshold`).
+The trade-off figure (``ftc_mc/plots/campaign.py``), the threshold point
+recommended for each variant (:func:`recommend_threshold`), and the operating
+characteristic of the sweep's designs with the design recommended for its
+condition (``operating.py``, ``ftc_mc/plots/operating.py``).
 """
 
 from __future__ import annotations
@@ -12,6 +14,7 @@ import pandas as pd
 
 from .load import ResultDir
 from .markdown import LABELS, plant_text, rel_link
+from .operating import operating_section
 
 FALSE_RESET_TARGET_PER_H = 0.01
 """Largest acceptable false-reset rate when recommending a threshold: one per
@@ -65,14 +68,16 @@ def recommend_threshold(table: pd.DataFrame, variant: str,
 
 
 def sweep_section(r: ResultDir, fig_dir: Path, slug: str, report: Path) -> list:
-    """Report section of one sweep: trade-off plots and the recommended threshold.
+    """Report section of one sweep: trade-off plots, the recommended threshold per
+    variant, and the operating characteristic with the recommended design.
 
     Parameters
     ----------
     r : ResultDir
         A sweep directory.
     fig_dir : Path
-        Folder of the report's figures (``<slug>_sweep.png`` is written there).
+        Folder of the report's figures (``<slug>_sweep.png`` and
+        ``<slug>_operating.png`` are written there).
     slug : str
         The sweep's file-name stem.
     report : Path
@@ -97,4 +102,6 @@ def sweep_section(r: ResultDir, fig_dir: Path, slug: str, report: Path) -> list:
         tq, tnx, why = recommend_threshold(t, variant)
         lines.append(f"- `{variant}`: **t_q = {tq:g}, t_nx = {tnx:g}**: {why}.")
     lines.append("")
+    lines += operating_section(t, r.meta.get("config", {}), fig_dir / f"{slug}_operating.png",
+                               report, FALSE_RESET_TARGET_PER_H)
     return lines

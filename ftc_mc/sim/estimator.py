@@ -19,7 +19,7 @@ import math
 import numpy as np
 
 from ..config.schema import EstimatorConfig
-from ..conventions import VARIANTS
+from ..conventions import TEST_ONE_STEP, VARIANTS
 from ..core.settings import Belief, Detection, FilterModel
 from ..conventions import N_AUG
 from ..model.faults import bias_matrix, fault_bounds
@@ -122,7 +122,10 @@ def filter_model(plant: LinearPlant, s: EstimatorSettings) -> FilterModel:
         A=np.ascontiguousarray(plant.A), B=np.ascontiguousarray(plant.B),
         Bb0=np.ascontiguousarray(bias_matrix(plant.B)), C=np.ascontiguousarray(C),
         c_ident=unit_rows(C), u0=plant.u0.copy(), q_diag=q,
-        r_diag=np.asarray(s.r_diag, dtype=float).copy(), lo=lo, hi=hi)
+        r_diag=np.asarray(s.r_diag, dtype=float).copy(), lo=lo, hi=hi,
+        # the paper's filter has no gust states (a gust-aware design adds them)
+        G=np.zeros((n, 0)), Ad=np.zeros((0, 0)), Dg=np.zeros((C.shape[0], 0)),
+        Qg=np.zeros((0, 0)))
 
 
 def detection(plant: LinearPlant, s: EstimatorSettings) -> Detection:
@@ -137,7 +140,8 @@ def detection(plant: LinearPlant, s: EstimatorSettings) -> Detection:
     reset_var = np.array([(rng[0] / s.t_nx) ** 2, (rng[1] / s.t_q) ** 2,
                           1.0 / s.t_nx ** 2, 1.0 / s.t_q ** 2, 1.0 / s.t_q ** 2])
     return Detection(t_q=float(s.t_q), t_nx=float(s.t_nx),
-                     swapped=1 if s.signature == "swapped" else 0, reset_var=reset_var)
+                     swapped=1 if s.signature == "swapped" else 0, reset_var=reset_var,
+                     test=TEST_ONE_STEP, window=1)
 
 
 def belief_settings(plant: LinearPlant, s: EstimatorSettings) -> Belief:

@@ -127,9 +127,9 @@ def _shared_start(setup, name: str, inp: TrialInputs, max_resets: int, k_share: 
     L = inp.w.shape[2]
     dinp = design_inputs(inp, setup.designs[name])
     rec0 = new_record(setup, L, max_resets)
-    st0 = new_state(L)
-    init_state(dinp, st0, rec0)
     no_resets = setup.detection(name, math.inf, math.inf)
+    st0 = new_state(L, dinp.xa0.shape[0], no_resets.window)
+    init_state(dinp, st0, rec0)
     advance(setup.scheme(name, no_resets), setup.flight, dinp, rec0, st0, 0, k_share)
     return rec0, st0
 
