@@ -76,8 +76,42 @@ def _listed(names):
     return None if names is None else list(names)
 
 
+def _design_names(cfg, design) -> list | None:
+    """The names of ``--design`` (a string is a comma list), checked against the
+    built-in designs and the config's ``designs`` section."""
+    from .config.schema import BUILTIN_DESIGNS
+
+    names = _listed(design)
+    if not names:
+        return None
+    known = [*BUILTIN_DESIGNS, *cfg.designs]
+    for n in names:
+        if n not in known:
+            raise UserError(f"--design: unknown design {n!r}; known designs: "
+                            f"{', '.join(known)}")
+    if len(set(names)) != len(names):
+        raise UserError(f"--design: a design is named twice in {names}")
+    return names
+
+
+def _design_override(cfg, design, signature) -> dict | None:
+    """``campaign`` fields that run the designs ``design`` (built-in ones first),
+    replacing ``campaign.signature`` and ``campaign.designs``."""
+    from .config.schema import BUILTIN_DESIGNS
+
+    names = _design_names(cfg, design)
+    if names is None:
+        return None
+    if signature is not None:
+        raise UserError("--design: give either --design or --signature, not both")
+    builtin = [n for n in BUILTIN_DESIGNS if n in names]
+    sig = "both" if len(builtin) == 2 else builtin[0] if builtin else "none"
+    return {"signature": sig, "designs": [n for n in names if n not in BUILTIN_DESIGNS]}
+
+
 def campaign_config(config, *, trials=None, seed=None, signature=None, transitions=None,
-                    controller=None, plant=None, turbulence=None, airframe=None):
+                    controller=None, plant=None, turbulence=None, airframe=None,
+                    design=None):
     """A validated campaign :class:`~ftc_mc.config.Config` with overrides.
 
     Parameters
@@ -85,7 +119,7 @@ def campaign_config(config, *, trials=None, seed=None, signature=None, transitio
     config : str, Path, dict or Config
     trials, seed : int, optional
         ``campaign.trials``, ``campaign.seed``.
-    signature : {"paper", "swapped", "both"}, optional
+    signature : {"paper", "swapped", "both", "none"}, optional
     transitions : list of str or str, optional
         Transition names (a string is a comma list).
     controller : {"nominal", "reconfiguring"}, optional
@@ -94,6 +128,10 @@ def campaign_config(config, *, trials=None, seed=None, signature=None, transitio
     airframe : str or Path, optional
         ``model.airframe``: a preset name, an airframe YAML file or a linear
         model (``.npz``/``.mat``).
+    design : list of str or str, optional
+        The designs to run (``--design``): ``paper``, ``swapped`` or keys of the
+        ``designs`` section, on the same trials; replaces ``campaign.signature``
+        and ``campaign.designs`` (the built-in designs run first).
     """
     from .config import Config, ScenarioConfig, load_config as load_campaign
     from .config import parse_config, with_overrides
@@ -113,10 +151,12 @@ def campaign_config(config, *, trials=None, seed=None, signature=None, transitio
             "plant": {"kind": plant, "turbulence": turbulence},
             "model": {"airframe": None if airframe is None else str(airframe)}}
     over = {k: v for k, v in over.items() if any(x is not None for x in v.values())}
-    return with_overrides(cfg, **over) if over else cfg
+    cfg = with_overrides(cfg, **over) if over else cfg
+    runs = _design_override(cfg, design, signature)
+    return cfg if runs is None else with_overrides(cfg, campaign=runs)
 
 
-def scenario_config(config, *, plant=None, turbulence=None, airframe=None):
+def scenario_config(config, *, plant=None, turbulence=None, airframe=None, design=None):
     """A validated :class:`~ftc_mc.config.ScenarioConfig` with plant overrides.
 
     Parameters
@@ -124,8 +164,13 @@ def scenario_config(config, *, plant=None, turbulence=None, airframe=None):
     config : str, Path, dict or ScenarioConfig
     plant, turbulence, airframe : str, optional
         As in :func:`campaign_config`.
+    design : str, optional
+        The one design to fly (``--design``): ``paper``, ``swapped`` (then
+        ``scenario.signature``) or a key of the ``designs`` section
+        (``scenario.design``).
     """
     from .config import Config, ScenarioConfig, load_scenario, with_overrides
+    from .config.schema import BUILTIN_DESIGNS
     from .config.load import validate_model
 
     if isinstance(config, Config):
@@ -140,7 +185,18 @@ def scenario_config(config, *, plant=None, turbulence=None, airframe=None):
     over = {"plant": {"kind": plant, "turbulence": turbulence},
             "model": {"airframe": None if airframe is None else str(airframe)}}
     over = {k: v for k, v in over.items() if any(x is not None for x in v.values())}
-    return with_overrides(sc, **over) if over else sc
+    sc = with_overrides(sc, **over) if over else sc
+    names = _design_names(sc, design)
+    if names is None:
+        return sc
+    if len(names) != 1:
+        raise UserError(f"--design: a scenario flies one design, got {len(names)}: "
+                        f"{', '.join(names)}")
+    data = sc.model_dump()
+    builtin = names[0] in BUILTIN_DESIGNS
+    data["scenario"].update(design=None if builtin else names[0],
+                            signature=names[0] if builtin else data["scenario"]["signature"])
+    return validate_model(ScenarioConfig, data, "options")
 
 
 # -- output directories -----------------------------------------------------------
@@ -205,7 +261,8 @@ def _finished(out_dir: Path, kind: str, files, identity: dict) -> bool:
 # -- the commands -----------------------------------------------------------------
 
 def run_campaign(config, *, trials=None, seed=None, signature=None, controller=None,
-                 plant=None, turbulence=None, airframe=None, jobs: int = 1, progress: bool = True,
+                 plant=None, turbulence=None, airframe=None, design=None, jobs: int = 1,
+                 progress: bool = True,
                  backend: str = "loky", scheduler: str | None = None, out=None,
                  overwrite: bool = False, resume: bool = False,
                  command: str | None = None):
@@ -215,7 +272,7 @@ def run_campaign(config, *, trials=None, seed=None, signature=None, controller=N
     ----------
     config : str, Path, dict or Config
         YAML path, parsed mapping or validated configuration.
-    trials, seed, signature, controller, plant, turbulence, airframe : optional
+    trials, seed, signature, controller, plant, turbulence, airframe, design : optional
         Overrides of the config (:func:`campaign_config`).
     jobs : int
         Worker processes; 1 runs here, -1 uses every core (or this process
@@ -259,7 +316,7 @@ def run_campaign(config, *, trials=None, seed=None, signature=None, controller=N
     _check_jobs(jobs)
     cfg = campaign_config(config, trials=trials, seed=seed, signature=signature,
                           controller=controller, plant=plant, turbulence=turbulence,
-                          airframe=airframe)
+                          airframe=airframe, design=design)
     kw = dict(jobs=jobs, progress=progress, backend=backend, scheduler=scheduler)
     out_dir = _check_out(out, resume)
     if out_dir is None:
@@ -299,7 +356,7 @@ def _spec(values, option: str):
 
 def run_sweep(config, thresholds=None, *, tq=None, tnx=None, transitions=None,
               signature=None, trials=None, seed=None, flights: int | None = None,
-              plant=None, turbulence=None, airframe=None, jobs: int = 1,
+              plant=None, turbulence=None, airframe=None, design=None, jobs: int = 1,
               progress: bool = True, backend: str = "loky", scheduler: str | None = None,
               out=None, overwrite: bool = False, resume: bool = False,
               command: str | None = None):
@@ -312,8 +369,9 @@ def run_sweep(config, thresholds=None, *, tq=None, tnx=None, transitions=None,
         ``t_q = t_nx`` values: ``"start:stop:step"``, ``"a,b,c"`` or numbers.
     tq, tnx : str or sequence of float, optional
         A grid of ``t_q`` by ``t_nx`` values instead of ``thresholds``.
-    transitions, signature, trials, seed, plant, turbulence, airframe : optional
-        Overrides of the config (:func:`campaign_config`).
+    transitions, signature, trials, seed, plant, turbulence, airframe, design : optional
+        Overrides of the config (:func:`campaign_config`); every design runs at
+        every threshold point.
     flights : int, optional
         Fault-free flights per point for the false-reset rate (default: trials).
     jobs, progress, backend, scheduler, out, overwrite, resume, command
@@ -334,7 +392,7 @@ def run_sweep(config, thresholds=None, *, tq=None, tnx=None, transitions=None,
 
     cfg = campaign_config(config, trials=trials, seed=seed, signature=signature,
                           transitions=transitions, plant=plant, turbulence=turbulence,
-                          airframe=airframe)
+                          airframe=airframe, design=design)
     points = threshold_points(_spec(thresholds, "--thresholds"), _spec(tq, "--tq"),
                               _spec(tnx, "--tnx"))
     if flights is not None and flights < 1:
@@ -371,7 +429,7 @@ def run_sweep(config, thresholds=None, *, tq=None, tnx=None, transitions=None,
 
 
 def run_scenario(config, *, seed: int | None = None, plant=None, turbulence=None,
-                 airframe=None, out=None, overwrite: bool = False, command: str | None = None):
+                 airframe=None, design=None, out=None, overwrite: bool = False, command: str | None = None):
     """Fly one closed-loop scenario: the paper's Table 4 by default (``ftc-mc scenario``).
 
     Parameters
@@ -381,6 +439,8 @@ def run_scenario(config, *, seed: int | None = None, plant=None, turbulence=None
         Noise seed (overrides ``scenario.seed``).
     plant, turbulence, airframe : str, optional
         Overrides, as in :func:`campaign_config`.
+    design : str, optional
+        The design flown (:func:`scenario_config`).
     out : str or Path, optional
         Write ``timeseries.parquet``, ``events.parquet``, ``segments.parquet``,
         Figs. 6-12 and ``summary.md`` there.
@@ -397,7 +457,8 @@ def run_scenario(config, *, seed: int | None = None, plant=None, turbulence=None
     from .io.results import prepare_output_dir, provenance
     from .scenario import run_scenario as run, write_scenario
 
-    sc = scenario_config(config, plant=plant, turbulence=turbulence, airframe=airframe)
+    sc = scenario_config(config, plant=plant, turbulence=turbulence, airframe=airframe,
+                         design=design)
     if seed is not None and seed < 0:
         raise UserError(f"--seed: must be >= 0, got {seed}")
     out_dir = _check_out(out, False)

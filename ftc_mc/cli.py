@@ -122,9 +122,10 @@ def airframes(airspeed, gamma_deg):
 def _default_out(config_path: str, cfg=None):
     """``results/<config stem>``, or the first ``-N`` suffix that holds no run.
 
-    An airframe other than the default, and a truth plant other than the
-    paper's (linear, still air), are named in the stem, e.g.
-    ``results/paper_tables-x8-gryte2018-nonlinear-moderate``.
+    The designs run beyond the signature variants, an airframe other than the
+    default, and a truth plant other than the paper's (linear, still air), are
+    named in the stem, e.g. ``results/paper_tables-x8-gryte2018-nonlinear-moderate``
+    or ``results/paper_tables-gust_glr``.
     """
     from pathlib import Path
 
@@ -134,6 +135,11 @@ def _default_out(config_path: str, cfg=None):
     from .model.source import DEFAULT_AIRFRAME, airframe_label
 
     stem = Path(config_path).stem
+    custom = () if cfg is None else (
+        cfg.campaign.designs if hasattr(cfg, "campaign") else
+        [d for d in [cfg.scenario.design] if d is not None])
+    if custom:
+        stem += "-" + "-".join(custom)
     if cfg is not None and cfg.model.airframe != DEFAULT_AIRFRAME:
         stem += f"-{airframe_label(cfg.model.airframe)}"
     if cfg is not None and (cfg.plant.kind, cfg.plant.turbulence) != ("linear", "none"):
@@ -150,6 +156,10 @@ def _default_out(config_path: str, cfg=None):
 
 AIRFRAME_HELP = ("Airframe: a preset (see ftc-mc airframes), an airframe YAML file, or a "
                  "linear model .npz/.mat (overrides model.airframe).")
+
+
+DESIGN_HELP = ("A design to run: paper, swapped or a key of the config's designs section "
+               "(repeatable; replaces campaign.signature and campaign.designs).")
 
 
 def plant_options(func):
@@ -235,6 +245,7 @@ def terminal_table(summary) -> str:
               help="Output directory [default: results/<config name>, never reused].")
 @click.option("--signature", type=click.Choice(["paper", "swapped", "both"]),
               help="Table 1 variant(s) (overrides the config).")
+@click.option("--design", "design", multiple=True, metavar="NAME", help=DESIGN_HELP)
 @click.option("--controller", type=click.Choice(["nominal", "reconfiguring"]),
               help="Controller in the loop (overrides the config).")
 @click.option("--overwrite", is_flag=True, help="Replace results already in --out.")
@@ -243,8 +254,8 @@ def terminal_table(summary) -> str:
 @plant_options
 @parallel_options
 @user_errors
-def run(config, trials, seed, jobs, out, signature, controller, overwrite, resume, backend,
-        scheduler, quiet, plant, turbulence, airframe):
+def run(config, trials, seed, jobs, out, signature, design, controller, overwrite, resume,
+        backend, scheduler, quiet, plant, turbulence, airframe):
     """Run a Monte Carlo campaign (the paper's Tables 2-3) from CONFIG."""
     from pathlib import Path
 
@@ -252,7 +263,7 @@ def run(config, trials, seed, jobs, out, signature, controller, overwrite, resum
 
     cfg = api.campaign_config(config, trials=trials, seed=seed, signature=signature,
                               controller=controller, plant=plant, turbulence=turbulence,
-                              airframe=airframe)
+                              airframe=airframe, design=list(design) or None)
     if resume and not out:
         raise UserError("--resume: name the run's directory with --out")
     out_dir = Path(out) if out else _default_out(config, cfg)
@@ -281,17 +292,21 @@ def run(config, trials, seed, jobs, out, signature, controller, overwrite, resum
 @click.option("--out", type=click.Path(file_okay=False),
               help="Output directory [default: results/<config name>, never reused].")
 @click.option("--seed", type=int, help="Noise seed (overrides the config).")
+@click.option("--design", metavar="NAME", help="The design to fly: paper, swapped or a "
+              "key of the config's designs section (overrides scenario.signature and "
+              "scenario.design).")
 @click.option("--overwrite", is_flag=True, help="Replace results already in --out.")
 @plant_options
 @user_errors
-def scenario(config, out, seed, overwrite, plant, turbulence, airframe):
+def scenario(config, out, seed, design, overwrite, plant, turbulence, airframe):
     """Run the closed-loop scenario of CONFIG (the paper's Table 4 by default)."""
     from pathlib import Path
 
     from . import api
     from .scenario import summary_markdown
 
-    sc = api.scenario_config(config, plant=plant, turbulence=turbulence, airframe=airframe)
+    sc = api.scenario_config(config, plant=plant, turbulence=turbulence, airframe=airframe,
+                             design=design)
     out_dir = Path(out) if out else _default_out(config, sc)
     res = api.run_scenario(sc, seed=seed, out=out_dir, overwrite=overwrite,
                            command=shlex.join(["ftc-mc", "scenario", config]))
@@ -308,6 +323,7 @@ def scenario(config, out, seed, overwrite, plant, turbulence, airframe):
 @click.option("--transitions", help="Comma list of transitions (overrides the config).")
 @click.option("--signature", type=click.Choice(["paper", "swapped", "both"]),
               help="Table 1 variant(s) (overrides the config).")
+@click.option("--design", "design", multiple=True, metavar="NAME", help=DESIGN_HELP)
 @click.option("--trials", type=int, help="Trials per transition (overrides the config).")
 @click.option("--flights", type=int, help="Fault-free flights per point [default: trials].")
 @click.option("--jobs", type=int, default=-1, show_default=True,
@@ -320,8 +336,8 @@ def scenario(config, out, seed, overwrite, plant, turbulence, airframe):
 @plant_options
 @parallel_options
 @user_errors
-def sweep(config, thresholds, tq, tnx, transitions, signature, trials, flights, jobs, out,
-          overwrite, resume, backend, scheduler, quiet, plant, turbulence, airframe):
+def sweep(config, thresholds, tq, tnx, transitions, signature, design, trials, flights, jobs,
+          out, overwrite, resume, backend, scheduler, quiet, plant, turbulence, airframe):
     """Sweep the Table 1 thresholds: Tables 2-3 and false resets per flight hour."""
     from pathlib import Path
 
@@ -330,7 +346,7 @@ def sweep(config, thresholds, tq, tnx, transitions, signature, trials, flights, 
 
     cfg = api.campaign_config(config, trials=trials, signature=signature,
                               transitions=transitions, plant=plant, turbulence=turbulence,
-                              airframe=airframe)
+                              airframe=airframe, design=list(design) or None)
     if resume and not out:
         raise UserError("--resume: name the sweep's directory with --out")
     out_dir = Path(out) if out else _default_out(config, cfg)

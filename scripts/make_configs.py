@@ -46,6 +46,18 @@ def campaign_configs() -> dict:
         cfg, "ftc-mc run configs/sensor_faults.yaml -- what the actuator FDI does with "
              "sensor faults (issue 14): bias, stuck, drift on q, n_x, n_z, alpha, theta, "
              "Va; default airframe, the paper's design")
+    cfg = Config.model_validate({
+        "campaign": {"transitions": list(TRANSITION_TABLE),
+                     "designs": ["gust_one_step", "gust_glr"]},
+        "plant": {"turbulence": "light"},
+        "designs": {"gust_one_step": {"estimator": "gust_aware",
+                                      "design_turbulence": "light"},
+                    "gust_glr": {"estimator": "gust_aware", "design_turbulence": "light",
+                                 "test": "glr"}}})
+    files["designs.yaml"] = render_yaml(
+        cfg, "ftc-mc run configs/designs.yaml -- detection designs on the same trials "
+             "(issue 13): the paper's, and a gust-aware filter with the one-step and the "
+             "GLR test, in light turbulence", omit=no_sensor)
     files["paper_scenario.yaml"] = render_yaml(
         ScenarioConfig(), "ftc-mc scenario configs/paper_scenario.yaml -- the paper's 100 s "
                           "landing approach (Table 4) with the full reconfiguring loop")

@@ -4,8 +4,9 @@ The one chunk executor of ``ftc-mc run`` and ``ftc-mc sweep`` (worker side).  A
 chunk is a fixed range of trial ids of one transition, or of fault-free flights
 (:data:`FLIGHT`); its results depend only on those ids and the root seed, never
 on which worker runs it or how many chunks there are.  :func:`run_chunk` lays
-out the inputs (``ftc_mc/sim/inputs.py``), runs them under every signature
-variant (and, in a sweep, every threshold point) with
+out the inputs (``ftc_mc/sim/inputs.py``), runs them under every design (the
+signature variants and ``campaign.designs``; in a sweep, each at every
+threshold point) with
 :func:`ftc_mc.sim.lanes.simulate`, and classifies the records.
 """
 
@@ -24,7 +25,7 @@ from ..core.settings import TrialInputs, TrialRecord
 from ..core.trial import run_trials
 from ..sim.inputs import build_inputs, draw_lanes, flight_inputs, sensor_faults
 from ..sim.lanes import simulate
-from ..sim.setup import SimSetup, build_setup, variants_of
+from ..sim.setup import SimSetup, build_setup, runs_of
 from .transitions import (TRANSITION_TABLE, FaultRanges, SensorTransition, fault_ranges,
                           is_sensor, transition_of)
 
@@ -42,7 +43,8 @@ class ChunkSpec:
     seed : int
         Root seed of the trial streams.
     variants : tuple of str
-        Signature variants run on the same inputs.
+        Names of the designs run on the same inputs (the signature variants,
+        then ``campaign.designs``): the ``variant`` column of the results.
     ranges : FaultRanges
         Ranges of the trials' fault values.
     near_trim : tuple
@@ -89,7 +91,7 @@ def chunk_spec(cfg: Config, setup: SimSetup | None = None, points=None) -> Chunk
     setup = build_setup(cfg) if setup is None else setup
     plant = setup.plant
     return ChunkSpec(setup=setup, seed=cfg.campaign.seed,
-                     variants=variants_of(cfg.campaign.signature),
+                     variants=runs_of(cfg),
                      ranges=fault_ranges(cfg.draws, plant.u_lower, plant.u_upper),
                      near_trim=(cfg.explain.engine_lock_near_trim,
                                 cfg.explain.elevon_lock_near_trim_rad),

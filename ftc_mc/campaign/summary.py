@@ -113,8 +113,11 @@ def summarize(trials: pd.DataFrame) -> pd.DataFrame:
         rows.append(row)
     out = pd.DataFrame(rows)
     if len(out):
+        # designs in the order they were run (the signature variants, paper first,
+        # then campaign.designs)
+        vorder = {v: i for i, v in enumerate(dict.fromkeys(trials["variant"]))}
         out = out.sort_values(["transition", "variant"],
-                              key=lambda s: s.map(order) if s.name == "transition" else s,
+                              key=lambda s: s.map(order if s.name == "transition" else vorder),
                               kind="stable").reset_index(drop=True)
     return out
 

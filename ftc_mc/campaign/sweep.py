@@ -85,7 +85,7 @@ class SweepResult:
     Attributes
     ----------
     table : DataFrame
-        One row per threshold point, transition and variant: the summary columns
+        One row per threshold point, transition and design (``variant``): the summary columns
         of :func:`~ftc_mc.campaign.summary.summarize` (among them the
         operating characteristic's correct-block rate ``correct_only_rate``
         with its Wilson interval and the correct-block delay
@@ -214,7 +214,7 @@ def run_sweep(cfg: Config, points, *, flights: int | None = None, jobs: int = 1,
 
 
 def sweep_markdown(res: SweepResult) -> str:
-    """The sweep as one Markdown table per variant, with the sharing saving."""
+    """The sweep as one Markdown table per design, with the sharing saving."""
     t = res.table
     lines = ["# ftc-mc sweep", "",
              f"{len(res.points)} threshold points; trial steps simulated "
@@ -228,6 +228,6 @@ def sweep_markdown(res: SweepResult) -> str:
             "no reset %": 100 * g["no_reset_rate"],
             "delay median [s]": g["delay_median_s"],
             "false resets / h": g["false_resets_per_hour"]})
-        lines += [f"## Signature `{variant}`", "",
+        lines += [f"## Design `{variant}`", "",
                   view.to_markdown(index=False, floatfmt=".3g"), ""]
     return "\n".join(lines)

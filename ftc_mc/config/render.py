@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import typing
+
 import yaml
 from pydantic import BaseModel
 
@@ -25,10 +27,13 @@ def render_yaml(cfg: BaseModel, title: str, omit=()) -> str:
     """
     lines = [f"# {title}", "# Every field is listed with its default; delete a field to "
              "use the default.", ""]
-    for section in type(cfg).model_fields:
+    for section, sinfo in type(cfg).model_fields.items():
         if section in omit:
             continue
         sub = getattr(cfg, section)
+        if isinstance(sub, dict):
+            lines += _named_models(section, sub, sinfo)
+            continue
         doc = (type(sub).__doc__ or "").strip().splitlines()[0]
         lines.append(f"{section}:  # {doc}")
         for name, info in type(sub).model_fields.items():
@@ -53,3 +58,29 @@ def render_yaml(cfg: BaseModel, title: str, omit=()) -> str:
             lines.append(f"  {name}: {text}  # {doc}".rstrip())
         lines.append("")
     return "\n".join(lines)
+
+
+def _fields(model: BaseModel, indent: str) -> list:
+    """``name: value  # doc`` lines of a model's fields."""
+    out = []
+    for name, info in type(model).model_fields.items():
+        text = yaml.safe_dump(getattr(model, name), default_flow_style=True,
+                              width=10_000).strip().removesuffix("...").strip()
+        out.append(f"{indent}{name}: {text}  # {' '.join((info.description or '').split())}")
+    return out
+
+
+def _named_models(section: str, models: dict, info) -> list:
+    """A top-level mapping of names to models (``designs``); when empty, the fields
+    of one entry with their defaults, commented out, as an example."""
+    doc = " ".join((info.description or "").split())
+    if models:
+        lines = [f"{section}:  # {doc}"]
+        for key, model in models.items():
+            lines.append(f"  {key}:")
+            lines += _fields(model, "    ")
+        return lines + [""]
+    model_type = typing.get_args(info.annotation)[1]
+    return [f"{section}: {{}}  # {doc}",
+            "# for example (replace {} by these lines uncommented, rename NAME, list NAME "
+            "to run it):", "#  NAME:", *_fields(model_type(), "#    "), ""]

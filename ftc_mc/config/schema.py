@@ -11,6 +11,7 @@ Reading YAML and formatting errors: :mod:`ftc_mc.config.load`.
 from __future__ import annotations
 
 import math
+import re
 from typing import Annotated, Literal
 
 from pydantic import (AfterValidator, BaseModel, BeforeValidator, ConfigDict, Field,
@@ -377,6 +378,68 @@ class SensorDrawsConfig(_Strict):
         return (0.0, 1.0)
 
 
+BUILTIN_DESIGNS = ("paper", "swapped")
+"""The built-in designs: the paper's estimator and one-step test at the ``estimator``
+section's thresholds, with Table 1 as printed or swapped (the signature variants)."""
+DESIGN_NAME = re.compile(r"[A-Za-z0-9_-]+")
+"""What a design's name may hold (it names result rows and files)."""
+RESERVED_DESIGN_NAMES = (*BUILTIN_DESIGNS, "both", "none")
+
+
+class DesignConfig(_Strict):
+    """A detection design (issue 13): estimator model x residual test x thresholds."""
+
+    estimator: Literal["paper", "gust_aware"] = "paper"
+    """paper: the 14-state filter of eqs. 4-6; gust_aware: plus the 4 Dryden gust states (docs/architecture.md)."""
+    design_turbulence: Literal["light", "moderate", "severe"] = "moderate"
+    """Dryden level of the gust states' process noise and initial covariance (gust_aware only)."""
+    test: Literal["one_step", "glr"] = "one_step"
+    """Residual test: one_step (the paper's eqs. 9-11) or glr (a mean change over a sliding window)."""
+    window_s: Pos = 2.0
+    """GLR window [s] (a multiple of model.dt_s; glr only)."""
+    signature: Literal["paper", "swapped"] = "swapped"
+    """Table 1 as printed (paper) or with its third clause swapped."""
+    t_q: Pos = 25.0
+    """Threshold on r_q (Table 1)."""
+    t_nx: Pos = 25.0
+    """Threshold on r_nx (Table 1)."""
+    sigma_qx: Pos | None = None
+    """Filter process-noise density of the plant states; null: estimator.sigma_qx (the truth noise never changes)."""
+    sigma_qb: Pos | None = None
+    """Filter random-walk density of the fault parameters; null: estimator.sigma_qb."""
+
+
+def _design_names(designs: dict) -> dict:
+    for name in designs:
+        if not DESIGN_NAME.fullmatch(name):
+            raise ValueError(f"{name!r}: a design name holds only letters, digits, _ and -")
+        if name in RESERVED_DESIGN_NAMES:
+            raise ValueError(f"{name!r}: reserved (built-in designs: "
+                             f"{', '.join(BUILTIN_DESIGNS)}); choose another name")
+    return designs
+
+
+Designs = Annotated[dict[str, DesignConfig], AfterValidator(_design_names)]
+
+
+def _check_designs(cfg, listed, where: str, duration: tuple) -> None:
+    """Every name of ``listed`` must be a key of ``cfg.designs``; every GLR window a
+    whole number of sampling periods, at most the run's ``duration = (name, s)``."""
+    for name in listed:
+        if name in BUILTIN_DESIGNS:
+            field = "campaign.signature" if where.startswith("campaign") else "scenario.signature"
+            raise ValueError(f"{where}: {name!r} is a built-in design; choose it with {field}")
+        if name not in cfg.designs:
+            known = ", ".join(cfg.designs) or "none (the designs section is empty)"
+            raise ValueError(f"{where}: unknown design {name!r}; designs defined: {known}")
+    _check_periods(cfg.model.dt_s, [(f"designs.{n}.window_s", d.window_s)
+                                    for n, d in cfg.designs.items() if d.test == "glr"])
+    for n, d in cfg.designs.items():
+        if d.test == "glr" and d.window_s > duration[1]:
+            raise ValueError(f"designs.{n}.window_s: must not exceed {duration[0]} "
+                             f"({duration[1]:g} s), got {d.window_s:g}")
+
+
 class CampaignConfig(_Strict):
     """What to run."""
 
@@ -389,8 +452,10 @@ class CampaignConfig(_Strict):
     """Trials per transition."""
     seed: Annotated[int, NoBool, Field(ge=0, lt=2 ** 63)] = 2026
     """Root seed: trial i draws from numpy.random.default_rng([i, seed])."""
-    signature: Literal["paper", "swapped", "both"] = "both"
-    """Table 1 variant(s) run on the same draws and noise."""
+    signature: Literal["paper", "swapped", "both", "none"] = "both"
+    """Table 1 variant(s) (the built-in designs) run on the same draws and noise; none: only campaign.designs."""
+    designs: list[str] = Field(default_factory=list)
+    """Designs (keys of the designs section) run after the signature variants, on the same trials."""
     chunk_size: Annotated[int, NoBool, Field(gt=0, le=4096)] = 128
     """Trials per chunk (one kernel call, lanes); results do not depend on it."""
     max_resets: Annotated[int, NoBool, Field(gt=0, le=100_000)] | None = None
@@ -400,7 +465,17 @@ class CampaignConfig(_Strict):
     def _unique(self):
         if len(set(self.transitions)) != len(self.transitions):
             raise ValueError("transitions: names must not repeat")
+        if len(set(self.designs)) != len(self.designs):
+            raise ValueError("designs: names must not repeat")
+        if self.signature == "none" and not self.designs:
+            raise ValueError("signature: none runs nothing; name designs in campaign.designs")
         return self
+
+    def runs(self) -> tuple:
+        """Names of the designs run, in order: the signature variants, then ``designs``."""
+        sig = (BUILTIN_DESIGNS if self.signature == "both" else
+               () if self.signature == "none" else (self.signature,))
+        return (*sig, *self.designs)
 
 
 class Config(_Sampled):
@@ -418,11 +493,15 @@ class Config(_Sampled):
     explain: ExplainConfig = Field(default_factory=ExplainConfig)
     validity: ValidityConfig = Field(default_factory=ValidityConfig)
     sensor_draws: SensorDrawsConfig = Field(default_factory=SensorDrawsConfig)
+    designs: Designs = Field(default_factory=dict)
+    """Detection designs compared on the same trials (issue 13): name -> design; run them with campaign.designs or --design NAME."""
 
     @model_validator(mode="after")
     def _steps(self):
         dt = self.model.dt_s
         t = self.timing
+        _check_designs(self, self.campaign.designs, "campaign.designs",
+                       ("timing.duration_s", t.duration_s))
         _check_periods(dt, [("timing.fault_time_s", t.fault_time_s),
                             ("timing.window_s", t.window_s),
                             ("timing.duration_s", t.duration_s),
@@ -515,6 +594,8 @@ class ScenarioSpec(_Strict):
     """Seed of the process and measurement noise."""
     signature: Literal["paper", "swapped"] = "swapped"
     """Table 1 variant (swapped: fewer inappropriate resets in ftc-mc run, see docs)."""
+    design: str | None = None
+    """A key of the designs section flown instead of the signature variant (null: the variant)."""
     reconfiguration_period_s: Pos = 1.0
     """Belief update and controller selection period [s] (paper: 1 s)."""
     detection_probability: Fraction = 0.5
@@ -557,11 +638,15 @@ class ScenarioConfig(_Sampled):
     excitation: ExcitationConfig = Field(default_factory=ExcitationConfig)
     noise: NoiseConfig = Field(default_factory=NoiseConfig)
     validity: ValidityConfig = Field(default_factory=ValidityConfig)
+    designs: Designs = Field(default_factory=dict)
+    """Detection designs (issue 13): name -> design; fly one with scenario.design or --design NAME."""
 
     @model_validator(mode="after")
     def _steps(self):
         dt = self.model.dt_s
         sc = self.scenario
+        _check_designs(self, [] if sc.design is None else [sc.design], "scenario.design",
+                       ("scenario.duration_s", sc.duration_s))
         _check_periods(dt, [("scenario.duration_s", sc.duration_s),
                             ("scenario.reconfiguration_period_s",
                              sc.reconfiguration_period_s)])

@@ -19,6 +19,20 @@ import pandas as pd
 from .figure import plt, save
 
 
+LINESTYLES = ("-", "--", ":", "-.")
+MARKERS = (None, "o", "s", "^", "v", "x")
+
+
+def design_styles(variants) -> dict:
+    """``name -> plot keywords`` of each design: ``paper`` solid and ``swapped``
+    dashed, as always; further designs in order of appearance, by line style and
+    then marker."""
+    names = ["paper", "swapped"]
+    names += [v for v in dict.fromkeys(variants) if v not in names]
+    return {v: {"linestyle": LINESTYLES[i % 4], "marker": MARKERS[(i // 4) % 6]}
+            for i, v in enumerate(names)}
+
+
 def _namer(labels):
     """``name -> label`` from a mapping (names missing from it are kept)."""
     labels = labels or {}
@@ -137,13 +151,14 @@ def sweep_figure(table: pd.DataFrame, path: Path, target_per_h: float, labels=No
     fig, axs = plt.subplots(nrows, ncols, figsize=(12, 3.2 * nrows), squeeze=False)
     pts = table[["t_q", "t_nx"]].drop_duplicates().reset_index(drop=True)
     xkey = {(a, b): (a if same else i) for i, (a, b) in enumerate(zip(pts["t_q"], pts["t_nx"]))}
-    styles = {"paper": "-", "swapped": "--"}
+    styles = design_styles(table["variant"])
     for ax, name in zip(axs.flat, names):
         for variant, g in table[table["transition"] == name].groupby("variant"):
             x = [xkey[(a, b)] for a, b in zip(g["t_q"], g["t_nx"])]
-            ls = styles.get(variant, ":")
-            ax.plot(x, 100 * g["inappropriate_rate"], "r" + ls, label=f"inappropriate {variant}")
-            ax.plot(x, 100 * g["no_reset_rate"], "b" + ls, label=f"no reset {variant}")
+            st = styles[variant]
+            ax.plot(x, 100 * g["inappropriate_rate"], color="r", **st,
+                    label=f"inappropriate {variant}")
+            ax.plot(x, 100 * g["no_reset_rate"], color="b", **st, label=f"no reset {variant}")
         ax.set_title(label(name), fontsize=9)
         ax.set_ylabel("% of trials")
         ax.grid(alpha=0.3)
@@ -151,8 +166,8 @@ def sweep_figure(table: pd.DataFrame, path: Path, target_per_h: float, labels=No
     for variant, g in table.groupby("variant"):
         g = g.drop_duplicates(["t_q", "t_nx"])
         x = [xkey[(a, b)] for a, b in zip(g["t_q"], g["t_nx"])]
-        ax.semilogy(x, g["false_resets_per_hour"].clip(lower=1e-3), "k" + styles.get(variant, ":"),
-                    label=variant)
+        ax.semilogy(x, g["false_resets_per_hour"].clip(lower=1e-3), color="k",
+                    **styles[variant], label=variant)
     ax.axhline(target_per_h, color="g", lw=0.8, label=f"1 per {1 / target_per_h:g} h")
     ax.set_title("false resets per flight hour", fontsize=9)
     ax.grid(alpha=0.3)

@@ -13,6 +13,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from ..conventions import VARIANTS
 from ..stats import mcnemar_exact, wilson
 from .load import ResultDir
 from .markdown import LABELS, count, label, num, plant_text, rel_link
@@ -71,7 +72,8 @@ def paper_tables(summary: pd.DataFrame) -> list:
     """
     lines = []
     for variant, g in summary.groupby("variant", sort=False):
-        lines += [f"#### Signature `{variant}`", "",
+        kind = "Signature" if variant in VARIANTS else "Design"
+        lines += [f"#### {kind} `{variant}`", "",
                   pd.DataFrame([_paper_row(r) for _, r in g.iterrows()])
                   .to_markdown(index=False), ""]
     lines += ["Counts are `k/n (rate %, 95 % Wilson CI)`, over judged trials only; the "
@@ -247,8 +249,18 @@ def _no_reset_note(nr: pd.DataFrame, a: str, b: str) -> str:
         for r in diff.itertuples()) + "; weigh these against the inappropriate resets.")
 
 
+def baseline_of(variants) -> str:
+    """The reference design of a comparison: the paper's (``paper``, Table 1 as
+    printed) when it was run, else the first run."""
+    variants = list(variants)
+    return "paper" if "paper" in variants else variants[0]
+
+
 def variant_comparison(trials: pd.DataFrame) -> list:
-    """Markdown lines: which signature variant is better, from paired trials.
+    """Markdown lines: which design (signature variant) is better, from paired trials.
+
+    Two designs are compared with each other; with more, each is compared with
+    the baseline (:func:`baseline_of`).
 
     Parameters
     ----------
@@ -260,10 +272,22 @@ def variant_comparison(trials: pd.DataFrame) -> list:
     list of str
     """
     variants = list(dict.fromkeys(trials["variant"]))
-    if len(variants) != 2:
+    if len(variants) < 2:
         return [f"Only the `{'`, `'.join(variants)}` variant was run; nothing to compare.",
                 ""]
-    a, b = variants
+    if len(variants) == 2:
+        return _pair_comparison(trials, *variants)
+    base = baseline_of(variants)
+    lines = [f"Each design against the baseline `{base}`, on the same trials.", ""]
+    for other in variants:
+        if other != base:
+            lines += [f"#### `{other}` against `{base}`", ""]
+            lines += _pair_comparison(trials, base, other)
+    return lines
+
+
+def _pair_comparison(trials: pd.DataFrame, a: str, b: str) -> list:
+    """Markdown lines: the paired comparison of the designs ``a`` and ``b``."""
     inap = paired_counts(trials, a, b, "inappropriate")
     nr = paired_counts(trials, a, b, "no_reset")
     table = pd.DataFrame({
@@ -282,10 +306,32 @@ def variant_comparison(trials: pd.DataFrame) -> list:
 # ------------------------------------------------------------------ section
 
 
+def _comparison_heading(trials: pd.DataFrame) -> str:
+    if set(trials["variant"]) <= set(VARIANTS):
+        return "### Which signature variant is better"
+    return "### Which design is better"
+
+
+def _design_text(cfg: dict) -> str:
+    """``designs `a` (estimator, test, t_q/t_nx), ...`` of a run's extra designs."""
+    names = cfg.get("campaign", {}).get("designs", [])
+    defs = cfg.get("designs", {})
+
+    def one(n):
+        d = defs.get(n, {})
+        test = d.get("test", "?") + (f" {d.get('window_s', '?'):g} s"
+                                     if d.get("test") == "glr" else "")
+        return (f"`{n}` ({d.get('estimator', '?')} estimator, {test}, "
+                f"t_q {d.get('t_q', '?')}, t_nx {d.get('t_nx', '?')})")
+
+    return (", designs " + ", ".join(one(n) for n in names)) if names else ""
+
+
 def _run_header(cfg: dict) -> str:
     c = cfg.get("campaign", {})
     return (f"{len(c.get('transitions', []))} transition(s), {c.get('trials', '?')} trials "
-            f"each, seed {c.get('seed', '?')}, signature `{c.get('signature', '?')}`, "
+            f"each, seed {c.get('seed', '?')}, signature `{c.get('signature', '?')}`"
+            f"{_design_text(cfg)}, "
             f"controller `{cfg.get('controller', {}).get('kind', '?')}`, "
             f"{plant_text(cfg)}.")
 
@@ -322,6 +368,6 @@ def run_section(r: ResultDir, fig_dir: Path, slug: str, report: Path) -> list:
     fig = delay_figure(trials, fig_dir / f"{slug}_delays.png", LABELS)
     return (head + ["### Tables 2-3: ours beside the paper", ""] + paper_tables(summary)
             + ["### Excluded trials", ""] + exclusion_table(summary, trials, cfg)
-            + ["### Which signature variant is better", ""] + variant_comparison(trials)
+            + [_comparison_heading(trials), ""] + variant_comparison(trials)
             + ["### Delay distributions", "", f"![delays of {slug}]({rel_link(fig, report)})",
                ""] + sensor)

@@ -126,7 +126,8 @@ def scenario_section(r: ResultDir, report: Path) -> list:
     sc = r.meta.get("config", {}).get("scenario", {})
     details = ev.to_markdown(index=False, floatfmt=".1f")
     return ([f"## Scenario `{r.path}`", "",
-             f"Signature `{sc.get('signature', '?')}`, controller "
+             (f"Design `{sc['design']}`, controller " if sc.get("design") else
+              f"Signature `{sc.get('signature', '?')}`, controller ") +
              f"`{r.meta.get('config', {}).get('controller', {}).get('kind', '?')}`, seed "
              f"{sc.get('seed', '?')}, {sc.get('duration_s', '?')} s, "
              f"{len(sc.get('schedule', []))} schedule entries, "

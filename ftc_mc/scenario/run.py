@@ -2,7 +2,8 @@
 
 One trajectory of the full reconfiguring loop (estimator, belief, controller
 selection among c0/c1/c2, excitation) on the truth plant with the config's
-fault schedule, kept step by step.  :func:`run_scenario` builds the setup from
+fault schedule, kept step by step, under the design ``scenario.design`` (or the
+signature variant ``scenario.signature``).  :func:`run_scenario` builds the setup from
 the scenario config (``ftc_mc/sim/setup.py``), maps the schedule to the trial
 inputs (``ftc_mc/sim/inputs.py``), runs the kernel and returns the time series,
 the events (fault switches, resets, excitations, detections, controller
@@ -24,7 +25,7 @@ from ..core.trial import run_trials
 from ..model.faults import mode_of
 from ..sim.inputs import scenario_inputs
 from ..sim.lanes import HISTORY_RESETS, run_alone
-from ..sim.setup import SimSetup, build_setup
+from ..sim.setup import SimSetup, build_setup, runs_of
 from ..paper import PAPER_TIMELINE
 
 
@@ -72,10 +73,10 @@ def run_scenario(sc: ScenarioConfig, seed: int | None = None,
         sc = sc.model_copy(update={"scenario": sc.scenario.model_copy(update={"seed": seed})})
     if setup is None:
         setup = build_setup(sc)
-    sig = sc.scenario.signature
+    name = runs_of(sc)[0]
     inp = scenario_inputs(setup, sc.scenario)
     announce_compile(run_trials)
-    rec = run_alone(setup, sig, setup.det[sig], inp, HISTORY_RESETS, history=True)
+    rec = run_alone(setup, name, setup.det[name], inp, HISTORY_RESETS, history=True)
     k_sw, b0, b1 = inp.k_switch, inp.b0[:, :, 0], inp.b1[:, :, 0]
     modes = np.array([int(mode_of(b, *setup.beta)) for b in b1], dtype=np.int64)
     ts = _timeseries(setup, sc, rec, k_sw, b0, b1)
@@ -115,8 +116,9 @@ def _timeseries(setup, sc, rec, k_sw, b0, b1) -> pd.DataFrame:
         cols[f"{nm}_sd"] = np.sqrt(np.maximum(rec.hist_pdiag[:, j, 0], 0.0))
     for j, nm in enumerate(("r_q", "r_nx", "r_nz")):
         cols[nm] = rec.hist_res[:, j, 0]
-    cols["t_q"] = np.full(n, setup.det[sc.scenario.signature].t_q)
-    cols["t_nx"] = np.full(n, setup.det[sc.scenario.signature].t_nx)
+    det = setup.det[runs_of(sc)[0]]
+    cols["t_q"] = np.full(n, det.t_q)
+    cols["t_nx"] = np.full(n, det.t_nx)
     for j, nm in enumerate(("gust_u_mps", "gust_w_mps", "gust_q_radps")):
         cols[nm] = rec.hist_wind[:, j, 0]  # zero in still air
     every = setup.tim.reconf_every

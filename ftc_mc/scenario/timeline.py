@@ -15,7 +15,7 @@ def summary_markdown(res: ScenarioResult) -> str:
     seg = res.segments.copy()
     ev = res.events
     lines = ["# ftc-mc scenario", "",
-             f"Signature: `{res.config.scenario.signature}`; controller: "
+             f"Design: `{res.config.scenario.design or res.config.scenario.signature}`; controller: "
              f"`{res.config.controller.kind}`; seed {res.config.scenario.seed}; "
              f"truth plant `{res.config.plant.kind}`, turbulence "
              f"`{res.config.plant.turbulence}`; run status: `{res.status}`.", "",

@@ -182,6 +182,28 @@ def build_inputs(setup, schedule: Schedule, draws: LaneDraws,
                        sensor_size=sensor.size, sensor_k=sensor.k)
 
 
+def design_inputs(inp: TrialInputs, design) -> TrialInputs:
+    """``inp`` as the design ``design`` starts it: its initial covariance, and the
+    initial estimate padded with zeros for its extra (gust) states.
+
+    The draws, the schedule and the sensor faults are untouched, so every design
+    flies the same trials (common random numbers).
+
+    Parameters
+    ----------
+    inp : TrialInputs
+        From :func:`build_inputs` (14-state estimate).
+    design : Design
+        ``ftc_mc/sim/designs.py``.
+    """
+    n, L = design.n_aug, inp.xa0.shape[1]
+    xa0 = inp.xa0
+    if n != xa0.shape[0]:
+        xa0 = np.zeros((n, L))
+        xa0[:inp.xa0.shape[0]] = inp.xa0
+    return inp._replace(xa0=xa0, P0=design.P0)
+
+
 def no_sensor_faults(L: int) -> "SensorFaults":
     """Sensor faults of ``L`` healthy lanes (output -1: the kernel skips them)."""
     return SensorFaults(out=np.full(L, NO_SENSOR_FAULT, dtype=np.int64),

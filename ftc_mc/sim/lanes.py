@@ -1,11 +1,13 @@
 """Run lanes of trial inputs through the kernels: alone, or sharing their start.
 
-:func:`simulate` runs the same inputs under several Table 1 detections (the
-signature variants, and in a sweep the threshold points).  Alone, each
+:func:`simulate` runs the same inputs under several designs and Table 1
+detections (the designs run, and in a sweep each at every threshold point).  Alone, each
 detection runs every lane from the start (:func:`ftc_mc.core.trial.run_trials`).
-Shared, the lanes are first advanced once to a step ``k_share`` with resets
+Shared, the runs are grouped by design key (the same filter model, initial
+covariance, residual test and window: :class:`ftc_mc.sim.designs.Design`); per
+group, the lanes are first advanced once to a step ``k_share`` with resets
 disabled, recording the largest ``r_q`` and ``r_nx`` of each lane; then, for
-each detection:
+each detection of the group:
 
 * a lane whose residuals stayed below its thresholds until ``k_share`` had no
   reset there either, so it continues from that shared state;
@@ -23,9 +25,9 @@ import math
 
 import numpy as np
 
-from ..conventions import VARIANTS
 from ..core.settings import TrialInputs, TrialRecord
 from ..core.trial import advance, init_state, new_state, run_trials
+from .inputs import design_inputs
 
 HISTORY_RESETS = 100_000
 """Resets stored per lane when every step is kept (a scenario)."""
@@ -56,11 +58,14 @@ def new_record(setup, L: int, max_resets: int, history: bool = False) -> TrialRe
         xa_end=np.zeros((14, L)))
 
 
-def run_alone(setup, variant: str, det, inp: TrialInputs, max_resets: int,
+def run_alone(setup, name: str, det, inp: TrialInputs, max_resets: int,
               history: bool = False) -> TrialRecord:
-    """Every lane of ``inp`` from the start to the end under the detection ``det``."""
+    """Every lane of ``inp`` from the start to the end under the design ``name``
+    with the detection ``det`` (``inp`` as :func:`~ftc_mc.sim.inputs.build_inputs`
+    lays it out, for any design)."""
     rec = new_record(setup, inp.w.shape[2], max_resets, history)
-    run_trials(setup.scheme(variant, det), setup.flight, inp, rec)
+    run_trials(setup.scheme(name, det), setup.flight,
+               design_inputs(inp, setup.designs[name]), rec)
     return rec
 
 
@@ -74,19 +79,21 @@ def _copy(nt):
 
 
 def simulate(setup, inp: TrialInputs, runs, max_resets: int, k_share: int | None = None):
-    """Records of the lanes of ``inp`` under each detection of ``runs``.
+    """Records of the lanes of ``inp`` under each run of ``runs``.
 
     Parameters
     ----------
     setup : SimSetup
     inp : TrialInputs
+        As :func:`~ftc_mc.sim.inputs.build_inputs` lays it out (any design).
     runs : list of (str, Detection)
-        Signature variant and Table 1 settings of each run.
+        Design name and Table 1 settings of each run.
     max_resets : int
         Resets stored per lane.
     k_share : int, optional
         ``None``: every run from the start, alone.  Else the step up to which the
-        runs share the lanes' start (module docstring), ``0 < k_share <= n_steps``.
+        runs of one design key share the lanes' start (module docstring),
+        ``0 < k_share <= n_steps``.
 
     Returns
     -------
@@ -99,23 +106,48 @@ def simulate(setup, inp: TrialInputs, runs, max_resets: int, k_share: int | None
     if k_share is None:
         return [run_alone(setup, v, det, inp, max_resets) for v, det in runs], L * n * len(runs)
     assert 0 < k_share <= n
-    rec0 = new_record(setup, L, max_resets)
-    no_resets = setup.detection(VARIANTS[0], math.inf, math.inf)
-    st0 = new_state(L, inp.xa0.shape[0], no_resets.window)
-    init_state(inp, st0, rec0)
-    advance(setup.scheme(VARIANTS[0], no_resets), setup.flight, inp, rec0, st0, 0, k_share)
-    simulated = L * k_share
-    recs = []
-    for variant, det in runs:
-        rec, st = _copy(rec0), _copy(st0)
-        if k_share < n:
-            advance(setup.scheme(variant, det), setup.flight, inp, rec, st, k_share, n)
-            simulated += L * (n - k_share)
-        dirty = np.flatnonzero((st0.rmax[0] >= det.t_q) | (st0.rmax[1] >= det.t_nx))
-        if len(dirty):
-            sub = run_alone(setup, variant, det, take_lanes(inp, dirty), max_resets)
-            for f, v in sub._asdict().items():
-                getattr(rec, f)[..., dirty] = v
-            simulated += len(dirty) * n
-        recs.append(rec)
+    groups = {}
+    for i, (name, _) in enumerate(runs):
+        groups.setdefault(setup.designs[name].key, []).append(i)
+    recs = [None] * len(runs)
+    simulated = 0
+    for members in groups.values():
+        lead = runs[members[0]][0]
+        rec0, st0 = _shared_start(setup, lead, inp, max_resets, k_share)
+        simulated += L * k_share
+        for i in members:
+            recs[i], sim = _continue(setup, runs[i], inp, rec0, st0, max_resets, k_share)
+            simulated += sim
     return recs, simulated
+
+
+def _shared_start(setup, name: str, inp: TrialInputs, max_resets: int, k_share: int):
+    """Record and state of every lane after ``k_share`` steps of the design ``name``
+    with resets disabled."""
+    L = inp.w.shape[2]
+    dinp = design_inputs(inp, setup.designs[name])
+    rec0 = new_record(setup, L, max_resets)
+    no_resets = setup.detection(name, math.inf, math.inf)
+    st0 = new_state(L, dinp.xa0.shape[0], no_resets.window)
+    init_state(dinp, st0, rec0)
+    advance(setup.scheme(name, no_resets), setup.flight, dinp, rec0, st0, 0, k_share)
+    return rec0, st0
+
+
+def _continue(setup, run, inp: TrialInputs, rec0, st0, max_resets: int, k_share: int):
+    """One run from the shared start: the record, and the lane steps simulated."""
+    name, det = run
+    L, n = inp.w.shape[2], setup.tim.n_steps
+    rec, st = _copy(rec0), _copy(st0)
+    simulated = 0
+    if k_share < n:
+        advance(setup.scheme(name, det), setup.flight, design_inputs(inp, setup.designs[name]),
+                rec, st, k_share, n)
+        simulated += L * (n - k_share)
+    dirty = np.flatnonzero((st0.rmax[0] >= det.t_q) | (st0.rmax[1] >= det.t_nx))
+    if len(dirty):
+        sub = run_alone(setup, name, det, take_lanes(inp, dirty), max_resets)
+        for f, v in sub._asdict().items():
+            getattr(rec, f)[..., dirty] = v
+        simulated += len(dirty) * n
+    return rec, simulated

@@ -2,8 +2,8 @@
 
 Everything that does not change from trial to trial, built once in the parent
 process and shipped to the workers (small arrays in namedtuples, cheap to
-pickle): the linear plant, the filter model, the Table 1 detection of each
-signature variant, the belief, the controllers with their Theorem 4.1 tables
+pickle): the linear plant, the designs run (filter model, Table 1 detection
+with its residual test, initial covariance: ``ftc_mc/sim/designs.py``), the belief, the controllers with their Theorem 4.1 tables
 and terminal costs, the truth plant and its gust model, the timing, the
 validity envelope, the truth noise and the initial covariance.
 
@@ -31,6 +31,7 @@ from ..design.theorem41 import cached_engine_tables
 from ..model.linear import LinearPlant
 from ..model.source import load_plant
 from ..model.turbulence import DrydenModel
+from .designs import Design, build_designs
 from .estimator import (EstimatorSettings, belief_settings, detection, filter_model,
                         initial_covariance)
 from .truth import truth_plant
@@ -44,10 +45,14 @@ class SimSetup:
     ----------
     plant : LinearPlant
     est : EstimatorSettings
-        The config's estimator settings (signature of the first variant run).
+        The config's estimator settings (signature of the first design run).
     fm : FilterModel
+        The paper's filter model at the config's estimator settings (the
+        controllers' terminal costs are built on it).
     det : dict of str to Detection
-        One per signature variant run.
+        Each design run's detection at its thresholds.
+    designs : dict of str to Design
+        The designs run, in order (``ftc_mc/sim/designs.py``).
     bs : Belief
     ctl : Controller
     exc : Excitation
@@ -57,7 +62,7 @@ class SimSetup:
     eng : EngineTables
         Theorem 4.1 tables of the engine-fault controller c1.
     P0 : ndarray, shape (14, 14)
-        Initial covariance.
+        Initial covariance of the paper's filter.
     q_std, r_std : ndarray
         Truth noise standard deviations (9,) and (12,).
     beta : tuple
@@ -75,6 +80,7 @@ class SimSetup:
     est: EstimatorSettings
     fm: FilterModel
     det: dict
+    designs: dict
     bs: Belief
     ctl: Controller
     exc: Excitation
@@ -90,32 +96,36 @@ class SimSetup:
     gust: DrydenModel | None
     gust_chol: np.ndarray | None
 
-    def scheme(self, variant: str, detection: Detection | None = None) -> Scheme:
-        """The kernels' :class:`Scheme` for one signature variant (or ``detection``)."""
-        return Scheme(filter=self.fm, detection=self.det[variant] if detection is None
-                      else detection, belief=self.bs, controller=self.ctl,
-                      excitation=self.exc, reconfig=self.rc, engine=self.eng)
+    def scheme(self, name: str, detection: Detection | None = None) -> Scheme:
+        """The kernels' :class:`Scheme` of the design ``name``: its filter, and its
+        detection (or ``detection``)."""
+        d: Design = self.designs[name]
+        return Scheme(filter=d.fm, detection=d.det if detection is None else detection,
+                      belief=self.bs, controller=self.ctl, excitation=self.exc,
+                      reconfig=self.rc, engine=self.eng)
 
     @property
     def flight(self) -> Flight:
         """The kernels' :class:`Flight`: timing, validity and truth plant."""
         return Flight(timing=self.tim, validity=self.val, plant=self.truth)
 
-    def detection(self, variant: str, t_q: float, t_nx: float) -> Detection:
-        """Table 1 settings of ``variant`` at the thresholds ``(t_q, t_nx)``.
+    def detection(self, name: str, t_q: float, t_nx: float) -> Detection:
+        """Table 1 settings of the design ``name`` at the thresholds ``(t_q, t_nx)``
+        (its residual test kept).
 
         Both infinite: no reset ever happens (the reset variances are then those
-        of the config's thresholds, and never used).
+        of the design's thresholds, and never used).
         """
-        s = dataclasses.replace(self.est, signature=variant)
-        if math.isinf(t_q) and math.isinf(t_nx):
-            return detection(self.plant, s)._replace(t_q=math.inf, t_nx=math.inf)
-        return detection(self.plant, dataclasses.replace(s, t_q=t_q, t_nx=t_nx))
+        return self.designs[name].detection(self.plant, t_q, t_nx)
 
 
-def variants_of(signature: str) -> tuple:
-    """Signature variants named by a config's ``signature`` field."""
-    return VARIANTS if signature == "both" else (signature,)
+def runs_of(cfg: Config | ScenarioConfig) -> tuple:
+    """Names of the designs a config runs, in order: a campaign's signature
+    variants then ``campaign.designs``; a scenario's ``scenario.design``, or its
+    signature variant."""
+    if isinstance(cfg, ScenarioConfig):
+        return (cfg.scenario.design or cfg.scenario.signature,)
+    return cfg.campaign.runs()
 
 
 def timing_of(cfg: Config | ScenarioConfig) -> Timing:
@@ -149,16 +159,15 @@ def build_setup(cfg: Config | ScenarioConfig) -> SimSetup:
     -------
     SimSetup
     """
-    signature = (cfg.scenario.signature if isinstance(cfg, ScenarioConfig)
-                 else cfg.campaign.signature)
-    variants = variants_of(signature)
+    runs = runs_of(cfg)
     m = cfg.model
     vc = cfg.validity
     plant = load_plant(m.airframe, m.airspeed_mps, m.gamma_deg, m.dt_s,
                        (math.radians(vc.alpha_min_deg), math.radians(vc.alpha_max_deg)))
-    est = EstimatorSettings.from_config(cfg.estimator, variants[0])
+    first = runs[0] if runs[0] in VARIANTS else VARIANTS[0]
+    est = EstimatorSettings.from_config(cfg.estimator, first)
     fm = filter_model(plant, est)
-    det = {v: detection(plant, dataclasses.replace(est, signature=v)) for v in variants}
+    designs = build_designs(runs, cfg.designs, plant, cfg.estimator, cfg.plant.altitude_m)
     bs = belief_settings(plant, est)
     c = cfg.controller
     Q = paper_q_lqr(plant.trim.gamma0)
@@ -188,7 +197,8 @@ def build_setup(cfg: Config | ScenarioConfig) -> SimSetup:
     pc = cfg.plant
     truth, gust = truth_plant(plant, pc.kind, pc.substeps, pc.turbulence, pc.altitude_m)
     return SimSetup(
-        plant=plant, est=est, fm=fm, det=det, bs=bs, ctl=ctl, exc=exc, tim=timing_of(cfg),
+        plant=plant, est=est, fm=fm, det={n: d.det for n, d in designs.items()},
+        designs=designs, bs=bs, ctl=ctl, exc=exc, tim=timing_of(cfg),
         val=val, rc=rc, eng=eng,
         # the paper's thresholds set the initial fault variances whatever thresholds
         # are run, so trials share their pre-fault part across a threshold sweep

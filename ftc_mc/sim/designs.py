@@ -1,0 +1,160 @@
+"""Detection designs: the kernel settings of each estimator model x residual test x
+thresholds (issue 13, docs/architecture.md).
+
+A design (:class:`~ftc_mc.config.schema.DesignConfig`) becomes a :class:`Design`:
+the filter model, the Table 1 detection at the design's thresholds with its
+residual test, and the initial covariance.  The built-in designs ``paper`` and
+``swapped`` are the paper's estimator with the one-step test at the ``estimator``
+section's thresholds (:func:`builtin_design`); their settings are exactly those
+the kernels ran before designs existed.
+
+The paper's filter estimates ``[x (9), b (5)]``.  A ``gust_aware`` filter appends
+the four states of the Dryden shaping filter (``[x, b, g (4)]``): gust states
+drive the plant states through ``G = B_w C_d`` and the outputs through
+``D_g = D_w C_d`` (``B_w, D_w``: the wind Jacobians at trim,
+:func:`ftc_mc.model.wind.plant_wind_matrices`, whatever the truth plant), and
+evolve as ``g+ = A_d g`` with process noise ``Q_g = B_d B_d^T`` of the design's
+turbulence level.  Its gust states start at 0 with the stationary Dryden
+covariance.
+
+A design changes only what the filter assumes: the truth noise of every trial
+comes from the config's ``estimator`` and ``noise`` sections, so all designs fly
+the same trials (common random numbers).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+import scipy.linalg
+
+from ..config.schema import BUILTIN_DESIGNS, DesignConfig, EstimatorConfig
+from ..conventions import TEST_GLR, TEST_NAMES, TEST_ONE_STEP
+from ..core.settings import Detection, FilterModel
+from ..model.linear import LinearPlant
+from ..model.turbulence import dryden_model
+from ..model.wind import plant_wind_matrices
+from .estimator import EstimatorSettings, detection, filter_model, initial_covariance
+
+
+@dataclasses.dataclass(frozen=True)
+class Design:
+    """Kernel settings of one design.
+
+    Attributes
+    ----------
+    name : str
+        The design's name (the ``variant`` column of the results).
+    est : EstimatorSettings
+        Filter noise densities, thresholds and signature of the design.
+    fm : FilterModel
+        The filter model (gust arrays empty for the paper's estimator).
+    det : Detection
+        Table 1 settings at the design's thresholds, with its test and window.
+    P0 : ndarray, shape (n, n)
+        Initial covariance, ``n = 14 + ng`` (``ng`` gust states).
+    test : int
+        ``conventions.TEST_ONE_STEP`` or ``TEST_GLR``.
+    window : int
+        GLR window [steps] (1 with the one-step test).
+    key : tuple
+        Equal for designs whose runs may share a start (same filter model and
+        initial covariance, same test and window; ``ftc_mc/sim/lanes.py``).
+    """
+
+    name: str
+    est: EstimatorSettings
+    fm: FilterModel
+    det: Detection
+    P0: np.ndarray
+    test: int
+    window: int
+    key: tuple
+
+    @property
+    def n_aug(self) -> int:
+        """Length of the augmented estimate, ``14 + ng``."""
+        return self.P0.shape[0]
+
+    def detection(self, plant: LinearPlant, t_q: float, t_nx: float) -> Detection:
+        """The design's detection at the thresholds ``(t_q, t_nx)``.
+
+        Both infinite: no reset ever happens (the reset variances are then those
+        of the design's thresholds, and never used).
+        """
+        if math.isinf(t_q) and math.isinf(t_nx):
+            return self.det._replace(t_q=math.inf, t_nx=math.inf)
+        det = detection(plant, dataclasses.replace(self.est, t_q=t_q, t_nx=t_nx))
+        return _with_test(det, self.test, self.window)
+
+
+def builtin_design(name: str, est: EstimatorConfig) -> DesignConfig:
+    """The design ``paper`` or ``swapped``: the paper's estimator and one-step test
+    at the ``estimator`` section's thresholds, Table 1 as printed or swapped."""
+    assert name in BUILTIN_DESIGNS, name
+    return DesignConfig(signature=name, t_q=est.t_q, t_nx=est.t_nx)
+
+
+def _with_test(det: Detection, test: int, window: int) -> Detection:
+    """``det`` with another residual test (a one-step detection is left as built)."""
+    return det if test == TEST_ONE_STEP else det._replace(test=test, window=window)
+
+
+def _c(a) -> np.ndarray:
+    return np.ascontiguousarray(a, dtype=np.float64)
+
+
+def build_design(name: str, dc: DesignConfig, plant: LinearPlant, est: EstimatorConfig,
+                 altitude_m: float) -> Design:
+    """The kernel settings of the design ``dc``.
+
+    Parameters
+    ----------
+    name : str
+    dc : DesignConfig
+        A validated design (:func:`builtin_design` for ``paper``/``swapped``).
+    plant : LinearPlant
+        The linear model the filter is built on.
+    est : EstimatorConfig
+        The config's ``estimator`` section: noise densities unless the design
+        overrides them, ``R``, mode boxes.
+    altitude_m : float
+        Altitude of the Dryden scale lengths of a gust-aware filter [m].
+
+    Returns
+    -------
+    Design
+    """
+    s = EstimatorSettings.from_config(est, dc.signature)
+    s = dataclasses.replace(
+        s, t_q=dc.t_q, t_nx=dc.t_nx,
+        sigma_qx=s.sigma_qx if dc.sigma_qx is None else dc.sigma_qx,
+        sigma_qb=s.sigma_qb if dc.sigma_qb is None else dc.sigma_qb)
+    fm = filter_model(plant, s)
+    # the paper's thresholds set the initial fault variances whatever thresholds are
+    # run, so runs share their pre-fault part across thresholds (ftc_mc/sim/lanes.py)
+    P0 = initial_covariance(fm, detection(plant, EstimatorSettings()))
+    if dc.estimator == "gust_aware":
+        Bw, Dw = plant_wind_matrices(plant)
+        dm = dryden_model(dc.design_turbulence, V=plant.trim.V0, altitude_m=altitude_m,
+                          dt=plant.dt)
+        fm = fm._replace(G=_c(Bw @ dm.Cd), Ad=_c(dm.Ad), Dg=_c(Dw @ dm.Cd),
+                         Qg=_c(dm.Bd @ dm.Bd.T))
+        P0 = scipy.linalg.block_diag(P0, dm.P0)
+    test = TEST_NAMES.index(dc.test)
+    window = int(round(dc.window_s / plant.dt)) if test == TEST_GLR else 1
+    det = _with_test(detection(plant, s), test, window)
+    key = (dc.estimator, dc.design_turbulence if dc.estimator == "gust_aware" else None,
+           s.sigma_qx, s.sigma_qb, test, window)
+    return Design(name=name, est=s, fm=fm, det=det, P0=_c(P0), test=test, window=window,
+                  key=key)
+
+
+def build_designs(names, designs: dict, plant: LinearPlant, est: EstimatorConfig,
+                  altitude_m: float) -> dict:
+    """``name -> Design`` of the designs ``names`` run (built-in or keys of
+    ``designs``, the config's validated ``designs`` section), in order."""
+    return {n: build_design(n, builtin_design(n, est) if n in BUILTIN_DESIGNS
+                            else designs[n], plant, est, altitude_m) for n in names}
