@@ -18,7 +18,7 @@ from pydantic import (AfterValidator, BaseModel, BeforeValidator, ConfigDict, Fi
                       field_validator, model_validator)
 
 from ..conventions import (ACTUATOR_NAMES, OUTPUT_NAMES, PLANT_KINDS, SENSOR_FAULT_KINDS,
-                           SENSOR_PREFIX, TRANSITIONS, TURBULENCE_LEVELS)
+                           SENSOR_PREFIX, STATE_NAMES, TRANSITIONS, TURBULENCE_LEVELS)
 from ..errors import UserError
 from ..model.source import (DEFAULT_AIRFRAME, check_airframe, check_condition,
                             is_linear_model)
@@ -88,6 +88,11 @@ def _check_airframe_use(cfg) -> tuple:
         raise ValueError(f"plant.kind: nonlinear needs an airframe's equations, but "
                          f"model.airframe is a linear model ({m.airframe}); use a preset "
                          "or an airframe YAML file, or plant.kind: linear")
+    for name, d in cfg.designs.items():
+        if d.prediction == "nonlinear" and is_linear_model(m.airframe):
+            raise ValueError(f"designs.{name}.prediction: nonlinear needs an airframe's "
+                             f"equations, but model.airframe is a linear model "
+                             f"({m.airframe}); use prediction: linear")
     alpha = (math.radians(cfg.validity.alpha_min_deg),
              math.radians(cfg.validity.alpha_max_deg))
     try:
@@ -391,6 +396,8 @@ class DesignConfig(_Strict):
 
     estimator: Literal["paper", "gust_aware"] = "paper"
     """paper: the 14-state filter of eqs. 4-6; gust_aware: plus the 4 Dryden gust states (docs/architecture.md)."""
+    prediction: Literal["linear", "nonlinear"] = "linear"
+    """linear: the model of eq. 5; nonlinear: the airframe's equations predict the states and outputs (an extended filter; covariance with the trim Jacobians)."""
     design_turbulence: Literal["light", "moderate", "severe"] = "moderate"
     """Dryden level of the gust states' process noise and initial covariance (gust_aware only)."""
     test: Literal["one_step", "glr"] = "one_step"
@@ -407,6 +414,8 @@ class DesignConfig(_Strict):
     """Filter process-noise density of the plant states; null: estimator.sigma_qx (the truth noise never changes)."""
     sigma_qb: Pos | None = None
     """Filter random-walk density of the fault parameters; null: estimator.sigma_qb."""
+    state_noise: dict[Literal[STATE_NAMES], NonNeg] = Field(default_factory=dict)
+    """Extra filter process-noise standard deviation per step on named plant states (u, w [m/s], q [rad/s], ...): an allowance for the airframe model's error; {} adds none."""
 
 
 def _design_names(designs: dict) -> dict:

@@ -15,7 +15,9 @@ drive the plant states through ``G = B_w C_d`` and the outputs through
 :func:`ftc_mc.model.wind.plant_wind_matrices`, whatever the truth plant), and
 evolve as ``g+ = A_d g`` with process noise ``Q_g = B_d B_d^T`` of the design's
 turbulence level.  Its gust states start at 0 with the stationary Dryden
-covariance.
+covariance.  ``prediction: nonlinear`` makes it an extended filter: the airframe's
+equations predict the plant states and the outputs
+(:mod:`ftc_mc.core.gustfilter`), with or without gust states.
 
 A design changes only what the filter assumes: the truth noise of every trial
 comes from the config's ``estimator`` and ``noise`` sections, so all designs fly
@@ -31,7 +33,7 @@ import numpy as np
 import scipy.linalg
 
 from ..config.schema import BUILTIN_DESIGNS, DesignConfig, EstimatorConfig
-from ..conventions import TEST_GLR, TEST_NAMES, TEST_ONE_STEP
+from ..conventions import STATE_NAMES, TEST_GLR, TEST_NAMES, TEST_ONE_STEP
 from ..core.settings import Detection, FilterModel
 from ..model.linear import LinearPlant
 from ..model.turbulence import dryden_model
@@ -133,6 +135,11 @@ def build_design(name: str, dc: DesignConfig, plant: LinearPlant, est: Estimator
         sigma_qx=s.sigma_qx if dc.sigma_qx is None else dc.sigma_qx,
         sigma_qb=s.sigma_qb if dc.sigma_qb is None else dc.sigma_qb)
     fm = filter_model(plant, s)
+    if dc.state_noise:  # the model-error allowance on named plant states
+        q = fm.q_diag.copy()
+        for state, sd in dc.state_noise.items():
+            q[STATE_NAMES.index(state)] += sd ** 2
+        fm = fm._replace(q_diag=q)
     # the paper's thresholds set the initial fault variances whatever thresholds are
     # run, so runs share their pre-fault part across thresholds (ftc_mc/sim/lanes.py)
     P0 = initial_covariance(fm, detection(plant, EstimatorSettings()))
@@ -143,11 +150,15 @@ def build_design(name: str, dc: DesignConfig, plant: LinearPlant, est: Estimator
         fm = fm._replace(G=_c(Bw @ dm.Cd), Ad=_c(dm.Ad), Dg=_c(Dw @ dm.Cd),
                          Qg=_c(dm.Bd @ dm.Bd.T))
         P0 = scipy.linalg.block_diag(P0, dm.P0)
+        fm = fm._replace(Cg=_c(dm.Cd))
+    if dc.prediction == "nonlinear":
+        fm = fm._replace(nl=1)
     test = TEST_NAMES.index(dc.test)
     window = int(round(dc.window_s / plant.dt)) if test == TEST_GLR else 1
     det = _with_test(detection(plant, s), test, window)
     key = (dc.estimator, dc.design_turbulence if dc.estimator == "gust_aware" else None,
-           s.sigma_qx, s.sigma_qb, test, window)
+           dc.prediction, s.sigma_qx, s.sigma_qb, tuple(sorted(dc.state_noise.items())),
+           test, window)
     return Design(name=name, est=s, fm=fm, det=det, P0=_c(P0), test=test, window=window,
                   key=key)
 
