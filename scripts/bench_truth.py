@@ -13,6 +13,12 @@ Usage::
 
     .venv/bin/python scripts/bench_truth.py [--lanes 128] [--repeat 3]
 
+Then the detection designs of issue 13 (``DESIGNS``) on the nonlinear plant in
+moderate turbulence, each run alone on the same chunk: the paper's filter
+(``swapped``), the gust-aware filter (18 states, linear prediction) and the
+extended filter (the airframe predicts), with the one-step or the GLR test;
+ratios against ``swapped``.
+
 The last line is ``linear_trials_per_s=<a> nonlinear_trials_per_s=<b>
 nonlinear_moderate_trials_per_s=<c> ratio=<a/b>`` (nominal controller unless
 told otherwise).
@@ -43,11 +49,31 @@ PLANTS = (("linear", "none"), ("nonlinear", "none"), ("linear", "moderate"),
           ("nonlinear", "moderate"))
 TRANSITIONS = ("elevon_lock", "engine_loss")
 
+DESIGNS = {
+    "swapped": None,
+    "gust_one_step": {"estimator": "gust_aware", "test": "one_step"},
+    "gust_glr": {"estimator": "gust_aware", "test": "glr", "window_s": 2.0},
+    "extended_glr": {"estimator": "gust_aware", "prediction": "nonlinear", "test": "glr",
+                     "window_s": 2.0},
+}
+"""Designs timed on the nonlinear plant in moderate turbulence (``swapped``: the
+paper's filter, the reference)."""
 
-def trials_per_s(kind, turbulence, controller, lanes, repeat):
-    """Median trials/s of one chunk per transition (both variants count as trials)."""
+
+def trials_per_s(kind, turbulence, controller, lanes, repeat, design=None):
+    """Median trials/s of one chunk per transition (both variants count as trials;
+    with ``design``, that design alone)."""
+    campaign = {"transitions": list(TRANSITIONS), "signature": "both"}
+    designs = {}
+    if design is not None:
+        name, dc = design
+        if dc is None:
+            campaign["signature"] = name
+        else:
+            campaign.update(signature="none", designs=[name])
+            designs = {name: dc}
     cfg = Config.model_validate({
-        "campaign": {"transitions": list(TRANSITIONS), "signature": "both"},
+        "campaign": campaign, "designs": designs,
         "controller": {"kind": controller},
         "plant": {"kind": kind, "turbulence": turbulence}})
     spec = chunk_spec(cfg)
@@ -63,7 +89,7 @@ def trials_per_s(kind, turbulence, controller, lanes, repeat):
         t = time.perf_counter()
         once()
         times.append(time.perf_counter() - t)
-    n_trials = lanes * len(TRANSITIONS) * 2
+    n_trials = lanes * len(TRANSITIONS) * (2 if design is None else 1)
     return n_trials / statistics.median(times), cfg.steps(cfg.timing.duration_s)
 
 
@@ -85,6 +111,13 @@ def main():
           f"{'vs linear':>10}")
     for (kind, turb), r in rows.items():
         print(f"{kind:>10} {turb:>10} {r:10.1f} {r * n_steps:14.3g} {r / ref:10.3f}")
+    drows = {name: trials_per_s("nonlinear", "moderate", args.controller, args.lanes,
+                                args.repeat, (name, dc))[0]
+             for name, dc in DESIGNS.items()}
+    print("designs, nonlinear plant, moderate turbulence, one design per run:")
+    print(f"{'design':>14} {'trials/s':>10} {'trial steps/s':>14} {'vs swapped':>10}")
+    for name, r in drows.items():
+        print(f"{name:>14} {r:10.1f} {r * n_steps:14.3g} {r / drows['swapped']:10.3f}")
     nl = rows["nonlinear", "none"]
     print(f"linear_trials_per_s={ref:.1f} nonlinear_trials_per_s={nl:.1f} "
           f"nonlinear_moderate_trials_per_s={rows['nonlinear', 'moderate']:.1f} "
