@@ -87,6 +87,7 @@ class RefModel:
     Qg: np.ndarray | None = None
     test: str = "one_step"
     window: int = 1
+    min_window: int = 1
     nl: int = 0
     p: np.ndarray | None = None
     x0: np.ndarray | None = None
@@ -290,15 +291,15 @@ def innovations_ref(X, P, z, model):
     return np.array([mu[i] / np.sqrt(S[i, i]) for i in (OUT_Q, OUT_NX, OUT_NZ)])
 
 
-def glr_ref(newest_first):
+def glr_ref(newest_first, m_min=1):
     """GLR of a mean shift over a window (``ftc_mc/core/glr.py``), directly:
-    ``max_m (sum of the m newest e)^2 / m`` per channel; ``newest_first`` is
-    (m, 3).  Zero for an empty window."""
+    ``max_{m >= m_min} (sum of the m newest e)^2 / m`` per channel;
+    ``newest_first`` is (m, 3).  Zero while the window holds fewer than ``m_min``."""
     e = np.asarray(newest_first, dtype=float)
-    if len(e) == 0:
+    if len(e) < m_min:
         return np.zeros(3)
     m = np.arange(1, len(e) + 1)[:, None]
-    return np.max(np.cumsum(e, axis=0) ** 2 / m, axis=0)
+    return np.max((np.cumsum(e, axis=0) ** 2 / m)[m_min - 1:], axis=0)
 
 
 def filter_step_ref(X, P, u, z, model, stat=None):
@@ -540,6 +541,7 @@ def ref_of(scheme):
                     G=fm.G if gust else None, Ad=fm.Ad if gust else None,
                     Dg=fm.Dg if gust else None, Qg=fm.Qg if gust else None,
                     test=("one_step", "glr")[det.test], window=int(det.window),
+                    min_window=int(det.min_window),
                     nl=int(fm.nl), p=fm.p, x0=fm.x0, y0=fm.y0,
                     Cg=fm.Cg if gust else None, n_sub=int(fm.n_sub), dt=float(fm.dt))
 
@@ -715,7 +717,7 @@ def filter_update_ref(scheme, st, u, z, k=0):
             def stat(e, l=l):
                 ebuf[k % W, :, l] = e
                 ecount[l] = min(ecount[l] + 1, W)
-                return glr_ref(ebuf[(k - np.arange(ecount[l])) % W, :, l])
+                return glr_ref(ebuf[(k - np.arange(ecount[l])) % W, :, l], model.min_window)
         xa[:, l], P[:, :, l], block[l], res[:, l], _ = filter_step_ref(
             st.xa[:, l], st.P[:, :, l], u[:, l], z[:, l], model, stat)
         if model.test == "glr" and block[l]:

@@ -144,7 +144,7 @@ def test_glr_against_direct_window():
     full history since each lane's last restart, for windows of 1, 3 and 8 steps."""
     rng = np.random.default_rng(63)
     Lk, n_steps = 5, 40
-    for W in (1, 3, 8):
+    for W, m_min in ((1, 1), (3, 1), (8, 1), (8, 3), (8, 8)):
         ebuf = np.zeros((W, 3, Lk))
         ecount = np.zeros(Lk, dtype=np.int64)
         stat = np.zeros((3, Lk))
@@ -152,14 +152,15 @@ def test_glr_against_direct_window():
         shift = rng.uniform(-2.0, 2.0, (3, Lk))
         for k in range(n_steps):
             e = rng.standard_normal((3, Lk)) + (k > 15) * shift
-            glr_lanes(e, ebuf, ecount, k, stat)
+            glr_lanes(e, ebuf, ecount, k, m_min, stat)
             for l in range(Lk):
                 hist[l].append(e[:, l])
                 window = np.array(hist[l][-W:])[::-1]
-                want = naive.glr_ref(window)
+                want = naive.glr_ref(window, m_min)
                 np.testing.assert_allclose(stat[:, l], want, rtol=1e-13, atol=0.0)
                 # and straight from the definition, with a loop over start steps
-                direct = [max(np.sum(window[:m, c]) ** 2 / m for m in range(1, len(window) + 1))
+                direct = [max([np.sum(window[:m, c]) ** 2 / m
+                               for m in range(m_min, len(window) + 1)], default=0.0)
                           for c in range(3)]
                 np.testing.assert_allclose(stat[:, l], direct, rtol=1e-13)
             block = (rng.random(Lk) < 0.1).astype(np.int64)
@@ -168,7 +169,7 @@ def test_glr_against_direct_window():
                 hist[l] = []
     # W = 1 is the one-step test: the statistic is e^2
     e = rng.standard_normal((3, Lk))
-    glr_lanes(e, np.zeros((1, 3, Lk)), np.zeros(Lk, dtype=np.int64), 7, stat)
+    glr_lanes(e, np.zeros((1, 3, Lk)), np.zeros(Lk, dtype=np.int64), 7, 1, stat)
     np.testing.assert_allclose(stat, e ** 2, rtol=1e-15)
 
 
@@ -176,7 +177,8 @@ def test_gust_glr_whole_loop(linear_gusts):
     """25 steps of ``advance`` with the gust-aware filter, the GLR test and the
     reconfiguring controller, against ``naive.advance_ref``."""
     fm, P0, d = gust_filter(linear_gusts)
-    scheme = gust_scheme(linear_gusts, fm, window=6, test=TEST_GLR, t_q=12.0, t_nx=12.0)
+    scheme = gust_scheme(linear_gusts, fm, window=6, test=TEST_GLR, t_q=12.0, t_nx=12.0,
+                         min_window=2)
     flight = linear_gusts.flight._replace(timing=linear_gusts.tim._replace(n_steps=25))
     rng = np.random.default_rng(111)
     inp = random_inputs(linear_gusts, rng, 25)

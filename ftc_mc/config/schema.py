@@ -404,6 +404,8 @@ class DesignConfig(_Strict):
     """Residual test: one_step (the paper's eqs. 9-11) or glr (a mean change over a sliding window)."""
     window_s: Pos = 2.0
     """GLR window [s] (a multiple of model.dt_s; glr only)."""
+    min_change_s: Pos | None = None
+    """Shortest change the GLR tests [s] (a multiple of model.dt_s, at most window_s): a one-step outlier is not a persistent change; null: one step (glr only)."""
     signature: Literal["paper", "swapped"] = "swapped"
     """Table 1 as printed (paper) or with its third clause swapped."""
     t_q: Pos = 25.0
@@ -443,7 +445,13 @@ def _check_designs(cfg, listed, where: str, duration: tuple) -> None:
             raise ValueError(f"{where}: unknown design {name!r}; designs defined: {known}")
     _check_periods(cfg.model.dt_s, [(f"designs.{n}.window_s", d.window_s)
                                     for n, d in cfg.designs.items() if d.test == "glr"])
+    _check_periods(cfg.model.dt_s, [(f"designs.{n}.min_change_s", d.min_change_s)
+                                    for n, d in cfg.designs.items()
+                                    if d.test == "glr" and d.min_change_s is not None])
     for n, d in cfg.designs.items():
+        if d.test == "glr" and d.min_change_s is not None and d.min_change_s > d.window_s:
+            raise ValueError(f"designs.{n}.min_change_s: must not exceed window_s "
+                             f"({d.window_s:g} s), got {d.min_change_s:g}")
         if d.test == "glr" and d.window_s > duration[1]:
             raise ValueError(f"designs.{n}.window_s: must not exceed {duration[0]} "
                              f"({duration[1]:g} s), got {d.window_s:g}")

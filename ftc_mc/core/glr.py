@@ -10,7 +10,8 @@ their mean from an unknown step ``j`` on, over the last ``W`` steps, is
     g_k = max_{k-W < j <= k} (sum_{i=j}^{k} e_i)^2 / (k - j + 1)
 
 (Willsky & Jones, IEEE TAC 1976; Basseville & Nikiforov, *Detection of Abrupt
-Changes*, 1993, section 2.4 with a known variance): for each ``j`` the
+Changes*, 1993, section 2.4 with a known variance), over changes at least
+``m_min`` steps old (``Detection.min_window``; 1: any): for each ``j`` the
 statistic is chi-square with one degree of freedom under no fault, and a shift
 ``nu`` grows it as ``m nu^2`` with the ``m`` steps since the change.  It
 replaces ``r_q``, ``r_nx``, ``r_nz`` in Table 1, each channel on its own window.
@@ -26,7 +27,7 @@ from .jit import kernel
 
 
 @kernel(inline="always")
-def glr_lanes(innov, ebuf, ecount, k, stat):
+def glr_lanes(innov, ebuf, ecount, k, m_min, stat):
     """Append step ``k``'s innovations to each lane's window and form the GLR.
 
     Parameters
@@ -39,6 +40,10 @@ def glr_lanes(innov, ebuf, ecount, k, stat):
         Innovations in each lane's window, updated (at most ``W``).
     k : int
         Step (any counter that advances by one per call).
+    m_min : int
+        Shortest change tested, ``1 <= m_min <= W``: the maximum runs over
+        ``m_min <= k - j + 1``, so an outlier of one step does not count as a
+        persistent change; 0 until the window holds ``m_min`` innovations.
     stat : ndarray, shape (c, L)
         Written with ``g_k`` per channel and lane.
     """
@@ -60,7 +65,7 @@ def glr_lanes(innov, ebuf, ecount, k, stat):
             for m in range(1, ecount[l] + 1):
                 acc += ebuf[row, c, l]
                 g = acc * acc / m
-                if g > best:
+                if g > best and m >= m_min:
                     best = g
                 row = row - 1 if row > 0 else W - 1
             stat[c, l] = best

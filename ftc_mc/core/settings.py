@@ -46,6 +46,7 @@ Detection = namedtuple("Detection", [
     "reset_var",  # (5,) variance of each fault parameter after its block's reset
     "test",       # conventions.TEST_ONE_STEP (eqs. 9-11) or TEST_GLR (core/glr.py)
     "window",     # GLR window [steps] (1 with the one-step test)
+    "min_window", # shortest change the GLR tests [steps] (1: any; <= window)
 ])
 """Residual signature and covariance reset (paper section 3.2.2, Table 1)."""
 

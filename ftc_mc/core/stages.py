@@ -172,7 +172,7 @@ def filter_update(scheme, st, k, work):
     else:
         gust_predict_lanes(st.xa, st.P, fm, work)
     if det.test == TEST_GLR:
-        glr_lanes(work.innov, st.ebuf, st.ecount, k, res)
+        glr_lanes(work.innov, st.ebuf, st.ecount, k, det.min_window, res)
     signature_lanes(res, det, work.block)
     if paper:
         filter_correct_lanes(st.xa, st.P, work.u, work.z, fm, det, work.phi, work.T,

@@ -89,7 +89,7 @@ class Design:
         if math.isinf(t_q) and math.isinf(t_nx):
             return self.det._replace(t_q=math.inf, t_nx=math.inf)
         det = detection(plant, dataclasses.replace(self.est, t_q=t_q, t_nx=t_nx))
-        return _with_test(det, self.test, self.window)
+        return _with_test(det, self.test, self.window, self.det.min_window)
 
 
 def builtin_design(name: str, est: EstimatorConfig) -> DesignConfig:
@@ -99,9 +99,10 @@ def builtin_design(name: str, est: EstimatorConfig) -> DesignConfig:
     return DesignConfig(signature=name, t_q=est.t_q, t_nx=est.t_nx)
 
 
-def _with_test(det: Detection, test: int, window: int) -> Detection:
+def _with_test(det: Detection, test: int, window: int, min_window: int = 1) -> Detection:
     """``det`` with another residual test (a one-step detection is left as built)."""
-    return det if test == TEST_ONE_STEP else det._replace(test=test, window=window)
+    return det if test == TEST_ONE_STEP else det._replace(test=test, window=window,
+                                                            min_window=min_window)
 
 
 def _c(a) -> np.ndarray:
@@ -155,10 +156,12 @@ def build_design(name: str, dc: DesignConfig, plant: LinearPlant, est: Estimator
         fm = fm._replace(nl=1)
     test = TEST_NAMES.index(dc.test)
     window = int(round(dc.window_s / plant.dt)) if test == TEST_GLR else 1
-    det = _with_test(detection(plant, s), test, window)
+    min_window = (1 if test != TEST_GLR or dc.min_change_s is None
+                  else int(round(dc.min_change_s / plant.dt)))
+    det = _with_test(detection(plant, s), test, window, min_window)
     key = (dc.estimator, dc.design_turbulence if dc.estimator == "gust_aware" else None,
            dc.prediction, s.sigma_qx, s.sigma_qb, tuple(sorted(dc.state_noise.items())),
-           test, window)
+           test, window, min_window)
     return Design(name=name, est=s, fm=fm, det=det, P0=_c(P0), test=test, window=window,
                   key=key)
 
