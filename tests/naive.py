@@ -88,6 +88,7 @@ class RefModel:
     test: str = "one_step"
     window: int = 1
     min_window: int = 1
+    settle: int = 0
     nl: int = 0
     p: np.ndarray | None = None
     x0: np.ndarray | None = None
@@ -302,12 +303,13 @@ def glr_ref(newest_first, m_min=1):
     return np.max((np.cumsum(e, axis=0) ** 2 / m)[m_min - 1:], axis=0)
 
 
-def filter_step_ref(X, P, u, z, model, stat=None):
+def filter_step_ref(X, P, u, z, model, stat=None, gate=None):
     """One estimator step in ``ftc_mc.core.step.filter_step``'s order:
     predict, residuals, Table 1; on a reset, reset the block of ``P_{k|k}`` and
     predict again; update, projection.  ``stat``: a function of the signed
     innovations giving the decision statistics (the GLR test); ``None`` for
-    the paper's one-step residuals.
+    the paper's one-step residuals.  ``gate``: a function of Table 1's block
+    giving the block reset (the settling rule).
 
     Returns
     -------
@@ -319,6 +321,8 @@ def filter_step_ref(X, P, u, z, model, stat=None):
     if stat is not None:
         res = stat(e)
     block = signature_ref(res[0], res[1], res[2], model.t_q, model.t_nx, model.variant)
+    if gate is not None:
+        block = gate(block)
     if block:
         Xp, Pp = predict_ref(X, reset_ref(P, block, model.reset_var), u, model)
     X, P = update_ref(Xp, Pp, z, model)
@@ -541,7 +545,7 @@ def ref_of(scheme):
                     G=fm.G if gust else None, Ad=fm.Ad if gust else None,
                     Dg=fm.Dg if gust else None, Qg=fm.Qg if gust else None,
                     test=("one_step", "glr")[det.test], window=int(det.window),
-                    min_window=int(det.min_window),
+                    min_window=int(det.min_window), settle=int(det.settle),
                     nl=int(fm.nl), p=fm.p, x0=fm.x0, y0=fm.y0,
                     Cg=fm.Cg if gust else None, n_sub=int(fm.n_sub), dt=float(fm.dt))
 
@@ -709,6 +713,7 @@ def filter_update_ref(scheme, st, u, z, k=0):
     L = st.xa.shape[1]
     xa, P = st.xa.copy(), st.P.copy()
     ebuf, ecount = st.ebuf.copy(), st.ecount.copy()
+    last_k, last_block = st.last_k.copy(), st.last_block.copy()
     res, block = np.zeros((3, L)), np.zeros(L, dtype=np.int64)
     W = ebuf.shape[0]
     for l in range(L):
@@ -718,12 +723,19 @@ def filter_update_ref(scheme, st, u, z, k=0):
                 ebuf[k % W, :, l] = e
                 ecount[l] = min(ecount[l] + 1, W)
                 return glr_ref(ebuf[(k - np.arange(ecount[l])) % W, :, l], model.min_window)
+        gate = None
+        if model.settle > 0:
+            def gate(b, l=l):  # the other block, within `settle` steps of a reset
+                recent = k - last_k[l] < model.settle
+                return 0 if (b and last_block[l] and b != last_block[l] and recent) else b
         xa[:, l], P[:, :, l], block[l], res[:, l], _ = filter_step_ref(
-            st.xa[:, l], st.P[:, :, l], u[:, l], z[:, l], model, stat)
+            st.xa[:, l], st.P[:, :, l], u[:, l], z[:, l], model, stat, gate)
         if model.test == "glr" and block[l]:
             ecount[l] = 0
+        if model.settle > 0 and block[l]:
+            last_k[l], last_block[l] = k, block[l]
     rmax = np.maximum(st.rmax, res[:2])
-    return xa, P, res, block, rmax, ebuf, ecount
+    return xa, P, res, block, rmax, ebuf, ecount, last_k, last_block
 
 
 def positive_definite_ref(P):
@@ -835,9 +847,11 @@ def advance_ref(scheme, flight, inp, rec, st, k0, k1):
         u, exc = commands_ref(scheme, st, k)
         tr = truth_step_ref(scheme, flight, inp, k, st, u)
         st.x[:], st.gust[:], st.zhold[:] = tr["x"], tr["gust"], tr["zhold"]
-        xa, P, res, block, rmax, ebuf, ecount = filter_update_ref(scheme, st, u, tr["z"], k)
+        xa, P, res, block, rmax, ebuf, ecount, last_k, last_block = filter_update_ref(
+            scheme, st, u, tr["z"], k)
         st.xa[:], st.P[:], st.rmax[:] = xa, P, rmax
         st.ebuf[:], st.ecount[:] = ebuf, ecount
+        st.last_k[:], st.last_block[:] = last_k, last_block
         alive, status, stop_k = check_validity_ref(flight.validity, st, kn, tr["va"],
                                                    tr["alpha"], rec.status, rec.stop_k)
         st.alive[:], rec.status[:], rec.stop_k[:] = alive, status, stop_k

@@ -89,7 +89,7 @@ def test_gust_filter_update(linear_gusts, test):
     fm, P0, d = gust_filter(linear_gusts)
     W = 4 if test == "glr" else 1
     scheme = gust_scheme(linear_gusts, fm, window=W, test=int(test == "glr"), t_q=3.0,
-                         t_nx=3.0)
+                         t_nx=3.0, settle=4 if test == "glr" else 0)
     rng = np.random.default_rng(61)
     scale = np.array([0.3, 0.3, 1.0, 3.0, 10.0, 30.0, 100.0])
     fired = set()
@@ -98,13 +98,14 @@ def test_gust_filter_update(linear_gusts, test):
         work = new_trial_work(L, N)
         work.u[:] = 0.05 * rng.standard_normal((3, L))
         measurements(scheme, st, work, rng, scale if k % 2 else scale[::-1])
-        xa, P, res, block, rmax, ebuf, ecount = naive.filter_update_ref(
+        xa, P, res, block, rmax, ebuf, ecount, last_k, last_block = naive.filter_update_ref(
             scheme, st, work.u, work.z, k)
         stages.filter_update(scheme, st, k, work)
         assert np.array_equal(work.block, block), k
         assert_lanes(work.res, res, 1e-11, "statistics")
         assert rel(st.rmax, rmax) <= 1e-11
         assert np.array_equal(st.ecount, ecount)
+        assert np.array_equal(st.last_k, last_k) and np.array_equal(st.last_block, last_block)
         for l in range(L):
             assert rel(st.xa[:, l], xa[:, l]) <= 1e-9, (k, l)
             assert rel(st.P[:, :, l], P[:, :, l]) <= 1e-9, (k, l)
@@ -127,7 +128,7 @@ def test_paper_filter_with_glr():
         work = new_trial_work(L, N_AUG)
         work.u[:] = 0.05 * rng.standard_normal((3, L))
         measurements(scheme, st, work, rng, scale)
-        xa, P, res, block, rmax, ebuf, ecount = naive.filter_update_ref(
+        xa, P, res, block, rmax, ebuf, ecount, last_k, last_block = naive.filter_update_ref(
             scheme, st, work.u, work.z, k)
         stages.filter_update(scheme, st, k, work)
         assert np.array_equal(work.block, block), k
@@ -137,6 +138,16 @@ def test_paper_filter_with_glr():
             assert rel(st.xa[:, l], xa[:, l]) <= 1e-9, (k, l)
         fired.update(block.tolist())
     assert len(fired) > 1
+
+
+def test_settle_withholds_the_other_block():
+    """``settle_lanes``: within ``settle`` steps of a reset only the same block may
+    reset again; the rule written out case by case."""
+    block = np.array([1, 2, 1, 2, 0, 1, 2], dtype=np.int64)
+    last_block = np.array([2, 1, 1, 2, 1, 0, 1], dtype=np.int64)
+    last_k = np.array([8, 8, 8, 8, 8, 8, 5], dtype=np.int64)
+    stages.settle_lanes(block, last_k, last_block, 10, 3)  # lane 6: 5 steps ago
+    assert block.tolist() == [0, 0, 1, 2, 0, 1, 2]
 
 
 def test_glr_against_direct_window():
@@ -178,7 +189,7 @@ def test_gust_glr_whole_loop(linear_gusts):
     reconfiguring controller, against ``naive.advance_ref``."""
     fm, P0, d = gust_filter(linear_gusts)
     scheme = gust_scheme(linear_gusts, fm, window=6, test=TEST_GLR, t_q=12.0, t_nx=12.0,
-                         min_window=2)
+                         min_window=2, settle=5)
     flight = linear_gusts.flight._replace(timing=linear_gusts.tim._replace(n_steps=25))
     rng = np.random.default_rng(111)
     inp = random_inputs(linear_gusts, rng, 25)
@@ -264,7 +275,7 @@ def test_extended_filter_update(nonlinear_gusts, test):
         work = new_trial_work(L, N)
         work.u[:] = 0.05 * rng.standard_normal((3, L))
         measurements(scheme, st, work, rng, scale)
-        xa, P, res, block, rmax, ebuf, ecount = naive.filter_update_ref(
+        xa, P, res, block, rmax, ebuf, ecount, last_k, last_block = naive.filter_update_ref(
             scheme, st, work.u, work.z, k)
         stages.filter_update(scheme, st, k, work)
         assert np.array_equal(work.block, block), k

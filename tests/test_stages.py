@@ -132,7 +132,9 @@ def random_lanes(setup, rng, k, L=L):
                      alive=alive, cur=(np.arange(L) % N_CONTROLLERS).astype(np.int64),
                      rmax=rng.uniform(0.0, 50.0, (2, L)), gust=gust,
                      zhold=rng.standard_normal(L), ebuf=np.zeros((1, 3, L)),
-                     ecount=np.zeros(L, dtype=np.int64))
+                     ecount=np.zeros(L, dtype=np.int64),
+                     last_k=k - rng.integers(1, 40, L).astype(np.int64),
+                     last_block=rng.integers(0, 3, L).astype(np.int64))
 
 
 def copy_nt(nt):
@@ -426,7 +428,7 @@ def test_filter_update(linear, variant):
             Xp, Pp = naive.predict_ref(st.xa[:, l], st.P[:, :, l], work.u[:, l], model)
             mu0, S = naive.innovation_ref(Xp, Pp, np.zeros(12), model)
             work.z[:, l] = -mu0 + scale[l] * np.sqrt(np.diag(S)) * rng.standard_normal(12)
-        xa, P, res, block, rmax, _, _ = naive.filter_update_ref(scheme, st, work.u, work.z)
+        xa, P, res, block, rmax, *_ = naive.filter_update_ref(scheme, st, work.u, work.z)
         Pk = st.P.copy()
         stages.filter_update(scheme, st, 10, work)
         assert np.array_equal(work.block, block)

@@ -404,6 +404,8 @@ class DesignConfig(_Strict):
     """Residual test: one_step (the paper's eqs. 9-11) or glr (a mean change over a sliding window)."""
     window_s: Pos = 2.0
     """GLR window [s] (a multiple of model.dt_s; glr only)."""
+    settle_s: NonNeg = 0.0
+    """After a reset, the other block is not reset for this long [s] while the filter re-converges (a multiple of model.dt_s; 0: no wait)."""
     min_change_s: Pos | None = None
     """Shortest change the GLR tests [s] (a multiple of model.dt_s, at most window_s): a one-step outlier is not a persistent change; null: one step (glr only)."""
     signature: Literal["paper", "swapped"] = "swapped"
@@ -448,6 +450,8 @@ def _check_designs(cfg, listed, where: str, duration: tuple) -> None:
     _check_periods(cfg.model.dt_s, [(f"designs.{n}.min_change_s", d.min_change_s)
                                     for n, d in cfg.designs.items()
                                     if d.test == "glr" and d.min_change_s is not None])
+    _check_periods(cfg.model.dt_s, [(f"designs.{n}.settle_s", d.settle_s)
+                                    for n, d in cfg.designs.items() if d.settle_s > 0])
     for n, d in cfg.designs.items():
         if d.test == "glr" and d.min_change_s is not None and d.min_change_s > d.window_s:
             raise ValueError(f"designs.{n}.min_change_s: must not exceed window_s "

@@ -47,6 +47,7 @@ Detection = namedtuple("Detection", [
     "test",       # conventions.TEST_ONE_STEP (eqs. 9-11) or TEST_GLR (core/glr.py)
     "window",     # GLR window [steps] (1 with the one-step test)
     "min_window", # shortest change the GLR tests [steps] (1: any; <= window)
+    "settle",     # steps after a reset during which the other block is not reset (0: none)
 ])
 """Residual signature and covariance reset (paper section 3.2.2, Table 1)."""
 
@@ -185,6 +186,8 @@ LaneState = namedtuple("LaneState", [
     "zhold",    # (L,) last healthy measurement of the lane's faulty output (stuck)
     "ebuf",     # (W, 3, L) signed normalised innovations of the GLR window (ring)
     "ecount",   # (L,) int64 innovations in the window since the start or last reset
+    "last_k",   # (L,) int64 step of the last reset (Detection.settle), or far past
+    "last_block",  # (L,) int64 block of the last reset, or 0
 ])
 """Everything a trial carries from one step to the next (core/trial.py)."""
 

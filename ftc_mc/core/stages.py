@@ -142,10 +142,13 @@ def filter_update(scheme, st, k, work):
     Predict with ``u_k`` and the residuals on ``z_{k+1}``
     (:func:`ftc_mc.core.batch.filter_predict_lanes` for the paper's 14-state
     filter, :func:`ftc_mc.core.gustfilter.gust_predict_lanes` when the estimate
-    carries gust states or the airframe predicts, ``filter.nl``); with the GLR test (``detection.test == TEST_GLR``)
-    the statistics of :func:`ftc_mc.core.glr.glr_lanes` replace the one-step
-    residuals; Table 1 on them; reset, update and projection (the
-    ``*_correct_lanes`` halves); a reset restarts the lane's GLR window.  Then
+    carries gust states or the airframe predicts, ``filter.nl``); with the GLR
+    test (``detection.test == TEST_GLR``) the statistics of
+    :func:`ftc_mc.core.glr.glr_lanes` replace the one-step residuals; Table 1
+    on them, a decision for the other block withheld within
+    ``detection.settle`` steps of a reset (:func:`settle_lanes`); reset, update
+    and projection (the ``*_correct_lanes`` halves); a reset restarts the
+    lane's GLR window.  Then
     the largest ``r_q`` and ``r_nx`` seen so far (threshold sweeps).
 
     Parameters
@@ -174,6 +177,8 @@ def filter_update(scheme, st, k, work):
     if det.test == TEST_GLR:
         glr_lanes(work.innov, st.ebuf, st.ecount, k, det.min_window, res)
     signature_lanes(res, det, work.block)
+    if det.settle > 0:
+        settle_lanes(work.block, st.last_k, st.last_block, k, det.settle)
     if paper:
         filter_correct_lanes(st.xa, st.P, work.u, work.z, fm, det, work.phi, work.T,
                              work.fwork, work.block)
@@ -181,9 +186,31 @@ def filter_update(scheme, st, k, work):
         gust_correct_lanes(st.xa, st.P, fm, det, work)
     if det.test == TEST_GLR:
         glr_restart(work.block, st.ecount)
+    if det.settle > 0:
+        for l in range(st.xa.shape[1]):
+            if work.block[l] != 0:
+                st.last_k[l] = k
+                st.last_block[l] = work.block[l]
     for l in range(st.xa.shape[1]):
         st.rmax[R_Q, l] = max(st.rmax[R_Q, l], res[R_Q, l])
         st.rmax[R_NX, l] = max(st.rmax[R_NX, l], res[R_NX, l])
+
+
+@kernel(inline="always")
+def settle_lanes(block, last_k, last_block, k, settle):
+    """Withhold a reset of the other block within ``settle`` steps of a reset.
+
+    After a reset the filter re-converges (its reset variances are large), and
+    meanwhile the other block's residuals move too: on the nonlinear X8 a
+    locked elevon's drag shows in ``n_x`` 0.3-3 s later (DESIGN.md section 9).
+    A lane whose Table 1 decision at step ``k`` is the block other than its
+    last reset's, within ``settle`` steps of it, resets nothing (``block`` 0).
+    """
+    for l in range(block.shape[0]):
+        b = block[l]
+        if (b != 0 and last_block[l] != 0 and b != last_block[l]
+                and k - last_k[l] < settle):
+            block[l] = 0
 
 
 # ------------------------------------------------------------------ 4. validity

@@ -122,6 +122,8 @@ def init_state(inp, st, rec):
             st.gust[i, l] = inp.g0[i, l]
         st.zhold[l] = 0.0
         st.ecount[l] = 0
+        st.last_k[l] = NO_SIGNAL
+        st.last_block[l] = 0
 
 
 @kernel
@@ -137,7 +139,9 @@ def new_state(L, n, window):
                      alive=np.zeros(L, dtype=np.bool_), cur=np.zeros(L, dtype=np.int64),
                      rmax=np.zeros((N_RMAX, L)), gust=np.zeros((N_GUST_STATE, L)),
                      zhold=np.zeros(L), ebuf=np.zeros((window, len(RESIDUAL_OUTPUTS), L)),
-                     ecount=np.zeros(L, dtype=np.int64))
+                     ecount=np.zeros(L, dtype=np.int64),
+                     last_k=np.zeros(L, dtype=np.int64),
+                     last_block=np.zeros(L, dtype=np.int64))
 
 
 @kernel

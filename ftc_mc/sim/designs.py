@@ -89,7 +89,8 @@ class Design:
         if math.isinf(t_q) and math.isinf(t_nx):
             return self.det._replace(t_q=math.inf, t_nx=math.inf)
         det = detection(plant, dataclasses.replace(self.est, t_q=t_q, t_nx=t_nx))
-        return _with_test(det, self.test, self.window, self.det.min_window)
+        return _with_test(det, self.test, self.window, self.det.min_window)._replace(
+            settle=self.det.settle)
 
 
 def builtin_design(name: str, est: EstimatorConfig) -> DesignConfig:
@@ -158,10 +159,11 @@ def build_design(name: str, dc: DesignConfig, plant: LinearPlant, est: Estimator
     window = int(round(dc.window_s / plant.dt)) if test == TEST_GLR else 1
     min_window = (1 if test != TEST_GLR or dc.min_change_s is None
                   else int(round(dc.min_change_s / plant.dt)))
-    det = _with_test(detection(plant, s), test, window, min_window)
+    det = _with_test(detection(plant, s), test, window, min_window)._replace(
+        settle=int(round(dc.settle_s / plant.dt)))
     key = (dc.estimator, dc.design_turbulence if dc.estimator == "gust_aware" else None,
            dc.prediction, s.sigma_qx, s.sigma_qb, tuple(sorted(dc.state_noise.items())),
-           test, window, min_window)
+           test, window, min_window, dc.settle_s)
     return Design(name=name, est=s, fm=fm, det=det, P0=_c(P0), test=test, window=window,
                   key=key)
 
