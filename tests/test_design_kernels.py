@@ -81,6 +81,31 @@ def measurements(scheme, st, work, rng, scale):
         work.z[:, l] = -mu0 + scale[l] * np.sqrt(np.diag(S)) * rng.standard_normal(12)
 
 
+def compare_steps(scheme, st, rng, scales, k0, n, tol_res=1e-11):
+    """Steps ``k0 .. k0 + len(scales) - 1`` of the filter stage against
+    ``naive.filter_update_ref`` from the same state, the measurements' innovations
+    ``scales[i]`` standard deviations per lane; returns the blocks fired."""
+    fired = set()
+    for k, scale in enumerate(scales, start=k0):
+        work = new_trial_work(L, n)
+        work.u[:] = 0.05 * rng.standard_normal((3, L))
+        measurements(scheme, st, work, rng, scale)
+        xa, P, res, block, rmax, ebuf, ecount, last_k, last_block = naive.filter_update_ref(
+            scheme, st, work.u, work.z, k)
+        stages.filter_update(scheme, st, k, work)
+        assert np.array_equal(work.block, block), k
+        assert_lanes(work.res, res, tol_res, "statistics")
+        assert rel(st.rmax, rmax) <= tol_res
+        assert np.array_equal(st.ecount, ecount)
+        assert np.array_equal(st.last_k, last_k) and np.array_equal(st.last_block, last_block)
+        for l in range(L):
+            assert rel(st.xa[:, l], xa[:, l]) <= 1e-9, (k, l)
+            assert rel(st.P[:, :, l], P[:, :, l]) <= 1e-9, (k, l)
+            assert np.array_equal(st.P[:, :, l], st.P[:, :, l].T)
+        fired.update(block.tolist())
+    return fired
+
+
 @pytest.mark.parametrize("test", ["one_step", "glr"])
 def test_gust_filter_update(linear_gusts, test):
     """The gust-aware filter stage (predict, residuals, Table 1, reset, update,
@@ -92,25 +117,8 @@ def test_gust_filter_update(linear_gusts, test):
                          t_nx=3.0, settle=4 if test == "glr" else 0)
     rng = np.random.default_rng(61)
     scale = np.array([0.3, 0.3, 1.0, 3.0, 10.0, 30.0, 100.0])
-    fired = set()
     st = with_gust_states(random_lanes(linear_gusts, rng, 10), rng, d, P0, W)
-    for k in range(10, 16):
-        work = new_trial_work(L, N)
-        work.u[:] = 0.05 * rng.standard_normal((3, L))
-        measurements(scheme, st, work, rng, scale if k % 2 else scale[::-1])
-        xa, P, res, block, rmax, ebuf, ecount, last_k, last_block = naive.filter_update_ref(
-            scheme, st, work.u, work.z, k)
-        stages.filter_update(scheme, st, k, work)
-        assert np.array_equal(work.block, block), k
-        assert_lanes(work.res, res, 1e-11, "statistics")
-        assert rel(st.rmax, rmax) <= 1e-11
-        assert np.array_equal(st.ecount, ecount)
-        assert np.array_equal(st.last_k, last_k) and np.array_equal(st.last_block, last_block)
-        for l in range(L):
-            assert rel(st.xa[:, l], xa[:, l]) <= 1e-9, (k, l)
-            assert rel(st.P[:, :, l], P[:, :, l]) <= 1e-9, (k, l)
-            assert np.array_equal(st.P[:, :, l], st.P[:, :, l].T)
-        fired.update(block.tolist())
+    fired = compare_steps(scheme, st, rng, [scale[::-1], scale] * 3, 10, N)
     assert fired == {0, RESET_THRUST, RESET_ELEVONS}
 
 
@@ -123,21 +131,7 @@ def test_paper_filter_with_glr():
     scale = np.array([0.3, 0.6, 1.0, 1.5, 2.0, 3.0, 10.0])
     st = random_lanes(setup, rng, 10)._replace(ebuf=np.zeros((5, 3, L)),
                                                 ecount=np.zeros(L, dtype=np.int64))
-    fired = set()
-    for k in range(10, 22):
-        work = new_trial_work(L, N_AUG)
-        work.u[:] = 0.05 * rng.standard_normal((3, L))
-        measurements(scheme, st, work, rng, scale)
-        xa, P, res, block, rmax, ebuf, ecount, last_k, last_block = naive.filter_update_ref(
-            scheme, st, work.u, work.z, k)
-        stages.filter_update(scheme, st, k, work)
-        assert np.array_equal(work.block, block), k
-        assert_lanes(work.res, res, 1e-11, "GLR statistics")
-        assert np.array_equal(st.ecount, ecount)
-        for l in range(L):
-            assert rel(st.xa[:, l], xa[:, l]) <= 1e-9, (k, l)
-        fired.update(block.tolist())
-    assert len(fired) > 1
+    assert len(compare_steps(scheme, st, rng, [scale] * 12, 10, N_AUG)) > 1
 
 
 def test_settle_withholds_the_other_block():
@@ -270,21 +264,7 @@ def test_extended_filter_update(nonlinear_gusts, test):
     rng = np.random.default_rng(64)
     scale = np.array([0.3, 0.5, 1.0, 2.0, 3.0, 5.0, 10.0])  # the airframe stays flyable
     st = with_gust_states(random_lanes(nonlinear_gusts, rng, 10), rng, d, P0, W)
-    fired = set()
-    for k in range(10, 14):
-        work = new_trial_work(L, N)
-        work.u[:] = 0.05 * rng.standard_normal((3, L))
-        measurements(scheme, st, work, rng, scale)
-        xa, P, res, block, rmax, ebuf, ecount, last_k, last_block = naive.filter_update_ref(
-            scheme, st, work.u, work.z, k)
-        stages.filter_update(scheme, st, k, work)
-        assert np.array_equal(work.block, block), k
-        assert_lanes(work.res, res, 1e-9, "statistics")
-        for l in range(L):
-            assert rel(st.xa[:, l], xa[:, l]) <= 1e-9, (k, l)
-            assert rel(st.P[:, :, l], P[:, :, l]) <= 1e-9, (k, l)
-        fired.update(block.tolist())
-    assert len(fired) > 1
+    assert len(compare_steps(scheme, st, rng, [scale] * 4, 10, N, tol_res=1e-9)) > 1
 
 
 def test_extended_equals_linear_small_signal(nonlinear_gusts):
