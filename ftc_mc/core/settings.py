@@ -90,8 +90,8 @@ TrialInputs = namedtuple("TrialInputs", [
     "b1",         # (E, 3, L) truth b1 per actuator from each switch on
     "mode_pre",   # (L,) int64 mode whose box holds the initial truth
     "mode_post",  # (L,) int64 mode whose box holds the final truth
-    "xa0",        # (14, L) initial augmented estimate
-    "P0",         # (14, 14) initial covariance (shared)
+    "xa0",        # (n, L) initial augmented estimate (n = 14 + the design's extra states)
+    "P0",         # (n, n) initial covariance (shared)
     "w",          # (n_steps, 9, L) process noise, already scaled
     "v",          # (n_steps, 12, L) measurement noise, already scaled
     "eta",        # (n_steps, 4, L) standard normal gust draws, or (0, 4, L) without
@@ -116,10 +116,10 @@ TrialRecord = namedtuple("TrialRecord", [
     "status",       # (L,) int64 0 when the trial ran to its end, else a
                     #      trial.STATUS_* reason
     "stop_k",       # (L,) int64 step at which an invalid trial stopped, or -1
-    "xa_end",       # (14, L) final augmented estimate
+    "xa_end",       # (14, L) final augmented estimate (its first 14 states)
     "controller",   # (n_periods, L) int64 controller in use after each period
     "hist_x",       # (n_hist, 9, L) true state after each step (n_hist 0: none kept)
-    "hist_xa",      # (n_hist, 14, L) augmented estimate after each step
+    "hist_xa",      # (n_hist, 14, L) augmented estimate after each step (first 14)
     "hist_pdiag",   # (n_hist, 5, L) variances of the fault parameters
     "hist_u",       # (n_hist, 3, L) commands applied during each step
     "hist_res",     # (n_hist, 3, L) residuals r_q, r_nx, r_nz
@@ -173,8 +173,8 @@ Flight = namedtuple("Flight", [
 
 LaneState = namedtuple("LaneState", [
     "x",        # (9, L) true plant state (deviation from trim)
-    "xa",       # (14, L) augmented estimate
-    "P",        # (14, 14, L) covariance
+    "xa",       # (n, L) augmented estimate [x, b, g] (n = 14 for the paper's filter)
+    "P",        # (n, n, L) covariance
     "d_start",  # (L,) int64 step the running doublet started at (or far past)
     "s_start",  # (L,) int64 step the running 3211 started at (or far past)
     "recheck",  # (L,) int64 step of the pending doublet re-check, or -1

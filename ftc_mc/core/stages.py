@@ -407,7 +407,8 @@ def reconfigure(scheme, timing, inp, st, kn, period, work, rec):
 
     Per lane: the belief update (eqs. 13-14) with the fault-parameter estimate
     and its marginal variances (eq. 12); for the reconfiguring scheme
-    (``reconfig.kind != 0``) the controller selection (eqs. 45-47), for every
+    (``reconfig.kind != 0``) the controller selection (eqs. 45-47) on the
+    estimate's first 14 states (a design's gust states are left out), for every
     lane at once (:func:`ftc_mc.core.control.select_controllers_lanes`, per
     lane bit-identical to :func:`~ftc_mc.core.control.select_controller`; the
     horizon predictions run lane-interleaved, about 4x faster than one lane at
