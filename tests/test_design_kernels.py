@@ -22,12 +22,11 @@ import numpy as np
 import pytest
 
 import naive
-from test_stages import (L, X_SCALE, _setup, assert_lanes, copy_nt, new_rec, random_cov,
-                         random_inputs, random_lanes, rel)
+from test_stages import (L, X_SCALE, _setup, assert_lanes, assert_loop_matches, copy_nt,
+                         random_cov, random_inputs, random_lanes, rel)
 from ftc_mc.conventions import N_AUG, N_X, RESET_ELEVONS, RESET_THRUST, TEST_GLR
-from ftc_mc.core import stages, trial
+from ftc_mc.core import stages
 from ftc_mc.core.glr import glr_lanes, glr_restart
-from ftc_mc.core.settings import LaneState, TrialRecord
 from ftc_mc.core.workspace import new_trial_work
 from ftc_mc.model.turbulence import dryden_model
 from ftc_mc.model.wind import plant_wind_matrices
@@ -190,19 +189,7 @@ def test_gust_glr_whole_loop(linear_gusts):
     xa0 = np.zeros((N, L))
     xa0[:N_X] = 0.1 * X_SCALE[:, None] * rng.standard_normal((N_X, L))
     inp = inp._replace(xa0=xa0, P0=P0, g0=d.P0_chol @ rng.standard_normal((4, L)))
-    rec = new_rec(flight.timing, max_resets=16)
-    st = trial.new_state(L, N, 6)
-    trial.init_state(inp, st, rec)
-    rec_n, st_n = naive.advance_ref(scheme, flight, inp, copy_nt(rec), copy_nt(st), 0, 25)
-    trial.advance(scheme, flight, inp, rec, st, 0, 25)
-    for f in TrialRecord._fields:
-        a, b = getattr(rec, f), getattr(rec_n, f)
-        if a.dtype.kind in "iub":
-            assert np.array_equal(a, b), f
-        else:
-            assert rel(a, b) <= 1e-9, (f, rel(a, b))
-    for f in LaneState._fields:
-        assert rel(getattr(st, f), getattr(st_n, f)) <= 1e-9, f
+    rec = assert_loop_matches(scheme, flight, inp, 25, 1e-9)
     assert rec.n_resets.sum() > 0
 
 
