@@ -134,7 +134,16 @@ def random_lanes(setup, rng, k, L=L):
                      zhold=rng.standard_normal(L), ebuf=np.zeros((1, 3, L)),
                      ecount=np.zeros(L, dtype=np.int64),
                      last_k=k - rng.integers(1, 40, L).astype(np.int64),
-                     last_block=rng.integers(0, 3, L).astype(np.int64))
+                     last_block=rng.integers(0, 3, L).astype(np.int64),
+                     **trim_jacobians(fm, L))
+
+
+def trim_jacobians(fm, L=L):
+    """The per-lane Jacobians of a :class:`LaneState` at trim (``trial.init_jacobians``)."""
+    def lanes(M):
+        return np.ascontiguousarray(np.repeat(np.asarray(M)[:, :, None], L, axis=2))
+    return dict(JA=lanes(fm.A), JB=lanes(fm.B), JW=lanes(fm.Bw), JC=lanes(fm.C),
+                JHW=lanes(fm.Dw))
 
 
 def copy_nt(nt):
