@@ -157,7 +157,9 @@ def filter_update(scheme, st, k, work):
         Reads ``filter`` and ``detection``.
     st : LaneState
         ``xa``, ``P`` advanced in place; ``rmax`` updated; the GLR window
-        ``ebuf``, ``ecount``.
+        ``ebuf``, ``ecount``; the extended filter's Jacobians ``JA`` .. ``JHW``
+        (re-computed about the estimate every ``filter.relin`` steps, read
+        while ``relin > 0``).
     k : int
         Step (the GLR window's ring position).
     work : TrialWork
