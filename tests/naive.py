@@ -96,6 +96,7 @@ class RefModel:
     Cg: np.ndarray | None = None
     n_sub: int = 2
     dt: float = 0.1
+    relin: int = 0
 
     @property
     def ng(self) -> int:
@@ -198,6 +199,71 @@ def predicted_outputs(X, model):
     if model.nl:
         return x8_outputs_ref(model.x0 + X[:N_X], model.p, gust_wind(X, model)) - model.y0
     return aug(model, np.zeros(3))[2] @ X
+
+
+def jacobians_ref(X, u, model):
+    """Forward finite differences of the extended filter's one-period map
+    ``x_{k+1} = rk4(x0 + x, u0 + e, C_d g)`` and of the outputs
+    ``h(x0 + x, C_d g)`` at the estimate ``X`` with the command ``u``
+    (``core/gustfilter.relinearise_lanes``): steps ``1e-6 max(1, |x0_i + x_i|)``
+    in the states, ``1e-6`` in the effects and the wind, each divided by the
+    step actually represented.  Returns ``JA, JB, JW, JC, JHW``."""
+    b0, b1 = X[N_X:N_X + 2], X[N_X + 2:N_AUG]
+    cmd = model.u0 + u + np.array([b0[0], b0[1] / 2, b0[1] / 2]) - b1 * (u + model.u0)
+    xs = model.x0 + X[:N_X]
+    w = gust_wind(X, model)
+
+    def f(x, c, wind):
+        return rk4_ref(x, c, model.p, wind, model.dt, model.n_sub)
+
+    def h(x, wind):
+        return x8_outputs_ref(x, model.p, wind)
+
+    fb, yb = f(xs, cmd, w), h(xs, w)
+    JA, JB, JW = np.zeros((N_X, N_X)), np.zeros((N_X, 3)), np.zeros((N_X, 3))
+    JC, JHW = np.zeros((len(yb), N_X)), np.zeros((len(yb), 3))
+    for j in range(N_X):
+        xp = xs.copy()
+        xp[j] = xs[j] + 1e-6 * max(1.0, abs(xs[j]))
+        d = xp[j] - xs[j]
+        JA[:, j] = (f(xp, cmd, w) - fb) / d
+        JC[:, j] = (h(xp, w) - yb) / d
+    for j in range(3):
+        cp = cmd.copy()
+        cp[j] = cmd[j] + 1e-6
+        JB[:, j] = (f(xs, cp, w) - fb) / (cp[j] - cmd[j])
+        wp = w.copy()
+        wp[j] = w[j] + 1e-6
+        JW[:, j] = (f(xs, cmd, wp) - fb) / (wp[j] - w[j])
+        JHW[:, j] = (h(xs, wp) - yb) / (wp[j] - w[j])
+    return JA, JB, JW, JC, JHW
+
+
+JACOBIANS = ("JA", "JB", "JW", "JC", "JHW")
+"""The per-lane Jacobian fields of a ``LaneState``."""
+
+
+def lane_jacobians_ref(scheme, st, u, k):
+    """Every lane's Jacobians after step ``k``'s re-linearisation: recomputed about
+    ``st.xa`` (:func:`jacobians_ref`) when ``relin > 0`` divides ``k``, else
+    ``st``'s.  Returns a dict ``name -> (.., L)`` array."""
+    model = ref_of(scheme)
+    out = {f: np.array(getattr(st, f), copy=True) for f in JACOBIANS}
+    if model.relin > 0 and k % model.relin == 0:
+        for l in range(st.xa.shape[1]):
+            for f, J in zip(JACOBIANS, jacobians_ref(st.xa[:, l], u[:, l], model)):
+                out[f][:, :, l] = J
+    return out
+
+
+def relinearised(model, jac, l):
+    """``model`` with lane ``l``'s Jacobians: ``A = JA``, ``B = JB`` (so
+    ``Phi(u)`` is built from it), ``G = JW C_d``, ``C = JC``, ``D_g = JHW C_d``."""
+    if model.relin == 0:
+        return model
+    J = {f: jac[f][:, :, l] for f in JACOBIANS}
+    gust = {} if not model.ng else dict(G=J["JW"] @ model.Cg, Dg=J["JHW"] @ model.Cg)
+    return dataclasses.replace(model, A=J["JA"], B=J["JB"], C=J["JC"], **gust)
 
 
 def innovation_ref(X, P, z, model):
@@ -547,7 +613,8 @@ def ref_of(scheme):
                     test=("one_step", "glr")[det.test], window=int(det.window),
                     min_window=int(det.min_window), settle=int(det.settle),
                     nl=int(fm.nl), p=fm.p, x0=fm.x0, y0=fm.y0,
-                    Cg=fm.Cg if gust else None, n_sub=int(fm.n_sub), dt=float(fm.dt))
+                    Cg=fm.Cg if gust else None, n_sub=int(fm.n_sub), dt=float(fm.dt),
+                    relin=int(fm.relin))
 
 
 def horizon_cost_ref(c, X, P, scheme):
@@ -703,13 +770,17 @@ def sensor_fault_ref(z, v, zhold, k, dt, out, kind, size, k_onset):
     return z, zhold
 
 
-def filter_update_ref(scheme, st, u, z, k=0):
+def filter_update_ref(scheme, st, u, z, k=0, relinearised_already=False):
     """Every lane's filter step (:func:`filter_step_ref`) and the running maxima
     of the decision statistics of ``r_q``, ``r_nx``; with the GLR test the
     window (``st.ebuf`` row ``k % W``, ``st.ecount``) takes this step's
-    innovations and a reset empties it.  Returns ``xa, P, res, block, rmax,
-    ebuf, ecount``."""
+    innovations and a reset empties it.  With ``relin > 0`` each lane's step
+    uses its Jacobians (:func:`lane_jacobians_ref`, or ``st``'s as they are
+    with ``relinearised_already``).  Returns ``xa, P, res, block, rmax,
+    ebuf, ecount, last_k, last_block``."""
     model = ref_of(scheme)
+    jac = ({f: getattr(st, f) for f in JACOBIANS} if relinearised_already
+           else lane_jacobians_ref(scheme, st, u, k))
     L = st.xa.shape[1]
     xa, P = st.xa.copy(), st.P.copy()
     ebuf, ecount = st.ebuf.copy(), st.ecount.copy()
@@ -729,7 +800,8 @@ def filter_update_ref(scheme, st, u, z, k=0):
                 recent = k - last_k[l] < model.settle
                 return 0 if (b and last_block[l] and b != last_block[l] and recent) else b
         xa[:, l], P[:, :, l], block[l], res[:, l], _ = filter_step_ref(
-            st.xa[:, l], st.P[:, :, l], u[:, l], z[:, l], model, stat, gate)
+            st.xa[:, l], st.P[:, :, l], u[:, l], z[:, l], relinearised(model, jac, l), stat,
+            gate)
         if model.test == "glr" and block[l]:
             ecount[l] = 0
         if model.settle > 0 and block[l]:
@@ -847,8 +919,10 @@ def advance_ref(scheme, flight, inp, rec, st, k0, k1):
         u, exc = commands_ref(scheme, st, k)
         tr = truth_step_ref(scheme, flight, inp, k, st, u)
         st.x[:], st.gust[:], st.zhold[:] = tr["x"], tr["gust"], tr["zhold"]
+        for f, J in lane_jacobians_ref(scheme, st, u, k).items():
+            getattr(st, f)[:] = J
         xa, P, res, block, rmax, ebuf, ecount, last_k, last_block = filter_update_ref(
-            scheme, st, u, tr["z"], k)
+            scheme, st, u, tr["z"], k, relinearised_already=True)
         st.xa[:], st.P[:], st.rmax[:] = xa, P, rmax
         st.ebuf[:], st.ecount[:] = ebuf, ecount
         st.last_k[:], st.last_block[:] = last_k, last_block

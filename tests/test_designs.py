@@ -58,6 +58,10 @@ def test_designs_validate_and_run_in_order():
      "designs.x.window_s: must be a positive multiple of model.dt_s"),
     ({"designs": {"x": {"test": "glr", "window_s": 60.0}}},
      "designs.x.window_s: must not exceed timing.duration_s"),
+    ({"designs": {"x": {"prediction": "nonlinear", "relinearise_s": 0.15}}},
+     "designs.x.relinearise_s: must be a positive multiple of model.dt_s"),
+    ({"designs": {"x": {"relinearise_s": 1.0}}},
+     "designs.x.relinearise_s: only with prediction: nonlinear"),
     ({"campaign": {"designs": ["nope"]}, "designs": {"x": {}}},
      "campaign.designs: unknown design 'nope'; designs defined: x"),
     ({"campaign": {"designs": ["nope"]}}, "designs defined: none"),
@@ -173,6 +177,9 @@ def test_gust_aware_glr_design():
     np.testing.assert_allclose(d.fm.Dg, Dw @ dm.Cd)
     np.testing.assert_allclose(d.fm.Ad, dm.Ad)
     np.testing.assert_allclose(d.fm.Qg, dm.Bd @ dm.Bd.T)
+    np.testing.assert_array_equal(d.fm.Bw, Bw)
+    np.testing.assert_array_equal(d.fm.Dw, Dw)
+    assert d.fm.relin == 0 and p.fm.relin == 0 and not p.fm.Bw.any() and not p.fm.Dw.any()
     for f in ("A", "B", "Bb0", "C", "q_diag", "r_diag", "lo", "hi"):
         np.testing.assert_array_equal(getattr(d.fm, f), getattr(p.fm, f))
     assert d.P0.shape == (18, 18) and d.n_aug == 18
@@ -188,6 +195,20 @@ def test_gust_aware_glr_design():
     assert (det.t_q, det.t_nx, det.test, det.window) == (10.0, 12.0, TEST_GLR, 10)
     assert np.isinf(setup.detection("gust_glr", np.inf, np.inf).t_q)
     assert d.key != p.key
+
+
+def test_relinearise_design():
+    """``relinearise_s`` of an extended design: ``FilterModel.relin`` in steps and a
+    key of its own; the same design without it re-linearises never."""
+    from ftc_mc.sim.setup import build_setup
+
+    ext = {**GUST_GLR, "prediction": "nonlinear"}
+    cfg = config(designs={"ext": ext, "relin": {**ext, "relinearise_s": 1.0}},
+                 campaign={"designs": ["ext", "relin"], "trials": 3})
+    setup = build_setup(cfg)
+    e, r = setup.designs["ext"], setup.designs["relin"]
+    assert e.fm.relin == 0 and e.fm.nl == 1
+    assert r.fm.relin == round(1.0 / setup.plant.dt) and r.key != e.key
 
 
 def test_sigma_overrides_change_the_filter_only():

@@ -134,7 +134,16 @@ def random_lanes(setup, rng, k, L=L):
                      zhold=rng.standard_normal(L), ebuf=np.zeros((1, 3, L)),
                      ecount=np.zeros(L, dtype=np.int64),
                      last_k=k - rng.integers(1, 40, L).astype(np.int64),
-                     last_block=rng.integers(0, 3, L).astype(np.int64))
+                     last_block=rng.integers(0, 3, L).astype(np.int64),
+                     **trim_jacobians(fm, L))
+
+
+def trim_jacobians(fm, L=L):
+    """The per-lane Jacobians of a :class:`LaneState` at trim (``trial.init_jacobians``)."""
+    def lanes(M):
+        return np.ascontiguousarray(np.repeat(np.asarray(M)[:, :, None], L, axis=2))
+    return dict(JA=lanes(fm.A), JB=lanes(fm.B), JW=lanes(fm.Bw), JC=lanes(fm.C),
+                JHW=lanes(fm.Dw))
 
 
 def copy_nt(nt):
@@ -587,17 +596,18 @@ def test_advance_matches_the_chained_twins(fixture, request):
     xa0[:N_X] = 0.1 * X_SCALE[:, None] * rng.standard_normal((N_X, L))
     g0 = np.zeros((4, L)) if setup.gust is None else rng.standard_normal((4, L))
     inp = inp._replace(xa0=xa0, g0=g0)
-    rec = assert_loop_matches(scheme, flight, inp, 25, 1e-11)
+    rec, _ = assert_loop_matches(scheme, flight, inp, 25, 1e-11)
     assert rec.n_resets.sum() > 0 and np.any(rec.hist_exc[:, 2:])
 
 
 def assert_loop_matches(scheme, flight, inp, n_steps, tol):
     """``trial.advance`` over ``n_steps`` against ``naive.advance_ref`` from the
     same initial state: discrete record fields exactly, continuous ones and the
-    final lane state to ``tol``.  Returns the kernel's record."""
+    final lane state to ``tol``.  Returns the kernel's record and state."""
     rec = new_rec(flight.timing, max_resets=16)
     st = trial.new_state(L, inp.xa0.shape[0], scheme.detection.window)
     trial.init_state(inp, st, rec)
+    trial.init_jacobians(scheme.filter, st)
     rec_n, st_n = naive.advance_ref(scheme, flight, inp, copy_nt(rec), copy_nt(st), 0,
                                     n_steps)
     trial.advance(scheme, flight, inp, rec, st, 0, n_steps)
@@ -609,4 +619,4 @@ def assert_loop_matches(scheme, flight, inp, n_steps, tol):
             assert rel(a, b) <= tol, (f, rel(a, b))
     for f in LaneState._fields:
         assert rel(getattr(st, f), getattr(st_n, f)) <= tol, f
-    return rec
+    return rec, st

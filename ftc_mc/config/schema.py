@@ -420,6 +420,8 @@ class DesignConfig(_Strict):
     """Filter random-walk density of the fault parameters; null: estimator.sigma_qb."""
     state_noise: dict[Literal[STATE_NAMES], NonNeg] = Field(default_factory=dict)
     """Extra filter process-noise standard deviation per step on named plant states (u, w [m/s], q [rad/s], ...): an allowance for the airframe model's error; {} adds none."""
+    relinearise_s: Pos | None = None
+    """prediction: nonlinear only: every this many seconds [s], the covariance's Jacobians are re-computed about the lane's estimate (a multiple of model.dt_s); null: the Jacobians at trim."""
 
 
 def _design_names(designs: dict) -> dict:
@@ -452,7 +454,13 @@ def _check_designs(cfg, listed, where: str, duration: tuple) -> None:
                                     if d.test == "glr" and d.min_change_s is not None])
     _check_periods(cfg.model.dt_s, [(f"designs.{n}.settle_s", d.settle_s)
                                     for n, d in cfg.designs.items() if d.settle_s > 0])
+    _check_periods(cfg.model.dt_s, [(f"designs.{n}.relinearise_s", d.relinearise_s)
+                                    for n, d in cfg.designs.items()
+                                    if d.relinearise_s is not None])
     for n, d in cfg.designs.items():
+        if d.relinearise_s is not None and d.prediction != "nonlinear":
+            raise ValueError(f"designs.{n}.relinearise_s: only with prediction: nonlinear "
+                             f"(got prediction: {d.prediction})")
         if d.test == "glr" and d.min_change_s is not None and d.min_change_s > d.window_s:
             raise ValueError(f"designs.{n}.min_change_s: must not exceed window_s "
                              f"({d.window_s:g} s), got {d.min_change_s:g}")

@@ -50,6 +50,129 @@ def _c_row(fm, r, crow):
         crow[N_AUG + g] = fm.Dg[r, g]
 
 
+FD_X = 1e-6
+"""Relative step of the finite differences in the states: ``1e-6 max(1, |x0_i + x_i|)``."""
+FD_E = 1e-6
+"""Step of the finite differences in the actuator effects [throttle, rad]."""
+FD_W = 1e-6
+"""Step of the finite differences in the wind [m/s, rad/s]."""
+
+
+@kernel
+def _c_rows_lanes(fm, st, r, cl):
+    """Row ``r`` of every lane's re-linearised ``C_aug = [JC, 0, JHW C_d]`` into
+    ``cl`` (n, L)."""
+    n = cl.shape[0]
+    L = cl.shape[1]
+    for j in range(N_X):
+        for l in range(L):
+            cl[j, l] = st.JC[r, j, l]
+    for j in range(N_X, N_AUG):
+        for l in range(L):
+            cl[j, l] = 0.0
+    for g in range(n - N_AUG):
+        for l in range(L):
+            acc = 0.0
+            for w in range(N_WIND):
+                acc += st.JHW[r, w, l] * fm.Cg[w, g]
+            cl[N_AUG + g, l] = acc
+
+
+@kernel
+def relinearise_lanes(xa, u, fm, st, tw):
+    """Every lane's Jacobians about its estimate ``X_{k|k}`` by forward finite
+    differences (issue 13 item 2).
+
+    The one-period map ``x_{k+1} = f(x0 + x, u0 + e, w)`` (:func:`_nl_state`: RK4
+    over ``fm.dt`` with ``fm.n_sub`` steps, effect ``e`` of eq. 2 under the
+    estimated faults, wind ``w = C_d g`` held) and the outputs ``h(x0 + x, w)``,
+    differentiated at the lane's estimate: in ``x_i`` with the step
+    ``FD_X max(1, |x0_i + x_i|)`` (the step actually represented, ``(x + s) - x``,
+    divides), in the effects with ``FD_E``, in the wind with ``FD_W``.  Writes
+    ``st.JA`` (9, 9, L), ``JB`` (9, 3, L), ``JW`` (9, 3, L), ``JC`` (12, 9, L),
+    ``JHW`` (12, 3, L); uses the one-lane buffers of ``tw``.
+    """
+    ng = xa.shape[0] - N_AUG
+    xabs = tw.xabs
+    cmd = tw.cmd
+    wl = tw.wl
+    y = tw.y
+    xs = np.empty(N_X)
+    c0 = np.empty(N_U)
+    w0 = np.empty(N_WIND)
+    fb = np.empty(N_X)
+    yb = np.empty(N_Z)
+    for l in range(xa.shape[1]):
+        for i in range(N_X):
+            xs[i] = fm.x0[i] + xa[i, l]
+        b0t = xa[N_X, l]
+        b0e = 0.5 * xa[N_X + 1, l]
+        for j in range(N_U):
+            bias = b0t if j == 0 else b0e
+            c0[j] = fm.u0[j] + u[j, l] + bias - xa[N_X + N_B0 + j, l] * (u[j, l] + fm.u0[j])
+        for i in range(N_WIND):
+            acc = 0.0
+            for g in range(ng):
+                acc += fm.Cg[i, g] * xa[N_AUG + g, l]
+            w0[i] = acc
+        # the point itself
+        for i in range(N_X):
+            xabs[i] = xs[i]
+        for j in range(N_U):
+            cmd[j] = c0[j]
+        for i in range(N_WIND):
+            wl[i] = w0[i]
+        propagate(xabs, cmd, fm.p, wl, fm.dt, fm.n_sub, tw.rk4)
+        for i in range(N_X):
+            fb[i] = xabs[i]
+        outputs_nb(xs, fm.p, w0, yb)
+        # states
+        for j in range(N_X):
+            for i in range(N_X):
+                xabs[i] = xs[i]
+            xabs[j] = xs[j] + FD_X * max(1.0, abs(xs[j]))
+            dx = xabs[j] - xs[j]
+            outputs_nb(xabs, fm.p, w0, y)
+            for r in range(N_Z):
+                st.JC[r, j, l] = (y[r] - yb[r]) / dx
+            for j2 in range(N_U):
+                cmd[j2] = c0[j2]
+            for i in range(N_WIND):
+                wl[i] = w0[i]
+            propagate(xabs, cmd, fm.p, wl, fm.dt, fm.n_sub, tw.rk4)
+            for i in range(N_X):
+                st.JA[i, j, l] = (xabs[i] - fb[i]) / dx
+        # effects
+        for j in range(N_U):
+            for i in range(N_X):
+                xabs[i] = xs[i]
+            for j2 in range(N_U):
+                cmd[j2] = c0[j2]
+            for i in range(N_WIND):
+                wl[i] = w0[i]
+            cmd[j] = c0[j] + FD_E
+            de = cmd[j] - c0[j]
+            propagate(xabs, cmd, fm.p, wl, fm.dt, fm.n_sub, tw.rk4)
+            for i in range(N_X):
+                st.JB[i, j, l] = (xabs[i] - fb[i]) / de
+        # wind
+        for j in range(N_WIND):
+            for i in range(N_X):
+                xabs[i] = xs[i]
+            for j2 in range(N_U):
+                cmd[j2] = c0[j2]
+            for i in range(N_WIND):
+                wl[i] = w0[i]
+            wl[j] = w0[j] + FD_W
+            dw = wl[j] - w0[j]
+            outputs_nb(xabs, fm.p, wl, y)
+            for r in range(N_Z):
+                st.JHW[r, j, l] = (y[r] - yb[r]) / dw
+            propagate(xabs, cmd, fm.p, wl, fm.dt, fm.n_sub, tw.rk4)
+            for i in range(N_X):
+                st.JW[i, j, l] = (xabs[i] - fb[i]) / dw
+
+
 @kernel
 def _nl_state(xa, u, fm, xn, tw):
     """The extended filter's state prediction: ``x_{k+1|k} = f(x0 + x, u0 + e, C_d g) - x0``.
@@ -109,7 +232,7 @@ def _nl_outputs(xa, fm, hpred, xp, tw):
 
 
 @kernel
-def _gpredict(xa, P, Pn, u, fm, phi, T, xn, tw):
+def _gpredict(xa, P, Pn, u, fm, phi, T, xn, tw, st):
     """Time update of every lane: ``X <- F X + B_aug u``, ``Pn <- F P F^T + Q``.
 
     ``F = [[A, Phi(u), G], [0, I, 0], [0, 0, A_d]]`` and ``Q`` block-diagonal
@@ -118,17 +241,37 @@ def _gpredict(xa, P, Pn, u, fm, phi, T, xn, tw):
     ``phi`` (9, 5, L) holds ``Phi(u)`` on return; ``T`` (n, n, L) and ``xn``
     (n, L) are work arrays.  With ``fm.nl`` the plant states are predicted by
     the nonlinear airframe (:func:`_nl_state`); the covariance keeps the
-    Jacobians at trim (``A``, ``Phi``, ``G``).
+    Jacobians at trim (``A``, ``Phi``, ``G``), or with ``fm.relin > 0`` takes
+    each lane's (``st.JA``; ``Phi`` from ``st.JB``:
+    ``[JB_0, (JB_1 + JB_2) / 2, -JB diag(u + u0)]``; ``G = st.JW C_d`` into
+    ``tw.jg``).
     """
     n = xa.shape[0]
     L = xa.shape[1]
     ng = n - N_AUG
-    for i in range(N_X):
-        for l in range(L):
-            phi[i, 0, l] = fm.Bb0[i, 0]
-            phi[i, 1, l] = fm.Bb0[i, 1]
-            for j in range(N_U):
-                phi[i, N_B0 + j, l] = -fm.B[i, j] * (u[j, l] + fm.u0[j])
+    relin = fm.relin > 0
+    if relin:
+        JB = st.JB
+        jg = tw.jg
+        for i in range(N_X):
+            for l in range(L):
+                phi[i, 0, l] = JB[i, 0, l]
+                phi[i, 1, l] = 0.5 * (JB[i, 1, l] + JB[i, 2, l])
+                for j in range(N_U):
+                    phi[i, N_B0 + j, l] = -JB[i, j, l] * (u[j, l] + fm.u0[j])
+            for g in range(ng):
+                for l in range(L):
+                    acc = 0.0
+                    for w in range(N_WIND):
+                        acc += st.JW[i, w, l] * fm.Cg[w, g]
+                    jg[i, g, l] = acc
+    else:
+        for i in range(N_X):
+            for l in range(L):
+                phi[i, 0, l] = fm.Bb0[i, 0]
+                phi[i, 1, l] = fm.Bb0[i, 1]
+                for j in range(N_U):
+                    phi[i, N_B0 + j, l] = -fm.B[i, j] * (u[j, l] + fm.u0[j])
     # state
     for i in range(N_X):
         for l in range(L):
@@ -157,17 +300,32 @@ def _gpredict(xa, P, Pn, u, fm, phi, T, xn, tw):
         for l in range(L):
             xa[N_AUG + a, l] = xn[N_AUG + a, l]
     # T = F P
-    for i in range(N_X):
-        for c in range(n):
-            for l in range(L):
-                acc = 0.0
-                for j in range(N_X):
-                    acc += fm.A[i, j] * P[j, c, l]
-                for j in range(N_F):
-                    acc += phi[i, j, l] * P[N_X + j, c, l]
-                for g in range(ng):
-                    acc += fm.G[i, g] * P[N_AUG + g, c, l]
-                T[i, c, l] = acc
+    if relin:
+        JA = st.JA
+        jg = tw.jg
+        for i in range(N_X):
+            for c in range(n):
+                for l in range(L):
+                    acc = 0.0
+                    for j in range(N_X):
+                        acc += JA[i, j, l] * P[j, c, l]
+                    for j in range(N_F):
+                        acc += phi[i, j, l] * P[N_X + j, c, l]
+                    for g in range(ng):
+                        acc += jg[i, g, l] * P[N_AUG + g, c, l]
+                    T[i, c, l] = acc
+    else:
+        for i in range(N_X):
+            for c in range(n):
+                for l in range(L):
+                    acc = 0.0
+                    for j in range(N_X):
+                        acc += fm.A[i, j] * P[j, c, l]
+                    for j in range(N_F):
+                        acc += phi[i, j, l] * P[N_X + j, c, l]
+                    for g in range(ng):
+                        acc += fm.G[i, g] * P[N_AUG + g, c, l]
+                    T[i, c, l] = acc
     for i in range(N_X, N_AUG):
         for c in range(n):
             for l in range(L):
@@ -182,7 +340,17 @@ def _gpredict(xa, P, Pn, u, fm, phi, T, xn, tw):
     # Pn = T F^T (upper triangle), + Q, mirrored
     for i in range(n):
         for k in range(i, n):
-            if k < N_X:
+            if k < N_X and relin:
+                for l in range(L):
+                    acc = 0.0
+                    for j in range(N_X):
+                        acc += T[i, j, l] * st.JA[k, j, l]
+                    for j in range(N_F):
+                        acc += T[i, N_X + j, l] * phi[k, j, l]
+                    for g in range(ng):
+                        acc += T[i, N_AUG + g, l] * tw.jg[k, g, l]
+                    Pn[i, k, l] = acc
+            elif k < N_X:
                 for l in range(L):
                     acc = 0.0
                     for j in range(N_X):
@@ -217,17 +385,35 @@ def _gpredict(xa, P, Pn, u, fm, phi, T, xn, tw):
 
 
 @kernel
-def gust_residuals_lanes(xa, P, z, fm, crow, hpred, res, innov):
+def gust_residuals_lanes(xa, P, z, fm, crow, hpred, res, innov, st, cl):
     """Normalised residuals ``r_q, r_nx, r_nz`` (eqs. 9-11) with the gust columns
     of ``C_aug``: ``r_i = mu_i^2 / (c_i P c_i^T + R_ii)``, ``mu_i = z_i - c_i X``.
 
     ``P`` is the full symmetric prediction; ``crow`` (n,) is work; with
     ``fm.nl`` the predicted output is ``hpred`` (12, L) instead of ``c_i X``;
     ``res`` and ``innov`` (3, L) are written with ``r_i`` and
-    ``mu_i / sqrt(S_ii)``.
+    ``mu_i / sqrt(S_ii)``.  With ``fm.relin > 0`` the rows are each lane's
+    (:func:`_c_rows_lanes` of ``st`` into ``cl`` (n, L)).
     """
     n = xa.shape[0]
     L = xa.shape[1]
+    if fm.relin > 0:
+        for o in range(len(RESIDUAL_OUTPUTS)):
+            r = RESIDUAL_OUTPUTS[o]
+            _c_rows_lanes(fm, st, r, cl)
+            rr = fm.r_diag[r]
+            for l in range(L):
+                s = 0.0
+                for j in range(n):
+                    acc = 0.0
+                    for k in range(n):
+                        acc += P[j, k, l] * cl[k, l]
+                    s += cl[j, l] * acc
+                mu = z[r, l] - hpred[r, l]
+                s = s + rr
+                res[o, l] = mu * mu / s
+                innov[o, l] = mu / np.sqrt(s)
+        return
     for o in range(len(RESIDUAL_OUTPUTS)):
         r = RESIDUAL_OUTPUTS[o]
         _c_row(fm, r, crow)
@@ -250,14 +436,45 @@ def gust_residuals_lanes(xa, P, z, fm, crow, hpred, res, innov):
 
 
 @kernel
-def _gupdate(xa, P, z, fm, crow, h, v, gs, hpred, xp):
+def _gupdate(xa, P, z, fm, crow, h, v, gs, hpred, xp, st, cl):
     """Sequential scalar updates with the 12 outputs in order, on the upper
     triangle of ``P`` (mirrored by the caller): ``h = P c^T``, ``s = c h + R``,
     ``X += h (z - c X) / s``, ``P -= (h / s) h^T``; with ``fm.nl`` the
     predicted output is ``hpred_r + c (X - xp)`` (linearised about the
-    prediction ``xp``)."""
+    prediction ``xp``); with ``fm.relin > 0`` each lane's rows (``cl``, as in
+    :func:`gust_residuals_lanes`)."""
     n = xa.shape[0]
     L = xa.shape[1]
+    if fm.relin > 0:
+        for r in range(z.shape[0]):
+            _c_rows_lanes(fm, st, r, cl)
+            rr = fm.r_diag[r]
+            for a in range(n):
+                for l in range(L):
+                    acc = 0.0
+                    for j in range(n):
+                        if j < a:
+                            acc += P[j, a, l] * cl[j, l]
+                        else:
+                            acc += P[a, j, l] * cl[j, l]
+                    h[a, l] = acc
+            for l in range(L):
+                pred = hpred[r, l]
+                sv = rr
+                for j in range(n):
+                    pred += cl[j, l] * (xa[j, l] - xp[j, l])
+                    sv += cl[j, l] * h[j, l]
+                gs[0, l] = (z[r, l] - pred) / sv
+                gs[1, l] = 1.0 / sv
+            for a in range(n):
+                for l in range(L):
+                    xa[a, l] += h[a, l] * gs[0, l]
+                    v[a, l] = h[a, l] * gs[1, l]
+            for a in range(n):
+                for b in range(a, n):
+                    for l in range(L):
+                        P[a, b, l] -= v[a, l] * h[b, l]
+        return
     for r in range(z.shape[0]):
         _c_row(fm, r, crow)
         rr = fm.r_diag[r]
@@ -296,7 +513,7 @@ def _gupdate(xa, P, z, fm, crow, h, v, gs, hpred, xp):
 
 
 @kernel
-def gust_predict_lanes(xa, P, fm, tw):
+def gust_predict_lanes(xa, P, fm, tw, st, k):
     """First half of a general filter step: predict into ``tw.fwork[:n]`` and the
     residuals; ``X_{k|k}`` is kept in ``tw.fwork`` for a re-prediction.
 
@@ -313,8 +530,14 @@ def gust_predict_lanes(xa, P, fm, tw):
         Reads ``u`` (commands of the step) and ``z`` (measurements ``z_{k+1}``);
         writes ``res``, ``innov`` (3, L); work ``phi``, ``T`` (n, n, L),
         ``fwork`` (rows ``n + 3`` .. ``n + 5``: prediction scratch, predicted
-        outputs, the prediction; row ``n + 13``: ``X_{k|k}``), ``crow`` and the
-        one-lane buffers of the nonlinear airframe.
+        outputs, the prediction; row ``n + 13``: ``X_{k|k}``), ``crow``, ``jg``,
+        ``jc`` and the one-lane buffers of the nonlinear airframe.
+    st : LaneState
+        The lanes' Jacobians ``JA`` .. ``JHW`` (read with ``fm.relin > 0``,
+        re-computed first when ``k`` is a multiple of it,
+        :func:`relinearise_lanes`).
+    k : int
+        Step.
     """
     n = xa.shape[0]
     work = tw.fwork
@@ -322,18 +545,22 @@ def gust_predict_lanes(xa, P, fm, tw):
     for i in range(n):
         for l in range(xa.shape[1]):
             x_prev[i, l] = xa[i, l]
-    _gpredict(xa, P, work[0:n], tw.u, fm, tw.phi, tw.T, work[n + 3], tw)
+    if fm.relin > 0 and k % fm.relin == 0:
+        relinearise_lanes(xa, tw.u, fm, st, tw)
+    _gpredict(xa, P, work[0:n], tw.u, fm, tw.phi, tw.T, work[n + 3], tw, st)
     if fm.nl != 0:
         _nl_outputs(xa, fm, work[n + 4], work[n + 5], tw)
-    gust_residuals_lanes(xa, work[0:n], tw.z, fm, tw.crow, work[n + 4], tw.res, tw.innov)
+    gust_residuals_lanes(xa, work[0:n], tw.z, fm, tw.crow, work[n + 4], tw.res, tw.innov,
+                         st, tw.jc)
 
 
 @kernel
-def gust_correct_lanes(xa, P, fm, det, tw):
+def gust_correct_lanes(xa, P, fm, det, tw, st):
     """Second half, once ``tw.block`` is decided: reset the block of ``P_{k|k}``
     (section 3.2.2) of every lane that resets and predict all lanes again from
     ``X_{k|k}`` (identical for the others), update, projection (eqs. 6-8).
-    Parameters as :func:`gust_predict_lanes`; ``P`` gets ``P_{k+1|k+1}``."""
+    Parameters as :func:`gust_predict_lanes` (the Jacobians of ``st`` as they
+    left it); ``P`` gets ``P_{k+1|k+1}``."""
     n = xa.shape[0]
     L = xa.shape[1]
     work = tw.fwork
@@ -349,11 +576,11 @@ def gust_correct_lanes(xa, P, fm, det, tw):
         for i in range(n):
             for l in range(L):
                 xa[i, l] = x_prev[i, l]
-        _gpredict(xa, P, Pn, tw.u, fm, tw.phi, tw.T, work[n + 3], tw)
+        _gpredict(xa, P, Pn, tw.u, fm, tw.phi, tw.T, work[n + 3], tw, st)
         if fm.nl != 0:
             _nl_outputs(xa, fm, work[n + 4], work[n + 5], tw)
     _gupdate(xa, Pn, tw.z, fm, tw.crow, work[n], work[n + 1], work[n + 2], work[n + 4],
-             work[n + 5])
+             work[n + 5], st, tw.jc)
     for i in range(n):
         for k in range(i, n):
             for l in range(L):

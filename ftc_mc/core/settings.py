@@ -31,6 +31,11 @@ FilterModel = namedtuple("FilterModel", [
     "Cg",       # (3, ng) gust states -> u_g, w_g [m/s], q_g [rad/s] (C_d)
     "n_sub",    # RK4 sub-steps of the nonlinear prediction per period
     "dt",       # control period [s]
+    "Bw",       # (9, 3)  trim wind Jacobian of the discrete state map (G = Bw Cg); zeros
+                #         for the paper's filter
+    "Dw",       # (12, 3) trim wind Jacobian of the outputs (Dg = Dw Cg); zeros likewise
+    "relin",    # steps between re-linearisations of the extended filter's covariance
+                #    about each lane's estimate (LaneState.JA ..); 0: the trim Jacobians
 ])
 """The augmented Kalman filter's model (paper eqs. 4-6).
 
@@ -188,6 +193,13 @@ LaneState = namedtuple("LaneState", [
     "ecount",   # (L,) int64 innovations in the window since the start or last reset
     "last_k",   # (L,) int64 step of the last reset (Detection.settle), or far past
     "last_block",  # (L,) int64 block of the last reset, or 0
+    # the extended filter's Jacobians about the lane's estimate (FilterModel.relin > 0;
+    # the trim matrices otherwise, never read)
+    "JA",       # (9, 9, L)  d x_{k+1} / d x_k of the one-period airframe map
+    "JB",       # (9, 3, L)  d x_{k+1} / d e (actuator effects)
+    "JW",       # (9, 3, L)  d x_{k+1} / d wind (u_g, w_g [m/s], q_g [rad/s])
+    "JC",       # (12, 9, L) d h / d x of the outputs
+    "JHW",      # (12, 3, L) d h / d wind
 ])
 """Everything a trial carries from one step to the next (core/trial.py)."""
 

@@ -157,7 +157,9 @@ def filter_update(scheme, st, k, work):
         Reads ``filter`` and ``detection``.
     st : LaneState
         ``xa``, ``P`` advanced in place; ``rmax`` updated; the GLR window
-        ``ebuf``, ``ecount``.
+        ``ebuf``, ``ecount``; the extended filter's Jacobians ``JA`` .. ``JHW``
+        (re-computed about the estimate every ``filter.relin`` steps, read
+        while ``relin > 0``).
     k : int
         Step (the GLR window's ring position).
     work : TrialWork
@@ -173,7 +175,7 @@ def filter_update(scheme, st, k, work):
         filter_predict_lanes(st.xa, st.P, work.u, work.z, fm, work.phi, work.T, work.fwork,
                              res, work.innov)
     else:
-        gust_predict_lanes(st.xa, st.P, fm, work)
+        gust_predict_lanes(st.xa, st.P, fm, work, st, k)
     if det.test == TEST_GLR:
         glr_lanes(work.innov, st.ebuf, st.ecount, k, det.min_window, res)
     signature_lanes(res, det, work.block)
@@ -183,7 +185,7 @@ def filter_update(scheme, st, k, work):
         filter_correct_lanes(st.xa, st.P, work.u, work.z, fm, det, work.phi, work.T,
                              work.fwork, work.block)
     else:
-        gust_correct_lanes(st.xa, st.P, fm, det, work)
+        gust_correct_lanes(st.xa, st.P, fm, det, work, st)
     if det.test == TEST_GLR:
         glr_restart(work.block, st.ecount)
     if det.settle > 0:

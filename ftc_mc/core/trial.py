@@ -29,10 +29,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..conventions import (N_AUG, N_MODES, N_X, STATUS_AIRSPEED,  # noqa: F401
+from ..conventions import (N_AUG, N_MODES, N_U, N_X, N_Z, STATUS_AIRSPEED,  # noqa: F401
                            STATUS_ALPHA, STATUS_NAMES, STATUS_NONFINITE,
                            STATUS_NOT_PSD, STATUS_OK, C_NOMINAL, RESIDUAL_OUTPUTS)
 from .dryden import N_GUST_STATE
+from .gustfilter import N_WIND
 from .jit import kernel
 from .plant import truth_step
 from .settings import LaneState
@@ -141,7 +142,31 @@ def new_state(L, n, window):
                      zhold=np.zeros(L), ebuf=np.zeros((window, len(RESIDUAL_OUTPUTS), L)),
                      ecount=np.zeros(L, dtype=np.int64),
                      last_k=np.zeros(L, dtype=np.int64),
-                     last_block=np.zeros(L, dtype=np.int64))
+                     last_block=np.zeros(L, dtype=np.int64),
+                     JA=np.zeros((N_X, N_X, L)), JB=np.zeros((N_X, N_U, L)),
+                     JW=np.zeros((N_X, N_WIND, L)), JC=np.zeros((N_Z, N_X, L)),
+                     JHW=np.zeros((N_Z, N_WIND, L)))
+
+
+@kernel
+def init_jacobians(fm, st):
+    """Every lane's Jacobians (``st.JA``, ``JB``, ``JW``, ``JC``, ``JHW``) at trim:
+    ``fm.A``, ``fm.B``, ``fm.Bw``, ``fm.C``, ``fm.Dw``.  The extended filter with
+    ``fm.relin > 0`` replaces them at its first step (``k = 0``); otherwise they
+    are never read."""
+    for l in range(st.JA.shape[2]):
+        for i in range(N_X):
+            for j in range(N_X):
+                st.JA[i, j, l] = fm.A[i, j]
+            for j in range(N_U):
+                st.JB[i, j, l] = fm.B[i, j]
+            for j in range(N_WIND):
+                st.JW[i, j, l] = fm.Bw[i, j]
+        for r in range(N_Z):
+            for j in range(N_X):
+                st.JC[r, j, l] = fm.C[r, j]
+            for j in range(N_WIND):
+                st.JHW[r, j, l] = fm.Dw[r, j]
 
 
 @kernel
@@ -153,4 +178,5 @@ def run_trials(scheme, flight, inp, rec):
     """
     st = new_state(inp.w.shape[2], inp.xa0.shape[0], scheme.detection.window)
     init_state(inp, st, rec)
+    init_jacobians(scheme.filter, st)
     advance(scheme, flight, inp, rec, st, 0, flight.timing.n_steps)

@@ -91,6 +91,8 @@ TrialWork = namedtuple("TrialWork", [
     "xsel",       # (N_AUG, L) the paper's part of a gust-aware estimate (selection)
     "Psel",       # (N_AUG, N_AUG, L) its covariance
     "finite",     # (L,) bool: the lane's estimate, variances and air data are finite
+    "jg",         # (N_X, n - N_AUG, L) a re-linearised extended filter's G = JW C_d
+    "jc",         # (n, L) a row of its C_aug per lane, [JC_r, 0, JHW_r C_d]
     # one lane at a time
     "xl",         # (n,) a lane's estimate
     "Pl",         # (n, n) a lane's covariance
@@ -150,6 +152,7 @@ def new_trial_work(L, n):
         block=np.zeros(L, dtype=np.int64), innov=np.zeros((N_RES, L)),
         xsel=np.zeros((N_AUG, L)), Psel=np.zeros((N_AUG, N_AUG, L)),
         finite=np.zeros(L, dtype=np.bool_),
+        jg=np.zeros((N_X, max(n - N_AUG, 0), L)), jc=np.zeros((n, L)),
         xl=np.zeros(n), Pl=np.zeros((n, n)), Ul=np.zeros(N_U), chol=np.zeros((n, n)),
         crow=np.zeros(n),
         gust=np.zeros(N_GUST_STATE), eta=np.zeros(N_GUST_NOISE), wl=np.zeros(N_GUST_OUT),

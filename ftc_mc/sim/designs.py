@@ -17,7 +17,9 @@ evolve as ``g+ = A_d g`` with process noise ``Q_g = B_d B_d^T`` of the design's
 turbulence level.  Its gust states start at 0 with the stationary Dryden
 covariance.  ``prediction: nonlinear`` makes it an extended filter: the airframe's
 equations predict the plant states and the outputs
-(:mod:`ftc_mc.core.gustfilter`), with or without gust states.
+(:mod:`ftc_mc.core.gustfilter`), with or without gust states; its covariance
+takes the Jacobians at trim, or with ``relinearise_s`` those about each lane's
+estimate, re-computed every ``relinearise_s`` seconds (``FilterModel.relin``).
 
 A design changes only what the filter assumes: the truth noise of every trial
 comes from the config's ``estimator`` and ``noise`` sections, so all designs fly
@@ -150,11 +152,13 @@ def build_design(name: str, dc: DesignConfig, plant: LinearPlant, est: Estimator
         dm = dryden_model(dc.design_turbulence, V=plant.trim.V0, altitude_m=altitude_m,
                           dt=plant.dt)
         fm = fm._replace(G=_c(Bw @ dm.Cd), Ad=_c(dm.Ad), Dg=_c(Dw @ dm.Cd),
-                         Qg=_c(dm.Bd @ dm.Bd.T))
+                         Qg=_c(dm.Bd @ dm.Bd.T), Bw=_c(Bw), Dw=_c(Dw))
         P0 = scipy.linalg.block_diag(P0, dm.P0)
         fm = fm._replace(Cg=_c(dm.Cd))
     if dc.prediction == "nonlinear":
         fm = fm._replace(nl=1)
+        if dc.relinearise_s is not None:  # Jacobians about each lane's estimate
+            fm = fm._replace(relin=int(round(dc.relinearise_s / plant.dt)))
     test = TEST_NAMES.index(dc.test)
     window = int(round(dc.window_s / plant.dt)) if test == TEST_GLR else 1
     min_window = (1 if test != TEST_GLR or dc.min_change_s is None
@@ -163,7 +167,7 @@ def build_design(name: str, dc: DesignConfig, plant: LinearPlant, est: Estimator
         settle=int(round(dc.settle_s / plant.dt)))
     key = (dc.estimator, dc.design_turbulence if dc.estimator == "gust_aware" else None,
            dc.prediction, s.sigma_qx, s.sigma_qb, tuple(sorted(dc.state_noise.items())),
-           test, window, min_window, dc.settle_s)
+           test, window, min_window, dc.settle_s, fm.relin)
     return Design(name=name, est=s, fm=fm, det=det, P0=_c(P0), test=test, window=window,
                   key=key)
 

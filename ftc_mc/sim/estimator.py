@@ -131,7 +131,9 @@ def filter_model(plant: LinearPlant, s: EstimatorSettings) -> FilterModel:
                  else np.ascontiguousarray(plant.trim.params, dtype=np.float64)),
         x0=np.ascontiguousarray(plant.trim.x0, dtype=np.float64),
         y0=np.ascontiguousarray(plant.trim.y0, dtype=np.float64), Cg=np.zeros((3, 0)),
-        n_sub=10, dt=float(plant.dt))
+        n_sub=10, dt=float(plant.dt),
+        # no wind Jacobians (a gust-aware design sets them) and no re-linearisation
+        Bw=np.zeros((n, 3)), Dw=np.zeros((C.shape[0], 3)), relin=0)
 
 
 def detection(plant: LinearPlant, s: EstimatorSettings) -> Detection:

@@ -26,7 +26,7 @@ import math
 import numpy as np
 
 from ..core.settings import TrialInputs, TrialRecord
-from ..core.trial import advance, init_state, new_state, run_trials
+from ..core.trial import advance, init_jacobians, init_state, new_state, run_trials
 from .inputs import design_inputs
 
 HISTORY_RESETS = 100_000
@@ -130,6 +130,7 @@ def _shared_start(setup, name: str, inp: TrialInputs, max_resets: int, k_share: 
     no_resets = setup.detection(name, math.inf, math.inf)
     st0 = new_state(L, dinp.xa0.shape[0], no_resets.window)
     init_state(dinp, st0, rec0)
+    init_jacobians(setup.designs[name].fm, st0)
     advance(setup.scheme(name, no_resets), setup.flight, dinp, rec0, st0, 0, k_share)
     return rec0, st0
 
