@@ -123,7 +123,7 @@ def bench_numpy(ref, P0, U, Z):
     def go():
         X, P = np.zeros(14), P0.copy()
         for k in range(U.shape[0]):
-            X, P, _, _ = naive.filter_step_ref(X, P, U[k], Z[k], ref)
+            X, P, *_ = naive.filter_step_ref(X, P, U[k], Z[k], ref)
     return best_rate(go, U.shape[0], repeats=2)
 
 
