@@ -59,6 +59,29 @@ FD_W = 1e-6
 
 
 @kernel
+def _lane_point(xa, u, fm, l, xabs, cmd, wind):
+    """Lane ``l``'s operating point for the airframe's equations: the absolute
+    state ``x0 + x``, the absolute commands under the estimated faults (eq. 2
+    with ``b_hat``: ``u0 + u + [b0_T, b0_e / 2, b0_e / 2] - b1 (u + u0)``, the
+    terms ``B_b0 b0`` and ``Phi(u) b1`` of eq. 4) and the estimated gust
+    ``C_d g``; ``u`` may be ``None`` for the state and wind only."""
+    ng = xa.shape[0] - N_AUG
+    for i in range(N_X):
+        xabs[i] = fm.x0[i] + xa[i, l]
+    if u is not None:
+        b0t = xa[N_X, l]
+        b0e = 0.5 * xa[N_X + 1, l]
+        for j in range(N_U):
+            bias = b0t if j == 0 else b0e
+            cmd[j] = fm.u0[j] + u[j, l] + bias - xa[N_X + N_B0 + j, l] * (u[j, l] + fm.u0[j])
+    for i in range(N_WIND):
+        acc = 0.0
+        for g in range(ng):
+            acc += fm.Cg[i, g] * xa[N_AUG + g, l]
+        wind[i] = acc
+
+
+@kernel
 def _c_rows_lanes(fm, st, r, cl):
     """Row ``r`` of every lane's re-linearised ``C_aug = [JC, 0, JHW C_d]`` into
     ``cl`` (n, L)."""
@@ -92,7 +115,6 @@ def relinearise_lanes(xa, u, fm, st, tw):
     ``st.JA`` (9, 9, L), ``JB`` (9, 3, L), ``JW`` (9, 3, L), ``JC`` (12, 9, L),
     ``JHW`` (12, 3, L); uses the one-lane buffers of ``tw``.
     """
-    ng = xa.shape[0] - N_AUG
     xabs = tw.xabs
     cmd = tw.cmd
     wl = tw.wl
@@ -103,18 +125,7 @@ def relinearise_lanes(xa, u, fm, st, tw):
     fb = np.empty(N_X)
     yb = np.empty(N_Z)
     for l in range(xa.shape[1]):
-        for i in range(N_X):
-            xs[i] = fm.x0[i] + xa[i, l]
-        b0t = xa[N_X, l]
-        b0e = 0.5 * xa[N_X + 1, l]
-        for j in range(N_U):
-            bias = b0t if j == 0 else b0e
-            c0[j] = fm.u0[j] + u[j, l] + bias - xa[N_X + N_B0 + j, l] * (u[j, l] + fm.u0[j])
-        for i in range(N_WIND):
-            acc = 0.0
-            for g in range(ng):
-                acc += fm.Cg[i, g] * xa[N_AUG + g, l]
-            w0[i] = acc
+        _lane_point(xa, u, fm, l, xs, c0, w0)
         # the point itself
         for i in range(N_X):
             xabs[i] = xs[i]
@@ -184,23 +195,11 @@ def _nl_state(xa, u, fm, xn, tw):
     and ``Phi(u) b1`` of eq. 4) and the estimated gust ``C_d g`` held over the
     period.  Writes ``xn[:9]`` (deviation from trim); one-lane buffers of ``tw``.
     """
-    ng = xa.shape[0] - N_AUG
     xabs = tw.xabs
     cmd = tw.cmd
     wl = tw.wl
     for l in range(xa.shape[1]):
-        for i in range(N_X):
-            xabs[i] = fm.x0[i] + xa[i, l]
-        b0t = xa[N_X, l]
-        b0e = 0.5 * xa[N_X + 1, l]
-        for j in range(N_U):
-            bias = b0t if j == 0 else b0e
-            cmd[j] = fm.u0[j] + u[j, l] + bias - xa[N_X + N_B0 + j, l] * (u[j, l] + fm.u0[j])
-        for i in range(N_WIND):
-            acc = 0.0
-            for g in range(ng):
-                acc += fm.Cg[i, g] * xa[N_AUG + g, l]
-            wl[i] = acc
+        _lane_point(xa, u, fm, l, xabs, cmd, wl)
         propagate(xabs, cmd, fm.p, wl, fm.dt, fm.n_sub, tw.rk4)
         for i in range(N_X):
             xn[i, l] = xabs[i] - fm.x0[i]
@@ -212,20 +211,13 @@ def _nl_outputs(xa, fm, hpred, xp, tw):
     ``hpred[:12]`` and the prediction itself into ``xp`` (the update linearises
     about it: ``z_r - hpred_r - c_r (X - xp)``)."""
     n = xa.shape[0]
-    ng = n - N_AUG
     xabs = tw.xabs
     wl = tw.wl
     y = tw.y
     for l in range(xa.shape[1]):
         for i in range(n):
             xp[i, l] = xa[i, l]
-        for i in range(N_X):
-            xabs[i] = fm.x0[i] + xa[i, l]
-        for i in range(N_WIND):
-            acc = 0.0
-            for g in range(ng):
-                acc += fm.Cg[i, g] * xa[N_AUG + g, l]
-            wl[i] = acc
+        _lane_point(xa, None, fm, l, xabs, tw.cmd, wl)
         outputs_nb(xabs, fm.p, wl, y)
         for r in range(N_Z):
             hpred[r, l] = y[r] - fm.y0[r]
