@@ -64,6 +64,8 @@ I_B1_RIGHT = N_X + PARAM_NAMES.index("b1_right")
 RESIDUAL_NAMES = ("r_q", "r_nx", "r_nz")
 """Normalised residuals of eqs. 9-11, on the outputs :data:`RESIDUAL_OUTPUTS`."""
 RESIDUAL_OUTPUTS = (OUT_Q, OUT_NX, OUT_NZ)
+BIASED_OUTPUTS = tuple(OUTPUT_NAMES[o] for o in RESIDUAL_OUTPUTS)
+"""Outputs whose sensor bias a sensor-aware design may estimate (issue 14)."""
 
 NO_RESET = 0
 RESET_THRUST = 1

@@ -97,6 +97,8 @@ class RefModel:
     n_sub: int = 2
     dt: float = 0.1
     relin: int = 0
+    Dz: np.ndarray | None = None
+    reset_g: np.ndarray | None = None
 
     @property
     def ng(self) -> int:
@@ -195,9 +197,12 @@ def gust_wind(X, model):
 
 
 def predicted_outputs(X, model):
-    """``C_aug X``, or with the extended filter ``h(x0 + x, C_d g) - y0``."""
+    """``C_aug X``, or with the extended filter ``h(x0 + x, C_d g) - y0 + D_z g``
+    (``D_z``: the output biases of a sensor-aware design)."""
     if model.nl:
-        return x8_outputs_ref(model.x0 + X[:N_X], model.p, gust_wind(X, model)) - model.y0
+        bias = model.Dz @ X[N_AUG:] if model.Dz is not None else 0.0
+        return (x8_outputs_ref(model.x0 + X[:N_X], model.p, gust_wind(X, model)) - model.y0
+                + bias)
     return aug(model, np.zeros(3))[2] @ X
 
 
@@ -258,11 +263,13 @@ def lane_jacobians_ref(scheme, st, u, k):
 
 def relinearised(model, jac, l):
     """``model`` with lane ``l``'s Jacobians: ``A = JA``, ``B = JB`` (so
-    ``Phi(u)`` is built from it), ``G = JW C_d``, ``C = JC``, ``D_g = JHW C_d``."""
+    ``Phi(u)`` is built from it), ``G = JW C_d``, ``C = JC``,
+    ``D_g = JHW C_d + D_z``."""
     if model.relin == 0:
         return model
     J = {f: jac[f][:, :, l] for f in JACOBIANS}
-    gust = {} if not model.ng else dict(G=J["JW"] @ model.Cg, Dg=J["JHW"] @ model.Cg)
+    gust = {} if not model.ng else dict(G=J["JW"] @ model.Cg,
+                                        Dg=J["JHW"] @ model.Cg + model.Dz)
     return dataclasses.replace(model, A=J["JA"], B=J["JB"], C=J["JC"], **gust)
 
 
@@ -312,6 +319,21 @@ def reset_ref(P, block, reset_var):
         P[i, :] = 0.0
         P[:, i] = 0.0
         P[i, i] = reset_var[i - N_X]
+    return P
+
+
+def reset_extra_ref(P, block, reset_g):
+    """The extra states that go with a reset block (a sensor-aware design's
+    output biases, issue 14): each ``g`` with ``reset_g[block, g] > 0`` gets its
+    row and column zeroed and that variance."""
+    P = np.array(P, dtype=float, copy=True)
+    if reset_g is None or not block:
+        return P
+    for g in np.flatnonzero(reset_g[block] > 0):
+        i = N_AUG + g
+        P[i, :] = 0.0
+        P[:, i] = 0.0
+        P[i, i] = reset_g[block, g]
     return P
 
 
@@ -390,7 +412,8 @@ def filter_step_ref(X, P, u, z, model, stat=None, gate=None):
     if gate is not None:
         block = gate(block)
     if block:
-        Xp, Pp = predict_ref(X, reset_ref(P, block, model.reset_var), u, model)
+        P0 = reset_extra_ref(reset_ref(P, block, model.reset_var), block, model.reset_g)
+        Xp, Pp = predict_ref(X, P0, u, model)
     X, P = update_ref(Xp, Pp, z, model)
     X, _ = project_ref(X, model.lo, model.hi)
     return X, P, block, res, e
@@ -614,7 +637,8 @@ def ref_of(scheme):
                     min_window=int(det.min_window), settle=int(det.settle),
                     nl=int(fm.nl), p=fm.p, x0=fm.x0, y0=fm.y0,
                     Cg=fm.Cg if gust else None, n_sub=int(fm.n_sub), dt=float(fm.dt),
-                    relin=int(fm.relin))
+                    relin=int(fm.relin), Dz=fm.Dz if gust else None,
+                    reset_g=fm.reset_g if gust else None)
 
 
 def horizon_cost_ref(c, X, P, scheme):

@@ -43,7 +43,8 @@ def gust_filter(setup, level="moderate"):
     Bw, Dw = plant_wind_matrices(p)
     fm = setup.fm._replace(G=np.ascontiguousarray(Bw @ d.Cd), Ad=np.ascontiguousarray(d.Ad),
                            Dg=np.ascontiguousarray(Dw @ d.Cd),
-                           Qg=np.ascontiguousarray(d.Bd @ d.Bd.T))
+                           Qg=np.ascontiguousarray(d.Bd @ d.Bd.T), Dz=np.zeros((12, NG)),
+                           reset_g=np.zeros((3, NG)))
     P0 = np.zeros((N, N))
     P0[:N_AUG, :N_AUG] = setup.P0
     P0[N_AUG:, N_AUG:] = d.P0

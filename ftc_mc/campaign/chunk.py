@@ -287,7 +287,12 @@ def classify_sensor(spec: ChunkSpec, tr_name: str, variant: str, trial_ids, size
       ``k_f`` after some update (``controller_switch_s``);
     * ``first_action_s``: the earliest of the three;
     * ``envelope_exit``: the aircraft left the airspeed or angle-of-attack
-      envelope (the trial stopped there).
+      envelope (the trial stopped there);
+    * ``sensor_bias_hat_end``: the design's estimate of the faulty output's bias
+      at the end (NaN when the design does not estimate it, issue 14);
+    * ``isolated``: a bias fault the design names: the trial flew to the end,
+      the estimated bias is within :data:`ISOLATION_TOLERANCE` of the true one,
+      and the belief's most probable mode at the last update is nominal.
 
     The actuator-row columns keep their definitions with the correct block
     ``none``: ``correct`` is True for no reset in the window, ``inappropriate``
@@ -365,7 +370,29 @@ def classify_sensor(spec: ChunkSpec, tr_name: str, variant: str, trial_ids, size
         "first_action_s": first_action,
         "envelope_exit": (rec.status == STATUS_AIRSPEED) | (rec.status == STATUS_ALPHA),
     }
+    trials.update(_isolation(setup.designs[variant], tr, sizes, rec))
     return trials, resets
+
+
+ISOLATION_TOLERANCE = 0.25
+"""Largest relative error of the estimated bias of an isolated sensor fault: the
+filter then carries at most a quarter of the bias as a wrong state or fault
+parameter (issue 14)."""
+
+
+def _isolation(design, tr, sizes, rec: TrialRecord) -> dict:
+    """``sensor_bias_hat_end`` and ``isolated`` of a sensor transition's lanes
+    (:func:`classify_sensor`)."""
+    L = rec.xa_end.shape[1]
+    row = design.bias_row(tr.output)
+    if row is None or row >= rec.xa_end.shape[0]:
+        return {"sensor_bias_hat_end": np.full(L, np.nan), "isolated": np.zeros(L, dtype=bool)}
+    hat = rec.xa_end[row].copy()
+    size = np.asarray(sizes, dtype=float)
+    nominal_end = np.argmax(rec.belief[-1], axis=0) == MODE_NOMINAL
+    close = np.abs(hat - size) <= ISOLATION_TOLERANCE * np.abs(size)
+    return {"sensor_bias_hat_end": hat,
+            "isolated": (tr.kind == "bias") & (rec.status == 0) & close & nominal_end}
 
 
 def count_flights(rec: TrialRecord) -> dict:

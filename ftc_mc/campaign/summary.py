@@ -127,7 +127,9 @@ def sensor_row(name: str, variant: str, g: pd.DataFrame) -> dict:
 
     Over the judged trials (no numerical failure, every reset stored): the rates
     of :data:`SENSOR_RATES` with Wilson intervals, and the median / p95 time
-    from the sensor fault to each first action and to the first of any.
+    from the sensor fault to each first action and to the first of any; for a
+    bias on an output the design estimates, the ``isolated`` rate
+    (:func:`ftc_mc.campaign.chunk.classify_sensor`).
     """
     tr = transition_of(name)
     ok = g[g["judged"].astype(bool)]
@@ -150,6 +152,9 @@ def sensor_row(name: str, variant: str, g: pd.DataFrame) -> dict:
         row.update(_quantiles(key, ok[f"{key}_s"].to_numpy(dtype=float)))
     row.update(_quantiles("first_action", ok["first_action_s"].to_numpy(dtype=float)))
     row["false_resets"] = int(ok["false_resets"].sum())
+    if (tr.kind == "bias" and "sensor_bias_hat_end" in ok
+            and ok["sensor_bias_hat_end"].notna().any()):  # the design estimates it
+        row.update(_rate("isolated", int(ok["isolated"].astype(bool).sum()), n))
     return row
 
 
@@ -160,7 +165,9 @@ def sensor_markdown_table(summary: pd.DataFrame, intervals: bool = True) -> str:
     actuator-block reset, a wrong mode (an actuator fault most probable with
     >= 0.5), a controller switch, any of them, and an envelope exit (95 % Wilson
     intervals when ``intervals``), and the median time from the fault to the first
-    action.  Empty string without sensor rows.
+    action; with a design estimating sensor biases, the share of bias faults it
+    isolates (``-`` where it does not estimate that bias).  Empty string without
+    sensor rows.
     """
     if "transition" not in summary or not summary["transition"].map(is_sensor).any():
         return ""
@@ -184,6 +191,8 @@ def sensor_markdown_table(summary: pd.DataFrame, intervals: bool = True) -> str:
             "envelope exit %": pct("envelope_exit"),
             "1st action med [s]": "-" if not np.isfinite(med) else f"{med:.1f}",
         })
+        if "isolated_rate" in summary:
+            rows[-1]["isolated %"] = pct("isolated")
     return pd.DataFrame(rows).to_markdown(index=False)
 
 
@@ -197,7 +206,10 @@ def actuator_rows(summary: pd.DataFrame) -> pd.DataFrame:
     with their counts as integers again (a run mixing both kinds has NaN there)."""
     if "transition" not in summary or not summary["transition"].map(is_sensor).any():
         return summary
-    sub = summary[~summary["transition"].map(is_sensor)].dropna(axis=1, how="all")
+    sensor = summary["transition"].map(is_sensor)
+    act = summary[~sensor]
+    only = [c for c in summary if act[c].isna().all() and summary.loc[sensor, c].notna().any()]
+    sub = act.drop(columns=only)
     return sub.astype({c: "int64" for c in _COUNTS if c in sub})
 
 

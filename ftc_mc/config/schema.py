@@ -17,8 +17,9 @@ from typing import Annotated, Literal
 from pydantic import (AfterValidator, BaseModel, BeforeValidator, ConfigDict, Field,
                       field_validator, model_validator)
 
-from ..conventions import (ACTUATOR_NAMES, OUTPUT_NAMES, PLANT_KINDS, SENSOR_FAULT_KINDS,
-                           SENSOR_PREFIX, STATE_NAMES, TRANSITIONS, TURBULENCE_LEVELS)
+from ..conventions import (ACTUATOR_NAMES, BIASED_OUTPUTS, OUTPUT_NAMES, PLANT_KINDS,
+                           SENSOR_FAULT_KINDS, SENSOR_PREFIX, STATE_NAMES, TRANSITIONS,
+                           TURBULENCE_LEVELS)
 from ..errors import UserError
 from ..model.source import (DEFAULT_AIRFRAME, check_airframe, check_condition,
                             is_linear_model)
@@ -422,6 +423,22 @@ class DesignConfig(_Strict):
     """Extra filter process-noise standard deviation per step on named plant states (u, w [m/s], q [rad/s], ...): an allowance for the airframe model's error; {} adds none."""
     relinearise_s: Pos | None = None
     """prediction: nonlinear only: every this many seconds [s], the covariance's Jacobians are re-computed about the lane's estimate (a multiple of model.dt_s); null: the Jacobians at trim."""
+    sensor_biases: list[Literal[BIASED_OUTPUTS]] = Field(default_factory=list)
+    """Outputs whose sensor bias the filter estimates (issue 14; q, n_x, n_z: the residuals' sensors): a bias opens, like a fault block, when Table 1 resets the block sharing its residual (n_x with thrust; q and n_z with elevons); [] estimates none."""
+    sensor_bias_sd: dict[Literal[BIASED_OUTPUTS], Pos] = Field(default_factory=dict)
+    """Standard deviation a bias takes when its hypothesis opens, per output [rad/s, g]; outputs left out take the largest bias of a typical small-UAV sensor (q 5 deg/s, n_x and n_z 80 mg: the upper ends of sensor_draws' defaults)."""
+    sensor_bias_walk: dict[Literal[BIASED_OUTPUTS], NonNeg] = Field(default_factory=dict)
+    """Random-walk density of each estimated bias per sqrt(s), as a fraction of the output's measurement-noise standard deviation; outputs left out take q 0.3, n_z 0.3 (a bias too small for Table 1 is still learnt in the 30 s after it), n_x 0.05 (faster, it would hide small thrust losses); issue 14's note. The biases start at 0 with that standard deviation (a calibrated sensor)."""
+
+    @model_validator(mode="after")
+    def _biases(self):
+        if len(set(self.sensor_biases)) != len(self.sensor_biases):
+            raise ValueError("sensor_biases: outputs must not repeat")
+        for field in ("sensor_bias_sd", "sensor_bias_walk"):
+            extra = sorted(set(getattr(self, field)) - set(self.sensor_biases))
+            if extra:
+                raise ValueError(f"{field}: {', '.join(extra)} not in sensor_biases")
+        return self
 
 
 def _design_names(designs: dict) -> dict:

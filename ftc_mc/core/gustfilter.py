@@ -13,6 +13,10 @@ after the fault parameters, ``X = [x (9), b (5), g (ng)]``:
 
 with ``B_w``, ``D_w`` the wind Jacobians the truth plant uses
 (``ftc_mc/model/wind.py``) and the Dryden model at a *design* turbulence level.
+A sensor-aware design (issue 14) appends output biases ``s`` to ``g``: columns
+of ``G`` and ``C_d`` zero, ``A_d`` the identity on them, ``Q_g`` their random
+walk, ``D_g`` (and ``D_z``) a unit entry on the biased output; a reset of a
+Table 1 block also resets the biases ``FilterModel.reset_g`` names.
 The steps are those of the paper's filter (eqs. 5-11, Table 1, section 3.2.2,
 eqs. 6-8): predict, residuals on the three outputs, reset of a block of
 ``P_{k|k}`` and a re-prediction, sequential scalar updates with the 12 outputs
@@ -83,8 +87,8 @@ def _lane_point(xa, u, fm, l, xabs, cmd, wind):
 
 @kernel
 def _c_rows_lanes(fm, st, r, cl):
-    """Row ``r`` of every lane's re-linearised ``C_aug = [JC, 0, JHW C_d]`` into
-    ``cl`` (n, L)."""
+    """Row ``r`` of every lane's re-linearised ``C_aug = [JC, 0, JHW C_d + D_z]``
+    into ``cl`` (n, L)."""
     n = cl.shape[0]
     L = cl.shape[1]
     for j in range(N_X):
@@ -98,7 +102,7 @@ def _c_rows_lanes(fm, st, r, cl):
             acc = 0.0
             for w in range(N_WIND):
                 acc += st.JHW[r, w, l] * fm.Cg[w, g]
-            cl[N_AUG + g, l] = acc
+            cl[N_AUG + g, l] = acc + fm.Dz[r, g]
 
 
 @kernel
@@ -207,8 +211,8 @@ def _nl_state(xa, u, fm, xn, tw):
 
 @kernel
 def _nl_outputs(xa, fm, hpred, xp, tw):
-    """The extended filter's predicted outputs ``h(x0 + x, C_d g) - y0`` into
-    ``hpred[:12]`` and the prediction itself into ``xp`` (the update linearises
+    """The extended filter's predicted outputs ``h(x0 + x, C_d g) - y0 + D_z g``
+    (``D_z``: a sensor-aware design's output biases) into ``hpred[:12]`` and the prediction itself into ``xp`` (the update linearises
     about it: ``z_r - hpred_r - c_r (X - xp)``)."""
     n = xa.shape[0]
     xabs = tw.xabs
@@ -220,7 +224,10 @@ def _nl_outputs(xa, fm, hpred, xp, tw):
         _lane_point(xa, None, fm, l, xabs, tw.cmd, wl)
         outputs_nb(xabs, fm.p, wl, y)
         for r in range(N_Z):
-            hpred[r, l] = y[r] - fm.y0[r]
+            acc = y[r] - fm.y0[r]
+            for g in range(n - N_AUG):
+                acc += fm.Dz[r, g] * xa[N_AUG + g, l]
+            hpred[r, l] = acc
 
 
 @kernel
@@ -547,9 +554,44 @@ def gust_predict_lanes(xa, P, fm, tw, st, k):
 
 
 @kernel
+def reset_extra_lanes(P, block, reset_g):
+    """Reset the extra states that go with each lane's block (issue 14).
+
+    A sensor-aware design opens the hypothesis of an output bias beside the
+    actuator block whose residuals it shares: for each extra state ``g`` with
+    ``reset_g[block, g] > 0`` the rows and columns of ``N_AUG + g`` are zeroed
+    and its variance set to ``reset_g[block, g]``, as section 3.2.2 does for the
+    fault parameters (:func:`ftc_mc.core.batch.reset_lanes`).
+
+    Parameters
+    ----------
+    P : ndarray, shape (n, n, L)
+        Covariances, updated in place.
+    block : ndarray of int64, shape (L,)
+        Table 1's block per lane (0: none).
+    reset_g : ndarray, shape (3, n - 14)
+        Variance after a reset, row = block.
+    """
+    n = P.shape[0]
+    for l in range(P.shape[2]):
+        b = block[l]
+        if b <= 0 or b >= reset_g.shape[0]:
+            continue
+        for g in range(reset_g.shape[1]):
+            v = reset_g[b, g]
+            if v > 0.0:
+                i = N_AUG + g
+                for k in range(n):
+                    P[i, k, l] = 0.0
+                    P[k, i, l] = 0.0
+                P[i, i, l] = v
+
+
+@kernel
 def gust_correct_lanes(xa, P, fm, det, tw, st):
     """Second half, once ``tw.block`` is decided: reset the block of ``P_{k|k}``
-    (section 3.2.2) of every lane that resets and predict all lanes again from
+    (section 3.2.2, with the extra states that go with it,
+    :func:`reset_extra_lanes`) of every lane that resets and predict all lanes again from
     ``X_{k|k}`` (identical for the others), update, projection (eqs. 6-8).
     Parameters as :func:`gust_predict_lanes` (the Jacobians of ``st`` as they
     left it); ``P`` gets ``P_{k+1|k+1}``."""
@@ -565,6 +607,7 @@ def gust_correct_lanes(xa, P, fm, det, tw, st):
             n_reset += 1
     if n_reset > 0:
         reset_lanes(P, block, det.reset_var)
+        reset_extra_lanes(P, block, fm.reset_g)
         for i in range(n):
             for l in range(L):
                 xa[i, l] = x_prev[i, l]

@@ -36,13 +36,19 @@ FilterModel = namedtuple("FilterModel", [
     "Dw",       # (12, 3) trim wind Jacobian of the outputs (Dg = Dw Cg); zeros likewise
     "relin",    # steps between re-linearisations of the extended filter's covariance
                 #    about each lane's estimate (LaneState.JA ..); 0: the trim Jacobians
+    "Dz",       # (12, ng) extra states added to the outputs as they are (a sensor-aware
+                #          design's output biases; their columns of Dg too): the
+                #          extended filter adds Dz g to h(x, C_d g); zeros for gust states
+    "reset_g",  # (3, ng) variance an extra state takes when block 1 (thrust) or 2
+                #         (elevons) of Table 1 is reset, row = block; 0: not reset
 ])
 """The augmented Kalman filter's model (paper eqs. 4-6).
 
 The estimate is ``[x (9), b (5), g (ng)]``: the paper's filter has ``ng = 0``
 (the gust arrays are empty, :mod:`ftc_mc.core.batch`); a gust-aware filter
 carries the ``ng = 4`` Dryden states of the longitudinal gusts
-(:mod:`ftc_mc.core.gustfilter`, issue 13)."""
+(:mod:`ftc_mc.core.gustfilter`, issue 13); a sensor-aware design appends output
+biases after them (``Dz``, ``reset_g``; issue 14)."""
 
 Detection = namedtuple("Detection", [
     "t_q",        # threshold on r_q (Table 1), > 0
@@ -121,7 +127,8 @@ TrialRecord = namedtuple("TrialRecord", [
     "status",       # (L,) int64 0 when the trial ran to its end, else a
                     #      trial.STATUS_* reason
     "stop_k",       # (L,) int64 step at which an invalid trial stopped, or -1
-    "xa_end",       # (14, L) final augmented estimate (its first 14 states)
+    "xa_end",       # (m, L) final augmented estimate, its first m states (m = n: all of
+                    #        a design's extra states too, sim/lanes.py::new_record)
     "controller",   # (n_periods, L) int64 controller in use after each period
     "hist_x",       # (n_hist, 9, L) true state after each step (n_hist 0: none kept)
     "hist_xa",      # (n_hist, 14, L) augmented estimate after each step (first 14)

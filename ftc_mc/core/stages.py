@@ -481,8 +481,8 @@ def reconfigure(scheme, timing, inp, st, kn, period, work, rec):
 # ------------------------------------------------------------------ end
 @kernel(inline="always")
 def record_end(st, rec):
-    """The final augmented estimate of every lane (``rec.xa_end``; its first 14
-    states when the filter carries gust states)."""
+    """The final augmented estimate of every lane (``rec.xa_end``: its first
+    ``rec.xa_end.shape[0]`` states)."""
     for i in range(rec.xa_end.shape[0]):
         for l in range(st.xa.shape[1]):
             rec.xa_end[i, l] = st.xa[i, l]

@@ -362,7 +362,7 @@ def run_section(r: ResultDir, fig_dir: Path, slug: str, report: Path) -> list:
     summary, trials = actuator_part(full_summary, r.tables["trials"])
     cfg = r.meta.get("config", {})
     head = [f"## Run `{r.path}`", "", _run_header(cfg), ""]
-    sensor = misattribution_table(full_summary)
+    sensor = misattribution_table(full_summary, r.tables["trials"])
     if not len(summary):
         return head + sensor
     fig = delay_figure(trials, fig_dir / f"{slug}_delays.png", LABELS)

@@ -21,6 +21,13 @@ equations predict the plant states and the outputs
 takes the Jacobians at trim, or with ``relinearise_s`` those about each lane's
 estimate, re-computed every ``relinearise_s`` seconds (``FilterModel.relin``).
 
+A sensor-aware design (``sensor_biases``, issue 14) appends the biases of the
+residuals' sensors (q, n_x, n_z) after any gust states: random walks that only
+add to their output.  Table 1 still picks an actuator block; its reset also opens
+the biases of the sensors sharing its residual (:data:`BIAS_BLOCK`), so the
+filter, with the excitation the reset sends, sorts the change into an actuator
+fault or an output bias (:func:`_with_sensor_biases`).
+
 A design changes only what the filter assumes: the truth noise of every trial
 comes from the config's ``estimator`` and ``noise`` sections, so all designs fly
 the same trials (common random numbers).
@@ -35,7 +42,8 @@ import numpy as np
 import scipy.linalg
 
 from ..config.schema import BUILTIN_DESIGNS, DesignConfig, EstimatorConfig
-from ..conventions import STATE_NAMES, TEST_GLR, TEST_NAMES, TEST_ONE_STEP
+from ..conventions import (OUTPUT_NAMES, RESET_ELEVONS, RESET_THRUST, STATE_NAMES,
+                           TEST_GLR, TEST_NAMES, TEST_ONE_STEP)
 from ..core.settings import Detection, FilterModel
 from ..model.linear import LinearPlant
 from ..model.turbulence import dryden_model
@@ -66,6 +74,9 @@ class Design:
     key : tuple
         Equal for designs whose runs may share a start (same filter model and
         initial covariance, same test and window; ``ftc_mc/sim/lanes.py``).
+    biases : tuple of str
+        Outputs whose sensor bias the design estimates, in the order of their
+        states (the last ``len(biases)`` of the estimate).
     """
 
     name: str
@@ -76,11 +87,18 @@ class Design:
     test: int
     window: int
     key: tuple
+    biases: tuple = ()
 
     @property
     def n_aug(self) -> int:
         """Length of the augmented estimate, ``14 + ng``."""
         return self.P0.shape[0]
+
+    def bias_row(self, output: str) -> int | None:
+        """Row of the estimate holding the bias of ``output``, None if not estimated."""
+        if output not in self.biases:
+            return None
+        return self.n_aug - len(self.biases) + self.biases.index(output)
 
     def detection(self, plant: LinearPlant, t_q: float, t_nx: float) -> Detection:
         """The design's detection at the thresholds ``(t_q, t_nx)``.
@@ -154,7 +172,10 @@ def build_design(name: str, dc: DesignConfig, plant: LinearPlant, est: Estimator
         fm = fm._replace(G=_c(Bw @ dm.Cd), Ad=_c(dm.Ad), Dg=_c(Dw @ dm.Cd),
                          Qg=_c(dm.Bd @ dm.Bd.T), Bw=_c(Bw), Dw=_c(Dw))
         P0 = scipy.linalg.block_diag(P0, dm.P0)
-        fm = fm._replace(Cg=_c(dm.Cd))
+        fm = fm._replace(Cg=_c(dm.Cd), Dz=np.zeros((fm.C.shape[0], dm.Ad.shape[0])),
+                         reset_g=np.zeros((3, dm.Ad.shape[0])))
+    if dc.sensor_biases:
+        fm, P0 = _with_sensor_biases(fm, P0, dc, plant.dt)
     if dc.prediction == "nonlinear":
         fm = fm._replace(nl=1)
         if dc.relinearise_s is not None:  # Jacobians about each lane's estimate
@@ -167,9 +188,58 @@ def build_design(name: str, dc: DesignConfig, plant: LinearPlant, est: Estimator
         settle=int(round(dc.settle_s / plant.dt)))
     key = (dc.estimator, dc.design_turbulence if dc.estimator == "gust_aware" else None,
            dc.prediction, s.sigma_qx, s.sigma_qb, tuple(sorted(dc.state_noise.items())),
-           test, window, min_window, dc.settle_s, fm.relin)
+           test, window, min_window, dc.settle_s, fm.relin, tuple(dc.sensor_biases),
+           tuple(sorted(dc.sensor_bias_sd.items())),
+           tuple(sorted(dc.sensor_bias_walk.items())))
     return Design(name=name, est=s, fm=fm, det=det, P0=_c(P0), test=test, window=window,
-                  key=key)
+                  key=key, biases=tuple(dc.sensor_biases))
+
+
+SENSOR_BIAS_SD = {"q": 5.0 * math.pi / 180.0, "n_x": 0.08, "n_z": 0.08}
+"""Default standard deviation of a bias when its hypothesis opens [rad/s, g]: the
+largest bias of a typical small-UAV sensor (the upper ends of the default
+``sensor_draws``: gyro 5 deg/s, accelerometers 80 mg, InvenSense MPU-6000)."""
+
+SENSOR_BIAS_WALK = {"q": 0.3, "n_x": 0.05, "n_z": 0.3}
+"""Default random-walk density of each bias per sqrt(s), in measurement-noise
+standard deviations: q and n_z fast enough that a bias below Table 1's
+threshold is learnt within 30 s; n_x slower, as faster walks hide small thrust
+losses (measured on Tables 2-3, issue 14's note)."""
+
+BIAS_BLOCK = {"q": RESET_ELEVONS, "n_x": RESET_THRUST, "n_z": RESET_ELEVONS}
+"""The Table 1 block whose reset opens each bias: the one deciding on its residual
+(``r_nx`` thrust; ``r_q`` elevons, whose third clause reads ``r_nz``)."""
+
+
+def _with_sensor_biases(fm: FilterModel, P0: np.ndarray, dc: DesignConfig, dt: float):
+    """``fm`` and ``P0`` with the output biases of ``dc.sensor_biases`` appended
+    after the other extra states (issue 14).
+
+    Bias ``s_o`` of output ``o``: ``s+ = s + w``, ``Var w = (walk_o sigma_o)^2 dt``
+    (``walk_o``: ``dc.sensor_bias_walk`` or :data:`SENSOR_BIAS_WALK`)
+    (``sigma_o``: the output's measurement-noise standard deviation), no effect on
+    the plant (``G``, ``C_d`` columns 0), ``z_o += s_o`` (unit entry of ``D_g``
+    and ``D_z``), initial variance ``sigma_o^2``, and variance ``sd_o^2`` when the
+    block of :data:`BIAS_BLOCK` is reset (``FilterModel.reset_g``).
+    """
+    outs = [OUTPUT_NAMES.index(o) for o in dc.sensor_biases]
+    ns, ng0, nz = len(outs), fm.Ad.shape[0], fm.C.shape[0]
+    sig = np.sqrt(fm.r_diag[outs])
+    walk = np.array([dc.sensor_bias_walk.get(o, SENSOR_BIAS_WALK[o]) for o in dc.sensor_biases])
+    E = np.zeros((nz, ns))
+    E[outs, np.arange(ns)] = 1.0
+    reset = np.zeros((3, ns))
+    for j, o in enumerate(dc.sensor_biases):
+        reset[BIAS_BLOCK[o], j] = dc.sensor_bias_sd.get(o, SENSOR_BIAS_SD[o]) ** 2
+    fm = fm._replace(
+        G=_c(np.hstack([fm.G, np.zeros((fm.G.shape[0], ns))])),
+        Ad=_c(scipy.linalg.block_diag(fm.Ad, np.eye(ns))),
+        Dg=_c(np.hstack([fm.Dg, E])),
+        Qg=_c(scipy.linalg.block_diag(fm.Qg, np.diag((walk * sig) ** 2 * dt))),
+        Cg=_c(np.hstack([fm.Cg, np.zeros((fm.Cg.shape[0], ns))])),
+        Dz=_c(np.hstack([np.zeros((nz, ng0)), E])),
+        reset_g=_c(np.hstack([np.zeros((3, ng0)), reset])))
+    return fm, scipy.linalg.block_diag(P0, np.diag(sig ** 2))
 
 
 def build_designs(names, designs: dict, plant: LinearPlant, est: EstimatorConfig,

@@ -133,7 +133,8 @@ def filter_model(plant: LinearPlant, s: EstimatorSettings) -> FilterModel:
         y0=np.ascontiguousarray(plant.trim.y0, dtype=np.float64), Cg=np.zeros((3, 0)),
         n_sub=10, dt=float(plant.dt),
         # no wind Jacobians (a gust-aware design sets them) and no re-linearisation
-        Bw=np.zeros((n, 3)), Dw=np.zeros((C.shape[0], 3)), relin=0)
+        Bw=np.zeros((n, 3)), Dw=np.zeros((C.shape[0], 3)), relin=0,
+        Dz=np.zeros((C.shape[0], 0)), reset_g=np.zeros((3, 0)))
 
 
 def detection(plant: LinearPlant, s: EstimatorSettings) -> Detection:

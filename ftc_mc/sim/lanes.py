@@ -33,11 +33,14 @@ HISTORY_RESETS = 100_000
 """Resets stored per lane when every step is kept (a scenario)."""
 
 
-def new_record(setup, L: int, max_resets: int, history: bool = False) -> TrialRecord:
+def new_record(setup, L: int, max_resets: int, history: bool = False,
+               n_est: int = 14) -> TrialRecord:
     """Preallocated outputs of :func:`ftc_mc.core.trial.run_trials`.
 
     ``history=True`` keeps every step's state, estimate, commands, residuals
     and excitation (for scenarios); campaigns keep only the per-period arrays.
+    ``n_est``: states of the final estimate kept (the design's ``n_aug``: its
+    extra states too; the history keeps the first 14).
     """
     n_per = setup.tim.n_steps // setup.tim.reconf_every
     n_hist = setup.tim.n_steps if history else 0
@@ -55,7 +58,7 @@ def new_record(setup, L: int, max_resets: int, history: bool = False) -> TrialRe
         hist_res=np.zeros((n_hist, 3, L)), hist_exc=np.zeros((n_hist, 4, L)),
         hist_block=np.zeros((n_hist, L), dtype=np.int64),
         hist_wind=np.zeros((n_hist, 3, L)),
-        xa_end=np.zeros((14, L)))
+        xa_end=np.zeros((n_est, L)))
 
 
 def run_alone(setup, name: str, det, inp: TrialInputs, max_resets: int,
@@ -63,7 +66,7 @@ def run_alone(setup, name: str, det, inp: TrialInputs, max_resets: int,
     """Every lane of ``inp`` from the start to the end under the design ``name``
     with the detection ``det`` (``inp`` as :func:`~ftc_mc.sim.inputs.build_inputs`
     lays it out, for any design)."""
-    rec = new_record(setup, inp.w.shape[2], max_resets, history)
+    rec = new_record(setup, inp.w.shape[2], max_resets, history, setup.designs[name].n_aug)
     run_trials(setup.scheme(name, det), setup.flight,
                design_inputs(inp, setup.designs[name]), rec)
     return rec
@@ -126,7 +129,7 @@ def _shared_start(setup, name: str, inp: TrialInputs, max_resets: int, k_share: 
     with resets disabled."""
     L = inp.w.shape[2]
     dinp = design_inputs(inp, setup.designs[name])
-    rec0 = new_record(setup, L, max_resets)
+    rec0 = new_record(setup, L, max_resets, n_est=setup.designs[name].n_aug)
     no_resets = setup.detection(name, math.inf, math.inf)
     st0 = new_state(L, dinp.xa0.shape[0], no_resets.window)
     init_state(dinp, st0, rec0)
