@@ -184,7 +184,8 @@ def build_inputs(setup, schedule: Schedule, draws: LaneDraws,
 
 def design_inputs(inp: TrialInputs, design) -> TrialInputs:
     """``inp`` as the design ``design`` starts it: its initial covariance, and the
-    initial estimate padded with zeros for its extra (gust) states.
+    initial estimate padded with zeros for its extra (gust) states; every array
+    C-contiguous (the kernels' one signature).
 
     The draws, the schedule and the sensor faults are untouched, so every design
     flies the same trials (common random numbers).
@@ -201,7 +202,10 @@ def design_inputs(inp: TrialInputs, design) -> TrialInputs:
     if n != xa0.shape[0]:
         xa0 = np.zeros((n, L))
         xa0[:inp.xa0.shape[0]] = inp.xa0
-    return inp._replace(xa0=xa0, P0=design.P0)
+    inp = inp._replace(xa0=xa0, P0=design.P0)
+    # one memory layout whatever built the inputs (a sweep's lanes taken by index
+    # are not C-contiguous): each layout is another signature, compiled anew
+    return type(inp)(*(np.ascontiguousarray(v) for v in inp))
 
 
 def no_sensor_faults(L: int) -> "SensorFaults":
