@@ -263,7 +263,7 @@ def _finished(out_dir: Path, kind: str, files, identity: dict) -> bool:
 def run_campaign(config, *, trials=None, seed=None, signature=None, controller=None,
                  plant=None, turbulence=None, airframe=None, design=None, jobs: int = 1,
                  progress: bool = True,
-                 backend: str = "loky", scheduler: str | None = None, out=None,
+                 backend: str = "threads", scheduler: str | None = None, out=None,
                  overwrite: bool = False, resume: bool = False,
                  command: str | None = None):
     """Run a Monte Carlo campaign: the paper's Tables 2-3 (``ftc-mc run``).
@@ -275,11 +275,11 @@ def run_campaign(config, *, trials=None, seed=None, signature=None, controller=N
     trials, seed, signature, controller, plant, turbulence, airframe, design : optional
         Overrides of the config (:func:`campaign_config`).
     jobs : int
-        Worker processes; 1 runs here, -1 uses every core (or this process
+        Workers (``backend``); 1 runs here alone, -1 uses every core (or this process
         alone for a small run).  The results do not depend on it.
     progress : bool
         Show a progress bar.
-    backend : {"loky", "dask"}
+    backend : {"threads", "loky", "dask"}
     scheduler : str, optional
         Dask scheduler address (``backend="dask"``); a local cluster if None.
     out : str or Path, optional
@@ -357,7 +357,7 @@ def _spec(values, option: str):
 def run_sweep(config, thresholds=None, *, tq=None, tnx=None, transitions=None,
               signature=None, trials=None, seed=None, flights: int | None = None,
               plant=None, turbulence=None, airframe=None, design=None, jobs: int = 1,
-              progress: bool = True, backend: str = "loky", scheduler: str | None = None,
+              progress: bool = True, backend: str = "threads", scheduler: str | None = None,
               out=None, overwrite: bool = False, resume: bool = False,
               command: str | None = None):
     """Sweep the Table 1 thresholds (``ftc-mc sweep``).

@@ -180,9 +180,10 @@ def parallel_options(func):
     func = click.option("--quiet", is_flag=True, help="No progress bar.")(func)
     func = click.option("--scheduler", help="Dask scheduler address, e.g. "
                         "tcp://10.0.0.5:8786 [default: a local cluster].")(func)
-    return click.option("--backend", type=click.Choice(["loky", "dask"]), default="loky",
-                        show_default=True,
-                        help="Worker processes here (loky) or a Dask cluster.")(func)
+    return click.option("--backend", type=click.Choice(["threads", "loky", "dask"]),
+                        default="threads", show_default=True,
+                        help="Workers: threads in this process (the kernels release the "
+                        "GIL), worker processes here (loky), or a Dask cluster.")(func)
 
 
 @contextlib.contextmanager
@@ -239,7 +240,7 @@ def terminal_table(summary) -> str:
 @click.option("--trials", type=int, help="Trials per transition (overrides the config).")
 @click.option("--seed", type=int, help="Root seed (overrides the config).")
 @click.option("--jobs", type=int, default=-1, show_default=True,
-              help="Worker processes; -1: every core (one for a small run). Results do "
+              help="Workers; -1: every core (one for a small run). Results do "
               "not depend on it.")
 @click.option("--out", type=click.Path(file_okay=False),
               help="Output directory [default: results/<config name>, never reused].")
@@ -327,7 +328,7 @@ def scenario(config, out, seed, design, overwrite, plant, turbulence, airframe):
 @click.option("--trials", type=int, help="Trials per transition (overrides the config).")
 @click.option("--flights", type=int, help="Fault-free flights per point [default: trials].")
 @click.option("--jobs", type=int, default=-1, show_default=True,
-              help="Worker processes; -1: every core. Results do not depend on it.")
+              help="Workers; -1: every core. Results do not depend on it.")
 @click.option("--out", type=click.Path(file_okay=False),
               help="Output directory [default: results/<config name>, never reused].")
 @click.option("--overwrite", is_flag=True, help="Replace results already in --out.")

@@ -105,10 +105,11 @@ def test_summary_rates_and_wilson():
 def test_results_do_not_depend_on_jobs_or_chunks():
     cfg = small_config(["elevon_lock", "engine_loss"], trials=6)
     a = ftc_mc.run_campaign(cfg, jobs=1, progress=False)
-    b = ftc_mc.run_campaign(cfg, jobs=2, progress=False)
+    b = ftc_mc.run_campaign(cfg, jobs=2, progress=False)  # threads
     c = ftc_mc.run_campaign(cfg.model_copy(update={"campaign": cfg.campaign.model_copy(
         update={"chunk_size": 5})}), jobs=1, progress=False)
-    for other in (b, c):
+    p = ftc_mc.run_campaign(cfg, jobs=2, progress=False, backend="loky")  # processes
+    for other in (b, c, p):
         pd.testing.assert_frame_equal(a.trials, other.trials, check_exact=True)
         pd.testing.assert_frame_equal(a.resets, other.resets, check_exact=True)
     # a different seed gives different draws

@@ -1,9 +1,14 @@
-"""Where chunks run: local worker processes (joblib/loky) or a Dask cluster.
+"""Where chunks run: worker threads here, local worker processes (joblib/loky) or a
+Dask cluster.
 
 :func:`run_chunks` is the parent side of ``ftc-mc run`` and ``ftc-mc sweep``:
 it sends every chunk not yet finished to :func:`ftc_mc.campaign.chunk.run_chunk`,
 stores each as it completes, and returns them all.  The same chunk function
-runs either way, and results do not depend on where they ran.  With
+runs either way, and results do not depend on where they ran.  ``threads`` (the
+default) runs chunks on joblib's threading backend in this process: the kernels
+release the GIL (``nogil``), so the threads share one core each, with no worker
+start-up, no second load of the kernels and no results pickled back
+(``docs/performance.md``, lesson 5).  ``loky`` runs worker processes.  With
 ``backend="dask"`` the chunks go through joblib's Dask backend to a
 ``distributed`` cluster: the one at ``scheduler`` (e.g.
 ``tcp://10.0.0.5:8786``), or a local cluster of single-threaded worker
@@ -22,16 +27,16 @@ from tqdm.auto import tqdm
 from ..errors import UserError
 from .chunk import ChunkSpec, run_chunk, warm_up
 
-BACKENDS = ("loky", "dask")
+BACKENDS = ("threads", "loky", "dask")
 
 
 @contextlib.contextmanager
-def backend(name: str = "loky", scheduler: str | None = None, n_workers: int = 2):
+def backend(name: str = "threads", scheduler: str | None = None, n_workers: int = 2):
     """Route joblib's ``Parallel`` to the chosen backend inside the block.
 
     Parameters
     ----------
-    name : {"loky", "dask"}
+    name : {"threads", "loky", "dask"}
     scheduler : str, optional
         Address of a running Dask scheduler (dask only).
     n_workers : int
@@ -44,10 +49,11 @@ def backend(name: str = "loky", scheduler: str | None = None, n_workers: int = 2
     """
     if name not in BACKENDS:
         raise UserError(f"--backend: must be one of {', '.join(BACKENDS)}, got {name!r}")
-    if name == "loky":
+    if name in ("threads", "loky"):
         if scheduler is not None:
             raise UserError("--scheduler: only with --backend dask")
-        yield
+        with parallel_config(backend="threading" if name == "threads" else "loky"):
+            yield
         return
     try:
         from dask.distributed import Client, LocalCluster
@@ -73,7 +79,7 @@ def backend(name: str = "loky", scheduler: str | None = None, n_workers: int = 2
             cluster.close()
 
 
-def run_chunks(spec: ChunkSpec, units, *, n_jobs: int = 1, backend_name: str = "loky",
+def run_chunks(spec: ChunkSpec, units, *, n_jobs: int = 1, backend_name: str = "threads",
                scheduler: str | None = None, progress: bool = True, chunks=None,
                desc: str = "trials") -> list:
     """Run every chunk of a run or sweep; return their tables in the order of ``units``.

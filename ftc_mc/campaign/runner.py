@@ -117,7 +117,7 @@ def sort_rows(df: pd.DataFrame, transitions, variants, extra) -> pd.DataFrame:
 
 
 def run_campaign(config, *, trials=None, seed=None, signature=None, jobs: int = 1,
-                 progress: bool = True, chunks=None, backend: str = "loky",
+                 progress: bool = True, chunks=None, backend: str = "threads",
                  scheduler: str | None = None) -> CampaignResult:
     """Run every transition of a configuration.
 
@@ -130,12 +130,12 @@ def run_campaign(config, *, trials=None, seed=None, signature=None, jobs: int = 
     signature : {"paper", "swapped", "both"}, optional
         Override ``campaign.signature``.
     jobs : int
-        Worker processes (joblib/loky); 1 runs in this process; -1 every core,
-        or this process alone for a small run (:func:`auto_jobs`).  Results are
-        identical for every value.
+        Workers (threads, processes or Dask workers, ``backend``); 1 runs in this
+        process alone; -1 every core, or this process alone for a small run
+        (:func:`auto_jobs`).  Results are identical for every value.
     progress : bool
         Show a tqdm bar counting finished trials.
-    backend : {"loky", "dask"}
+    backend : {"threads", "loky", "dask"}
         Where chunks run (:mod:`ftc_mc.campaign.parallel`).
     scheduler : str, optional
         Dask scheduler address (``backend="dask"``); a local cluster if None.

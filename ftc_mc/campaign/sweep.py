@@ -148,7 +148,7 @@ def add_hours_per_false_reset(table: pd.DataFrame) -> pd.DataFrame:
 
 
 def run_sweep(cfg: Config, points, *, flights: int | None = None, jobs: int = 1,
-              progress: bool = True, backend: str = "loky",
+              progress: bool = True, backend: str = "threads",
               scheduler: str | None = None, chunks=None) -> SweepResult:
     """Run a threshold sweep.
 
@@ -162,7 +162,7 @@ def run_sweep(cfg: Config, points, *, flights: int | None = None, jobs: int = 1,
         Fault-free flights per point for the false-reset rate (default: the
         number of trials per transition); each lasts ``timing.duration_s``.
     jobs : int
-        Worker processes; results do not depend on it.
+        Workers (``backend``); results do not depend on it.
     progress : bool
         Show a tqdm bar.
     backend, scheduler
