@@ -22,7 +22,7 @@ from ..conventions import (BLOCK_NAMES, C_NOMINAL, MODE_NAMES, MODE_NOMINAL, STA
                            STATUS_ALPHA, STATUS_NAMES, STATUS_NONFINITE, STATUS_NOT_PSD)
 from ..core.jit import announce_compile
 from ..core.settings import TrialInputs, TrialRecord
-from ..core.trial import advance, run_trials
+from ..core.trial import run_trials
 from ..sim.inputs import build_inputs, draw_lanes, flight_inputs, sensor_faults
 from ..sim.lanes import simulate
 from ..sim.setup import SimSetup, build_setup, runs_of
@@ -468,6 +468,6 @@ def warm_up(spec: ChunkSpec, tr_name: str) -> None:
     trial of ``tr_name`` under the first variant.  When the trial kernel is not
     in the cache yet, one line on stderr says that it is being compiled
     (:func:`ftc_mc.core.jit.announce_compile`)."""
-    announce_compile(advance)
+    announce_compile(run_trials)
     run_chunk(dataclasses.replace(spec, variants=spec.variants[:1], max_resets=4, window=1,
                                   points=None), tr_name, np.arange(1))

@@ -169,13 +169,12 @@ def init_jacobians(fm, st):
                 st.JHW[r, j, l] = fm.Dw[r, j]
 
 
+@kernel
 def run_trials(scheme, flight, inp, rec):
     """Simulate ``L`` trials from the start to the end (see :func:`advance`).
 
     Parameters are those of :func:`advance` without the state and step range;
-    ``rec`` is overwritten.  A Python function calling the kernels: compiled,
-    it would make LLVM optimise :func:`advance` a second time inlined into it
-    (22 s of the cold compile, for four calls per chunk).
+    ``rec`` is overwritten.
     """
     st = new_state(inp.w.shape[2], inp.xa0.shape[0], scheme.detection.window)
     init_state(inp, st, rec)
