@@ -57,11 +57,16 @@ def gust_scheme(setup, fm, window=1, test=0, **det):
 
 
 def with_gust_states(st, rng, d, P0, W=1):
-    """``st`` (14 states) extended by gust estimates and a GLR window of ``W``."""
+    """``st`` (14 states) extended by gust estimates and a GLR window of ``W``; any
+    states of ``P0`` after the gust states (a sensor-aware design's biases) drawn
+    with their standard deviations in ``P0``."""
     Lk = st.xa.shape[1]
-    xa = np.zeros((N, Lk))
+    n = P0.shape[0]
+    xa = np.zeros((n, Lk))
     xa[:N_AUG] = st.xa
-    xa[N_AUG:] = d.P0_chol @ rng.standard_normal((NG, Lk))
+    xa[N_AUG:N] = d.P0_chol @ rng.standard_normal((NG, Lk))
+    if n > N:
+        xa[N:] = np.sqrt(np.diag(P0))[N:, None] * rng.standard_normal((n - N, Lk))
     P = np.stack([random_cov(rng, P0) for _ in range(Lk)], axis=-1)
     return st._replace(xa=xa, P=np.ascontiguousarray(P), ebuf=np.zeros((W, 3, Lk)),
                        ecount=np.zeros(Lk, dtype=np.int64))

@@ -18,8 +18,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from test_design_kernels import NG, compare_steps, extended, gust_filter, gust_scheme
-from test_stages import L, _setup, random_cov, random_lanes
+from test_design_kernels import (NG, compare_steps, extended, gust_filter, gust_scheme,
+                                 linear_gusts, nonlinear_gusts, with_gust_states,  # noqa: F401
+                                 with_trim_jacobians)
+from test_stages import random_cov, random_lanes
 from ftc_mc.config.schema import Config, DesignConfig
 from ftc_mc.conventions import N_AUG, OUTPUT_NAMES, RESET_ELEVONS, RESET_THRUST
 from ftc_mc.sim.designs import build_design
@@ -62,38 +64,15 @@ def with_biases(fm, P0, dt):
     return fm, P
 
 
-def lanes_with(setup, rng, P0, n, W=1):
-    """Random lanes at step 10 with ``n`` states: gust states and biases of a few
-    standard deviations of ``P0``."""
-    st = random_lanes(setup, rng, 10)
-    xa = np.zeros((n, L))
-    xa[:N_AUG] = st.xa
-    sd = np.sqrt(np.diag(P0))[N_AUG:]
-    xa[N_AUG:] = sd[:, None] * rng.standard_normal((n - N_AUG, L))
-    P = np.stack([random_cov(rng, P0) for _ in range(L)], axis=-1)
-    return st._replace(xa=xa, P=np.ascontiguousarray(P), ebuf=np.zeros((W, 3, L)),
-                       ecount=np.zeros(L, dtype=np.int64))
-
-
-@pytest.fixture(scope="module")
-def linear_gusts():
-    return _setup(turbulence="moderate")
-
-
-@pytest.fixture(scope="module")
-def nonlinear_gusts():
-    return _setup(plant_kind="nonlinear", turbulence="moderate")
-
-
 def test_bias_filter_update(linear_gusts):
     """Gust and bias states, linear prediction: the stage against the twin, over
     steps where both blocks are reset (so ``reset_g`` opens every bias)."""
-    fm, P0, _ = gust_filter(linear_gusts)
+    fm, P0, d = gust_filter(linear_gusts)
     fm, P0 = with_biases(fm, P0, linear_gusts.plant.dt)
     n = P0.shape[0]
     scheme = gust_scheme(linear_gusts, fm, t_q=3.0, t_nx=3.0)
     rng = np.random.default_rng(71)
-    st = lanes_with(linear_gusts, rng, P0, n)
+    st = with_gust_states(random_lanes(linear_gusts, rng, 10), rng, d, P0)
     scale = np.array([0.3, 0.3, 1.0, 3.0, 10.0, 30.0, 100.0])
     fired = compare_steps(scheme, st, rng, [scale[::-1], scale] * 3, 10, n)
     assert fired == {0, RESET_THRUST, RESET_ELEVONS}
@@ -120,14 +99,13 @@ def test_extended_bias_filter_update(nonlinear_gusts, relin):
     """Extended filter with biases: the predicted outputs are ``h(x, C_d g) - y0
     + D_z s`` and the re-linearised rows carry ``D_z``; against the twin
     (tolerances as ``test_relinearised_filter_update`` with re-linearisation)."""
-    fm, P0, _ = extended(nonlinear_gusts, relin)
+    fm, P0, d = extended(nonlinear_gusts, relin)
     fm, P0 = with_biases(fm, P0, nonlinear_gusts.plant.dt)
     n = P0.shape[0]
     scheme = gust_scheme(nonlinear_gusts, fm, t_q=3.0, t_nx=3.0)
     rng = np.random.default_rng(72)
-    st = lanes_with(nonlinear_gusts, rng, P0, n)
-    from test_design_kernels import with_trim_jacobians
-    st = with_trim_jacobians(st, fm)
+    st = with_trim_jacobians(with_gust_states(random_lanes(nonlinear_gusts, rng, 10), rng,
+                                              d, P0), fm)
     scale = np.array([0.3, 0.5, 1.0, 2.0, 3.0, 5.0, 10.0])
     tol = 1e-7 if relin else 1e-9
     fired = compare_steps(scheme, st, rng, [scale] * 4, 10, n, tol_res=tol, tol=tol,

@@ -58,14 +58,20 @@ def misattribution_table(summary: pd.DataFrame, trials: pd.DataFrame | None = No
         row["first action median / p95 [s]"] = (f"{num(r['first_action_median_s'])} / "
                                                 f"{num(r['first_action_p95_s'])}")
         out.append(row)
-    return ["### Sensor faults: what the actuator FDI does with them", "",
-            pd.DataFrame(out).to_markdown(index=False), "",
-            "The actuators stay healthy, so the correct block is `none`: any reset after "
-            "the sensor fault, an actuator mode most probable (>= 0.5) or a controller "
-            "switch is a misattribution. Counts are `k/n (rate %, 95 % Wilson CI)` over "
-            "judged trials (no numerical failure); leaving the envelope is an outcome "
-            "here, not an exclusion. Times are from the sensor fault to the first action "
-            "of any kind, over the trials with one.", ""] + isolation_table(rows, trials)
+    return _section(
+        "Sensor faults: what the actuator FDI does with them", out,
+        "The actuators stay healthy, so the correct block is `none`: any reset after "
+        "the sensor fault, an actuator mode most probable (>= 0.5) or a controller "
+        "switch is a misattribution. Counts are `k/n (rate %, 95 % Wilson CI)` over "
+        "judged trials (no numerical failure); leaving the envelope is an outcome "
+        "here, not an exclusion. Times are from the sensor fault to the first action "
+        "of any kind, over the trials with one.") + isolation_table(rows, trials)
+
+
+def _section(title: str, rows: list, note: str) -> list:
+    """Markdown lines of a report section: heading, the table of ``rows`` (dicts),
+    the note under it."""
+    return [f"### {title}", "", pd.DataFrame(rows).to_markdown(index=False), "", note, ""]
 
 
 SIZE_BINS = 4
@@ -103,15 +109,15 @@ def isolation_table(rows: pd.DataFrame, trials: pd.DataFrame | None) -> list:
                 row[f"bin {b + 1}"] = (f"{edges[b]:.3g}-{edges[b + 1]:.3g}: "
                                        f"{count(int(iso[m].sum()), int(m.sum()))}")
         out.append(row)
-    return ["### Sensor-bias isolation of the sensor-aware designs", "",
-            pd.DataFrame(out).to_markdown(index=False), "",
-            "Isolated: the trial flew to the end, the design's estimate of the bias is "
-            "within 25 % of the true bias, and the belief's most probable mode at the end "
-            "is nominal. Bins split the drawn |bias| (in the output's unit: rad/s, g) into "
-            f"{SIZE_BINS} of equal width. A reset of the block sharing the bias's "
-            "residual opens the bias hypothesis, so these designs' actuator-block resets "
-            "above are hypotheses opened, not misattributions; a wrong mode or a "
-            "controller switch still is.", ""]
+    return _section(
+        "Sensor-bias isolation of the sensor-aware designs", out,
+        "Isolated: the trial flew to the end, the design's estimate of the bias is "
+        "within 25 % of the true bias, and the belief's most probable mode at the end "
+        "is nominal. Bins split the drawn |bias| (in the output's unit: rad/s, g) into "
+        f"{SIZE_BINS} of equal width. A reset of the block sharing the bias's "
+        "residual opens the bias hypothesis, so these designs' actuator-block resets "
+        "above are hypotheses opened, not misattributions; a wrong mode or a "
+        "controller switch still is.")
 
 
 def has_sensor_rows(summary: pd.DataFrame) -> bool:
