@@ -275,8 +275,9 @@ def run_campaign(config, *, trials=None, seed=None, signature=None, controller=N
     trials, seed, signature, controller, plant, turbulence, airframe, design : optional
         Overrides of the config (:func:`campaign_config`).
     jobs : int
-        Workers (``backend``); 1 runs here alone, -1 uses every core (or this process
-        alone for a small run).  The results do not depend on it.
+        Workers (``backend``); 1 runs here alone, -1 uses every core (or, on
+        worker processes, this process alone for a small run).  The results do
+        not depend on it.
     progress : bool
         Show a progress bar.
     backend : {"threads", "loky", "dask"}

@@ -240,8 +240,8 @@ def terminal_table(summary) -> str:
 @click.option("--trials", type=int, help="Trials per transition (overrides the config).")
 @click.option("--seed", type=int, help="Root seed (overrides the config).")
 @click.option("--jobs", type=int, default=-1, show_default=True,
-              help="Workers; -1: every core (one for a small run). Results do "
-              "not depend on it.")
+              help="Workers; -1: every core (one for a small run on worker processes). "
+              "Results do not depend on it.")
 @click.option("--out", type=click.Path(file_okay=False),
               help="Output directory [default: results/<config name>, never reused].")
 @click.option("--signature", type=click.Choice(["paper", "swapped", "both"]),

@@ -76,13 +76,15 @@ def plan_chunks(cfg: Config):
 
 
 SMALL_RUN_STEPS = 3_000_000
-"""Below this many (controller-weighted) trial steps, ``jobs=-1`` runs in-process:
-starting worker processes (importing Numba and loading the cached kernels,
-about 3 s here) would cost more than it saves."""
+"""Below this many (controller-weighted) trial steps, ``jobs=-1`` with worker
+processes (``loky``, ``dask``) runs in-process: starting them (importing Numba
+and loading the cached kernels, about 3 s here) would cost more than it saves.
+Threads start at once, so the default backend does not wait for that."""
 
 
-def auto_jobs(cfg: Config, n_variants: int) -> int:
-    """Worker count for ``jobs=-1``: every core, or 1 for a small run.
+def auto_jobs(cfg: Config, n_variants: int, backend: str = "threads") -> int:
+    """Worker count for ``jobs=-1``: every core (at most one per chunk), or 1 for
+    a small run on worker processes (:data:`SMALL_RUN_STEPS`).
 
     A trial step of the reconfiguring loop costs about six of the nominal one
     (the controller selection predicts three controllers over the horizon); one
@@ -92,7 +94,7 @@ def auto_jobs(cfg: Config, n_variants: int) -> int:
     weight = 6 if cfg.controller.kind == "reconfiguring" else 1
     weight *= 4 if cfg.plant.kind == "nonlinear" else 1
     steps = c.trials * len(c.transitions) * n_variants * cfg.steps(cfg.timing.duration_s)
-    if steps * weight < SMALL_RUN_STEPS:
+    if backend != "threads" and steps * weight < SMALL_RUN_STEPS:
         return 1
     return max(1, min(os.cpu_count() or 1, len(plan_chunks(cfg))))
 
@@ -131,8 +133,8 @@ def run_campaign(config, *, trials=None, seed=None, signature=None, jobs: int = 
         Override ``campaign.signature``.
     jobs : int
         Workers (threads, processes or Dask workers, ``backend``); 1 runs in this
-        process alone; -1 every core, or this process alone for a small run
-        (:func:`auto_jobs`).  Results are identical for every value.
+        process alone; -1 every core, or with worker processes this process
+        alone for a small run (:func:`auto_jobs`).  Results are identical for every value.
     progress : bool
         Show a tqdm bar counting finished trials.
     backend : {"threads", "loky", "dask"}
@@ -151,7 +153,8 @@ def run_campaign(config, *, trials=None, seed=None, signature=None, jobs: int = 
     cfg = resolve_config(config, trials, seed, signature)
     spec = chunk_spec(cfg)
     c = cfg.campaign
-    n_jobs = auto_jobs(cfg, len(spec.variants)) if jobs == -1 else max(1, int(jobs))
+    n_jobs = (auto_jobs(cfg, len(spec.variants), backend) if jobs == -1
+              else max(1, int(jobs)))
     if backend == "dask" and jobs == -1:
         n_jobs = os.cpu_count()
     out = run_chunks(spec, plan_chunks(cfg), n_jobs=n_jobs, backend_name=backend,
