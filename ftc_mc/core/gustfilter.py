@@ -105,6 +105,18 @@ def _c_rows_lanes(fm, st, r, cl):
             cl[N_AUG + g, l] = acc + fm.Dz[r, g]
 
 
+@kernel(inline="always")
+def _at_point(xabs, cmd, wl, xs, c0, w0):
+    """Set the one-lane buffers to the operating point: state ``xs``, commands
+    ``c0``, wind ``w0`` (each finite difference perturbs one entry of them)."""
+    for i in range(N_X):
+        xabs[i] = xs[i]
+    for j in range(N_U):
+        cmd[j] = c0[j]
+    for i in range(N_WIND):
+        wl[i] = w0[i]
+
+
 @kernel
 def relinearise_lanes(xa, u, fm, st, tw):
     """Every lane's Jacobians about its estimate ``X_{k|k}`` by forward finite
@@ -131,40 +143,25 @@ def relinearise_lanes(xa, u, fm, st, tw):
     for l in range(xa.shape[1]):
         _lane_point(xa, u, fm, l, xs, c0, w0)
         # the point itself
-        for i in range(N_X):
-            xabs[i] = xs[i]
-        for j in range(N_U):
-            cmd[j] = c0[j]
-        for i in range(N_WIND):
-            wl[i] = w0[i]
+        _at_point(xabs, cmd, wl, xs, c0, w0)
         propagate(xabs, cmd, fm.p, wl, fm.dt, fm.n_sub, tw.rk4)
         for i in range(N_X):
             fb[i] = xabs[i]
         outputs_nb(xs, fm.p, w0, yb)
         # states
         for j in range(N_X):
-            for i in range(N_X):
-                xabs[i] = xs[i]
+            _at_point(xabs, cmd, wl, xs, c0, w0)
             xabs[j] = xs[j] + FD_X * max(1.0, abs(xs[j]))
             dx = xabs[j] - xs[j]
             outputs_nb(xabs, fm.p, w0, y)
             for r in range(N_Z):
                 st.JC[r, j, l] = (y[r] - yb[r]) / dx
-            for j2 in range(N_U):
-                cmd[j2] = c0[j2]
-            for i in range(N_WIND):
-                wl[i] = w0[i]
             propagate(xabs, cmd, fm.p, wl, fm.dt, fm.n_sub, tw.rk4)
             for i in range(N_X):
                 st.JA[i, j, l] = (xabs[i] - fb[i]) / dx
         # effects
         for j in range(N_U):
-            for i in range(N_X):
-                xabs[i] = xs[i]
-            for j2 in range(N_U):
-                cmd[j2] = c0[j2]
-            for i in range(N_WIND):
-                wl[i] = w0[i]
+            _at_point(xabs, cmd, wl, xs, c0, w0)
             cmd[j] = c0[j] + FD_E
             de = cmd[j] - c0[j]
             propagate(xabs, cmd, fm.p, wl, fm.dt, fm.n_sub, tw.rk4)
@@ -172,12 +169,7 @@ def relinearise_lanes(xa, u, fm, st, tw):
                 st.JB[i, j, l] = (xabs[i] - fb[i]) / de
         # wind
         for j in range(N_WIND):
-            for i in range(N_X):
-                xabs[i] = xs[i]
-            for j2 in range(N_U):
-                cmd[j2] = c0[j2]
-            for i in range(N_WIND):
-                wl[i] = w0[i]
+            _at_point(xabs, cmd, wl, xs, c0, w0)
             wl[j] = w0[j] + FD_W
             dw = wl[j] - w0[j]
             outputs_nb(xabs, fm.p, wl, y)
@@ -434,6 +426,22 @@ def gust_residuals_lanes(xa, P, z, fm, crow, hpred, res, innov, st, cl):
             innov[o, l] = mu / np.sqrt(s)
 
 
+@kernel(inline="always")
+def _apply_gain(xa, P, h, v, gs):
+    """One scalar update of every lane from ``h = P c^T`` and ``gs = [(z - pred) / s,
+    1 / s]``: ``X += h gs_0``, ``v = h gs_1``, ``P -= v h^T`` on the upper triangle."""
+    n = xa.shape[0]
+    L = xa.shape[1]
+    for a in range(n):
+        for l in range(L):
+            xa[a, l] += h[a, l] * gs[0, l]
+            v[a, l] = h[a, l] * gs[1, l]
+    for a in range(n):
+        for b in range(a, n):
+            for l in range(L):
+                P[a, b, l] -= v[a, l] * h[b, l]
+
+
 @kernel
 def _gupdate(xa, P, z, fm, crow, h, v, gs, hpred, xp, st, cl):
     """Sequential scalar updates with the 12 outputs in order, on the upper
@@ -465,14 +473,7 @@ def _gupdate(xa, P, z, fm, crow, h, v, gs, hpred, xp, st, cl):
                     sv += cl[j, l] * h[j, l]
                 gs[0, l] = (z[r, l] - pred) / sv
                 gs[1, l] = 1.0 / sv
-            for a in range(n):
-                for l in range(L):
-                    xa[a, l] += h[a, l] * gs[0, l]
-                    v[a, l] = h[a, l] * gs[1, l]
-            for a in range(n):
-                for b in range(a, n):
-                    for l in range(L):
-                        P[a, b, l] -= v[a, l] * h[b, l]
+            _apply_gain(xa, P, h, v, gs)
         return
     for r in range(z.shape[0]):
         _c_row(fm, r, crow)
@@ -501,14 +502,7 @@ def _gupdate(xa, P, z, fm, crow, h, v, gs, hpred, xp, st, cl):
                     sv += crow[j] * h[j, l]
             gs[0, l] = (z[r, l] - pred) / sv
             gs[1, l] = 1.0 / sv
-        for a in range(n):
-            for l in range(L):
-                xa[a, l] += h[a, l] * gs[0, l]
-                v[a, l] = h[a, l] * gs[1, l]
-        for a in range(n):
-            for b in range(a, n):
-                for l in range(L):
-                    P[a, b, l] -= v[a, l] * h[b, l]
+        _apply_gain(xa, P, h, v, gs)
 
 
 @kernel
