@@ -384,8 +384,8 @@ def _isolation(design, tr, sizes, rec: TrialRecord) -> dict:
     """``sensor_bias_hat_end`` and ``isolated`` of a sensor transition's lanes
     (:func:`classify_sensor`)."""
     L = rec.xa_end.shape[1]
-    row = design.bias_row(tr.output)
-    if row is None or row >= rec.xa_end.shape[0]:
+    row = design.bias_row(tr.output)  # rec.xa_end holds the whole estimate
+    if row is None:
         return {"sensor_bias_hat_end": np.full(L, np.nan), "isolated": np.zeros(L, dtype=bool)}
     hat = rec.xa_end[row].copy()
     size = np.asarray(sizes, dtype=float)

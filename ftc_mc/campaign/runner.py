@@ -134,7 +134,8 @@ def run_campaign(config, *, trials=None, seed=None, signature=None, jobs: int = 
     jobs : int
         Workers (threads, processes or Dask workers, ``backend``); 1 runs in this
         process alone; -1 every core, or with worker processes this process
-        alone for a small run (:func:`auto_jobs`).  Results are identical for every value.
+        alone for a small run (:func:`auto_jobs`).  Results are identical for
+        every value.
     progress : bool
         Show a tqdm bar counting finished trials.
     backend : {"threads", "loky", "dask"}

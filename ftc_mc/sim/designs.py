@@ -71,9 +71,9 @@ class Design:
         ``conventions.TEST_ONE_STEP`` or ``TEST_GLR``.
     window : int
         GLR window [steps] (1 with the one-step test).
-    key : tuple
-        Equal for designs whose runs may share a start (same filter model and
-        initial covariance, same test and window; ``ftc_mc/sim/lanes.py``).
+    key : str
+        Equal for designs whose runs may share a start (``ftc_mc/sim/lanes.py``):
+        designs differing at most in Table 1's signature and thresholds.
     biases : tuple of str
         Outputs whose sensor bias the design estimates, in the order of their
         states (the last ``len(biases)`` of the estimate).
@@ -86,7 +86,7 @@ class Design:
     P0: np.ndarray
     test: int
     window: int
-    key: tuple
+    key: str
     biases: tuple = ()
 
     @property
@@ -186,11 +186,9 @@ def build_design(name: str, dc: DesignConfig, plant: LinearPlant, est: Estimator
                   else int(round(dc.min_change_s / plant.dt)))
     det = _with_test(detection(plant, s), test, window, min_window)._replace(
         settle=int(round(dc.settle_s / plant.dt)))
-    key = (dc.estimator, dc.design_turbulence if dc.estimator == "gust_aware" else None,
-           dc.prediction, s.sigma_qx, s.sigma_qb, tuple(sorted(dc.state_noise.items())),
-           test, window, min_window, dc.settle_s, fm.relin, tuple(dc.sensor_biases),
-           tuple(sorted(dc.sensor_bias_sd.items())),
-           tuple(sorted(dc.sensor_bias_walk.items())))
+    # every field but those Table 1 reads only when it decides (a shared start runs
+    # with resets disabled)
+    key = dc.model_dump_json(exclude={"signature", "t_q", "t_nx"})
     return Design(name=name, est=s, fm=fm, det=det, P0=_c(P0), test=test, window=window,
                   key=key, biases=tuple(dc.sensor_biases))
 

@@ -3,8 +3,8 @@
 :func:`simulate` runs the same inputs under several designs and Table 1
 detections (the designs run, and in a sweep each at every threshold point).  Alone, each
 detection runs every lane from the start (:func:`ftc_mc.core.trial.run_trials`).
-Shared, the runs are grouped by design key (the same filter model, initial
-covariance, residual test and window: :class:`ftc_mc.sim.designs.Design`); per
+Shared, the runs are grouped by design key (designs differing at most in Table
+1's signature and thresholds: :class:`ftc_mc.sim.designs.Design`); per
 group, the lanes are first advanced once to a step ``k_share`` with resets
 disabled, recording the largest ``r_q`` and ``r_nx`` of each lane; then, for
 each detection of the group:
