@@ -16,8 +16,9 @@ Usage::
 Then the detection designs of issue 13 (``DESIGNS``) on the nonlinear plant in
 moderate turbulence, each run alone on the same chunk: the paper's filter
 (``swapped``), the gust-aware filter (18 states, linear prediction) and the
-extended filter (the airframe predicts), with the one-step or the GLR test;
-ratios against ``swapped``.
+extended filter (the airframe predicts), with the one-step or the GLR test, and
+the sensor-aware design of issue 14 (the paper's filter with three sensor biases:
+17 states on the general filter); ratios against ``swapped``.
 
 The last line is ``linear_trials_per_s=<a> nonlinear_trials_per_s=<b>
 nonlinear_moderate_trials_per_s=<c> ratio=<a/b>`` (nominal controller unless
@@ -55,6 +56,7 @@ DESIGNS = {
     "gust_glr": {"estimator": "gust_aware", "test": "glr", "window_s": 2.0},
     "extended_glr": {"estimator": "gust_aware", "prediction": "nonlinear", "test": "glr",
                      "window_s": 2.0},
+    "sensor_aware": {"sensor_biases": ["q", "n_x", "n_z"], "settle_s": 3.0},
 }
 """Designs timed on the nonlinear plant in moderate turbulence (``swapped``: the
 paper's filter, the reference)."""
