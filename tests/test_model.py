@@ -8,13 +8,15 @@ import numpy as np
 import pytest
 import scipy.integrate
 import scipy.linalg
+import scipy.signal
 from click.testing import CliRunner
 
 from ftc_mc.cli import cli
 from ftc_mc.config import EstimatorConfig
 from ftc_mc.model.airframe import X8
 from ftc_mc.model.dynamics import derivatives, outputs
-from ftc_mc.model.linear import build_plant, named_eigenvalues, redundancy
+from ftc_mc.model.linear import build_plant, named_eigenvalues, redundancy, zoh
+from ftc_mc.model.wind import wind_matrices
 
 
 def test_trim_is_an_equilibrium(plant):
@@ -58,6 +60,21 @@ def test_discretisation_is_zoh(plant):
     E = scipy.linalg.expm(M * plant.dt)
     np.testing.assert_allclose(plant.A, E[:n, :n], atol=1e-12)
     np.testing.assert_allclose(plant.B, E[:n, n:], atol=1e-12)
+
+
+def test_zoh_is_scipy_signal_to_the_bit(plant):
+    # model.linear.zoh stands in for scipy.signal.cont2discrete(method="zoh") so
+    # that runs need not import scipy.signal; results must not move
+    zeros = np.zeros((plant.Cc.shape[0], plant.Bc.shape[1]))
+    A, B, C, _, _ = scipy.signal.cont2discrete((plant.Ac, plant.Bc, plant.Cc, zeros),
+                                               plant.dt, method="zoh")
+    assert np.array_equal(plant.A, A) and np.array_equal(plant.B, B)
+    assert np.array_equal(plant.C, C) and plant.C is not plant.Cc
+    Bw, _, Ewc = wind_matrices(plant)
+    _, Bw_ref, _, _, _ = scipy.signal.cont2discrete(
+        (plant.Ac, Ewc, plant.Cc, np.zeros((plant.Cc.shape[0], 3))), plant.dt, method="zoh")
+    assert np.array_equal(Bw, Bw_ref)
+    assert np.array_equal(zoh(plant.Ac, Ewc, 0.0)[1], np.zeros_like(Ewc))
 
 
 def test_linear_model_matches_nonlinear_for_small_inputs(plant):

@@ -11,12 +11,11 @@ as ``A`` and ``B``; a linear model read from a file brings its own.
 from __future__ import annotations
 
 import numpy as np
-import scipy.signal
 
 from ..conventions import N_X as N_STATE
 from ..conventions import N_Z as N_OUTPUT
 from ..core.nonlinear import derivatives_nb, outputs_nb
-from .linear import LinearPlant, jacobian
+from .linear import LinearPlant, jacobian, zoh
 
 
 def wind_matrices(plant: LinearPlant):
@@ -56,8 +55,7 @@ def wind_matrices(plant: LinearPlant):
     # states themselves) do not depend on the air's motion
     Ewc[3:] = 0.0
     Dw[:6] = 0.0
-    _, Bw, _, _, _ = scipy.signal.cont2discrete(
-        (plant.Ac, Ewc, plant.Cc, np.zeros((N_OUTPUT, 3))), plant.dt, method="zoh")
+    _, Bw = zoh(plant.Ac, Ewc, plant.dt)
     return np.ascontiguousarray(Bw), np.ascontiguousarray(Dw), Ewc
 
 
