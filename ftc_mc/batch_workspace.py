@@ -52,11 +52,9 @@ LaneWorkspace = namedtuple("LaneWorkspace", [
     "work",   # (step_rows(n), n, L)  P_{k+1|k}, the update's gains, x_{k|k}
     "res",    # (3, L)                [r_q, r_nx, r_nz] (eqs. 9-11)
     "block",  # (L,) int64            block reset this step (Table 1)
-    "innov",  # (3, L)                signed normalised innovations
 ])
 """Arrays for :func:`ftc_mc.core.batch.filter_step_lanes`, in its argument order:
-``filter_step_lanes(xa, P, u, z, fm, det, ws.phi, ws.T, ws.work, ws.res, ws.block,
-ws.innov)``."""
+``filter_step_lanes(xa, P, u, z, fm, det, ws.phi, ws.T, ws.work, ws.res, ws.block)``."""
 
 
 def new_lane_workspace(L: int, n_aug: int = N_AUG) -> LaneWorkspace:
@@ -74,7 +72,7 @@ def new_lane_workspace(L: int, n_aug: int = N_AUG) -> LaneWorkspace:
     -------
     LaneWorkspace
         ``phi`` (9, 5, L), ``T`` (9, n, L), ``work`` (step_rows(n), n, L),
-        ``res`` (3, L) float64, ``block`` (L,) int64 and ``innov`` (3, L).  ``work[n:n + 13]``
+        ``res`` (3, L) float64 and ``block`` (L,) int64.  ``work[n:n + 13]``
         can serve as the work array ``h`` of
         :func:`~ftc_mc.core.batch.update_lanes`.
 
@@ -90,5 +88,4 @@ def new_lane_workspace(L: int, n_aug: int = N_AUG) -> LaneWorkspace:
     return LaneWorkspace(phi=lane_zeros((N_X, N_FAULT, L)), T=lane_zeros((N_X, n, L)),
                          work=lane_zeros((step_rows.py_func(n), n, L)),
                          res=lane_zeros((len(RESIDUAL_NAMES), L)),
-                         block=lane_zeros(L, dtype=np.int64),
-                         innov=lane_zeros((len(RESIDUAL_NAMES), L)))
+                         block=lane_zeros(L, dtype=np.int64))

@@ -85,11 +85,11 @@ def run_single(xa, P, U, Z, fm, det, phi, T, h, res, x_prev, P_prev):
 
 
 @numba.njit
-def run_lanes(xa, P, U, Z, fm, det, phi, T, work, res, block, innov):
+def run_lanes(xa, P, U, Z, fm, det, phi, T, work, res, block):
     """``filter_step_lanes`` over the first axis of ``U``, ``Z``; returns resets."""
     n = 0
     for k in range(U.shape[0]):
-        filter_step_lanes(xa, P, U[k], Z[k], fm, det, phi, T, work, res, block, innov)
+        filter_step_lanes(xa, P, U[k], Z[k], fm, det, phi, T, work, res, block)
         for l in range(block.shape[0]):
             n += block[l] != 0
     return n

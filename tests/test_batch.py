@@ -164,7 +164,8 @@ def test_residuals_lanes(plant):
     z = rng.normal(0.0, 0.3, (12, L))
     res = np.zeros((3, L))
     innov = np.zeros((3, L))
-    kb.residuals_lanes(X, lanes_of(Ps), z, fm, res, innov)
+    kb.residuals_lanes(X, lanes_of(Ps), z, fm, res)
+    kb.innovations_lanes(X, lanes_of(Ps), z, fm, innov)
     for l in range(L):
         out = np.zeros(3)
         kk.residuals(X[:, l].copy(), Ps[l], z[:, l].copy(), fm, out)

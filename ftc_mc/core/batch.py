@@ -281,7 +281,47 @@ def predict_lanes(xa, P, u, fm, phi, T):
 
 # ------------------------------------------------------------------ residuals
 @kernel
-def residuals_lanes(xa, P, z, fm, res, innov):
+def _normalised_lanes(xa, P, z, fm, out, signed):
+    """``mu_i^2 / S_ii`` (``signed`` false) or ``mu_i / sqrt(S_ii)`` (true) of the
+    residual outputs of every lane into ``out`` (3, L); see :func:`residuals_lanes`.
+
+    One loop body for both, so the two agree on ``mu_i`` and ``S_ii`` to the bit;
+    ``signed`` is a constant in each caller, so the branch leaves the lane loop.
+    """
+    L = xa.shape[1]
+    for o in range(len(RESIDUAL_OUTPUTS)):
+        r = RESIDUAL_OUTPUTS[o]
+        s_idx = fm.c_ident[r]
+        rr = fm.r_diag[r]
+        if s_idx >= 0:
+            for l in range(L):
+                mu = z[r, l] - xa[s_idx, l]
+                s = P[s_idx, s_idx, l] + rr
+                if signed:
+                    out[o, l] = mu / np.sqrt(s)
+                else:
+                    out[o, l] = mu * mu / s
+        else:
+            c = _row_x(fm.C, r)
+            for l in range(L):
+                pred = 0.0
+                s = 0.0
+                for j in range(N_X):
+                    pred += c[j] * xa[j, l]
+                    acc = 0.0
+                    for k in range(N_X):
+                        acc += P[j, k, l] * c[k]
+                    s += c[j] * acc
+                mu = z[r, l] - pred
+                s = s + rr
+                if signed:
+                    out[o, l] = mu / np.sqrt(s)
+                else:
+                    out[o, l] = mu * mu / s
+
+
+@kernel
+def residuals_lanes(xa, P, z, fm, res):
     """Normalised residuals ``r_q, r_nx, r_nz`` of every lane (eqs. 9-11).
 
     As :func:`ftc_mc.core.kalman.residuals`: ``r_i = mu_i^2 / (C_i P C_i^T + R_ii)``
@@ -299,36 +339,28 @@ def residuals_lanes(xa, P, z, fm, res, innov):
     res : ndarray, shape (3, L)
         Written with ``[r_q, r_nx, r_nz]`` of each lane (outputs
         :data:`ftc_mc.conventions.RESIDUAL_OUTPUTS`).
-    innov : ndarray, shape (3, L)
-        Written with the signed normalised innovations ``mu_i / sqrt(S_ii)``
-        (``r_i = innov_i^2`` up to rounding; the GLR test reads them).
     """
-    L = xa.shape[1]
-    for o in range(len(RESIDUAL_OUTPUTS)):
-        r = RESIDUAL_OUTPUTS[o]
-        s_idx = fm.c_ident[r]
-        rr = fm.r_diag[r]
-        if s_idx >= 0:
-            for l in range(L):
-                mu = z[r, l] - xa[s_idx, l]
-                s = P[s_idx, s_idx, l] + rr
-                res[o, l] = mu * mu / s
-                innov[o, l] = mu / np.sqrt(s)
-        else:
-            c = _row_x(fm.C, r)
-            for l in range(L):
-                pred = 0.0
-                s = 0.0
-                for j in range(N_X):
-                    pred += c[j] * xa[j, l]
-                    acc = 0.0
-                    for k in range(N_X):
-                        acc += P[j, k, l] * c[k]
-                    s += c[j] * acc
-                mu = z[r, l] - pred
-                s = s + rr
-                res[o, l] = mu * mu / s
-                innov[o, l] = mu / np.sqrt(s)
+    _normalised_lanes(xa, P, z, fm, res, False)
+
+
+@kernel
+def innovations_lanes(xa, P, z, fm, innov):
+    """Signed normalised innovations ``mu_i / sqrt(S_ii)`` of every lane, on the
+    same prediction as :func:`residuals_lanes` (``r_i = innov_i^2`` up to
+    rounding); the GLR test reads them (:mod:`ftc_mc.core.glr`).
+
+    Apart from :func:`residuals_lanes` because the paper's one-step test does
+    not need them: written in the same lane loop, they cost 8-15 % of
+    :func:`filter_step_lanes` (``scripts/bench_core.py``, 64-128 lanes).
+
+    Parameters
+    ----------
+    xa, P, z, fm
+        As :func:`residuals_lanes`.
+    innov : ndarray, shape (3, L)
+        Written with the signed normalised innovations.
+    """
+    _normalised_lanes(xa, P, z, fm, innov, True)
 
 
 # ------------------------------------------------------------------ signature
@@ -556,13 +588,13 @@ def project_lanes(xa, fm):
 
 # ------------------------------------------------------------------ step
 @kernel
-def filter_predict_lanes(xa, P, u, z, fm, phi, T, work, res, innov):
+def filter_predict_lanes(xa, P, u, z, fm, phi, T, work, res):
     """First half of :func:`filter_step_lanes`: predict (eq. 5) into ``work[:n]``
     and the residuals (eqs. 9-11); ``x_{k|k}`` is kept in ``work`` for a re-prediction.
 
-    ``xa`` holds ``X_{k+1|k}`` on return, ``P`` still ``P_{k|k}``.  Parameters
-    as :func:`filter_step_lanes`; ``innov`` (3, L) is written with the signed
-    normalised innovations.
+    ``xa`` holds ``X_{k+1|k}`` on return, ``P`` still ``P_{k|k}`` and
+    ``work[:n]`` ``P_{k+1|k}`` (for :func:`innovations_lanes`).  Parameters as
+    :func:`filter_step_lanes`.
     """
     n = xa.shape[0]
     L = xa.shape[1]
@@ -572,7 +604,7 @@ def filter_predict_lanes(xa, P, u, z, fm, phi, T, work, res, innov):
         for l in range(L):
             x_prev[i, l] = xa[i, l]
     _predict(xa, P, Pn, u, fm, phi, T, 0, L)
-    residuals_lanes(xa, Pn, z, fm, res, innov)
+    residuals_lanes(xa, Pn, z, fm, res)
 
 
 @kernel
@@ -618,7 +650,7 @@ def filter_correct_lanes(xa, P, u, z, fm, det, phi, T, work, block):
 
 
 @kernel
-def filter_step_lanes(xa, P, u, z, fm, det, phi, T, work, res, block, innov):
+def filter_step_lanes(xa, P, u, z, fm, det, phi, T, work, res, block):
     """Advance every lane's filter by one sampling period, as
     :func:`ftc_mc.core.step.filter_step`.
 
@@ -653,9 +685,7 @@ def filter_step_lanes(xa, P, u, z, fm, det, phi, T, work, res, block, innov):
         Written with ``[r_q, r_nx, r_nz]`` on the first prediction.
     block : ndarray of int64, shape (L,)
         Written with the block reset this step per lane (0 if none).
-    innov : ndarray, shape (3, L)
-        Written with the signed normalised innovations.
     """
-    filter_predict_lanes(xa, P, u, z, fm, phi, T, work, res, innov)
+    filter_predict_lanes(xa, P, u, z, fm, phi, T, work, res)
     signature_lanes(res, det, block)
     filter_correct_lanes(xa, P, u, z, fm, det, phi, T, work, block)

@@ -39,7 +39,8 @@ from ..conventions import (C_ELEVON, I_B1_LEFT, I_B1_THRUST, N_AUG, N_FAULT, N_M
                            N_U, N_X, NO_RESET, RESET_THRUST, STATUS_AIRSPEED,
                            STATUS_ALPHA, STATUS_NONFINITE, STATUS_NOT_PSD, STATUS_OK,
                            TEST_GLR)
-from .batch import filter_correct_lanes, filter_predict_lanes, signature_lanes
+from .batch import (filter_correct_lanes, filter_predict_lanes, innovations_lanes,
+                    signature_lanes)
 from .glr import glr_lanes, glr_restart
 from .gustfilter import gust_correct_lanes, gust_predict_lanes
 from .belief import belief_update
@@ -173,7 +174,9 @@ def filter_update(scheme, st, k, work):
     paper = st.xa.shape[0] == N_AUG and fm.nl == 0
     if paper:
         filter_predict_lanes(st.xa, st.P, work.u, work.z, fm, work.phi, work.T, work.fwork,
-                             res, work.innov)
+                             res)
+        if det.test == TEST_GLR:
+            innovations_lanes(st.xa, work.fwork[0:st.xa.shape[0]], work.z, fm, work.innov)
     else:
         gust_predict_lanes(st.xa, st.P, fm, work, st, k)
     if det.test == TEST_GLR:
