@@ -118,3 +118,23 @@ def test_the_kernel_cache_follows_every_kernel_module(tmp_path, monkeypatch):
     assert jit.source_digest(copy / "core") != same
     monkeypatch.setenv("FTC_MC_CACHE_DIR", str(tmp_path / "c"))
     assert jit.cache_dir() == tmp_path / "c" / "numba" / same
+
+
+@pytest.mark.skipif(not jit.CACHE, reason="FTC_MC_NUMBA_CACHE=0")
+def test_sweep_reuses_the_trial_kernels_advance(tmp_path):
+    """The sweep's shared start calls ``advance`` from Python; ``run_trials``
+    compiles it as a callee.  Both must ask for one signature, or a user's first
+    sweep compiles ``advance`` a second time (about 50 s cold): a constant
+    ``0`` for its start step was typed ``Literal[int](0)`` inside ``run_trials``.
+    Read from Numba's on-disk index of ``advance``, which holds every signature
+    compiled from this source (the folder is named after it, core/jit.py)."""
+    import ftc_mc
+    from ftc_mc.core.trial import advance
+
+    cfg = {"campaign": {"transitions": ["elevon_lock"], "trials": 2},
+           "controller": {"kind": "nominal"},
+           "timing": {"fault_time_s": 5.0, "window_s": 5.0, "duration_s": 15.0}}
+    ftc_mc.run_campaign(cfg, trials=2, jobs=1, progress=False, out=tmp_path / "run")
+    ftc_mc.run_sweep(cfg, "10,25", trials=2, jobs=1, progress=False, out=tmp_path / "sweep")
+    index = advance._cache._cache_file._load_index()
+    assert len(index) == 1, [str(key[0])[-60:] for key in index]

@@ -179,4 +179,7 @@ def run_trials(scheme, flight, inp, rec):
     st = new_state(inp.w.shape[2], inp.xa0.shape[0], scheme.detection.window)
     init_state(inp, st, rec)
     init_jacobians(scheme.filter, st)
-    advance(scheme, flight, inp, rec, st, 0, flight.timing.n_steps)
+    # np.int64(0), not a bare 0: Numba types a constant argument as Literal[int](0)
+    # and would compile advance for it apart from the int64 start that the
+    # sweep's shared start passes from Python (a second cold compile of ~50 s)
+    advance(scheme, flight, inp, rec, st, np.int64(0), flight.timing.n_steps)
