@@ -138,3 +138,70 @@ def test_sweep_reuses_the_trial_kernels_advance(tmp_path):
     ftc_mc.run_sweep(cfg, "10,25", trials=2, jobs=1, progress=False, out=tmp_path / "sweep")
     index = advance._cache._cache_file._load_index()
     assert len(index) == 1, [str(key[0])[-60:] for key in index]
+
+
+def _in_thread(fn):
+    import threading
+    t = threading.Thread(target=fn, daemon=True)
+    t.start()
+    return t
+
+
+def test_waiting_lock_waits_for_the_holder(tmp_path):
+    import threading
+    from ftc_mc.io.lock import waiting
+    path = tmp_path / "sub" / "x.lock"
+    waited, inside = threading.Event(), threading.Event()
+
+    def second():
+        with waiting(path, on_wait=waited.set, poll_s=0.01) as held:
+            assert held
+            inside.set()
+
+    with waiting(path) as held:
+        assert held and path.exists()
+        t = _in_thread(second)
+        assert waited.wait(10)
+        assert not inside.wait(0.2)  # still held here
+    assert inside.wait(10)
+    t.join(10)
+    with waiting(path, on_wait=waited.clear) as held:  # free again: no wait
+        assert held and waited.is_set()
+
+
+@pytest.mark.parametrize("holder_compiles", [True, False])
+def test_compiled_once_waits_then_loads(tmp_path, monkeypatch, holder_compiles):
+    """A second process finds the compile lock busy: it says it waits, and once
+    the holder has filled the cache it announces no compile of its own; if the
+    holder ended without filling it, the waiter compiles and says so."""
+    import threading
+    from ftc_mc.io.lock import waiting
+    from ftc_mc.sim.compiling import WAIT_NOTICE, compiled_once, lock_path
+    monkeypatch.setattr(jit, "CACHE", True)
+    monkeypatch.setattr(numba.config, "CACHE_DIR", str(tmp_path))
+    index = {}
+    fake = _FakeDispatcher(index)
+    out = io.StringIO()
+    inside = threading.Event()
+
+    def waiter():
+        with compiled_once(fake, stream=out):
+            inside.set()
+
+    with waiting(lock_path(fake)):
+        t = _in_thread(waiter)
+        for _ in range(1000):
+            if WAIT_NOTICE in out.getvalue():
+                break
+            inside.wait(0.01)
+        assert out.getvalue() == WAIT_NOTICE + "\n" and not inside.is_set()
+        if holder_compiles:
+            index[_key(fake)] = "file.nbc"
+    assert inside.wait(10)
+    t.join(10)
+    lines = out.getvalue().splitlines()
+    assert lines[0] == WAIT_NOTICE
+    if holder_compiles:
+        assert lines == [WAIT_NOTICE]
+    else:
+        assert len(lines) == 2 and lines[1].startswith("ftc-mc: compiling the simulation")

@@ -17,6 +17,7 @@ both hold one directory.
 
 from __future__ import annotations
 
+import contextlib
 import datetime as _dt
 import json
 import os
@@ -286,3 +287,50 @@ def holder(directory) -> dict | None:
         time.sleep(0.01)
         info = _read_info(path)
     return {"pid": None, "hostname": None, "started": None, "command": None, **(info or {})}
+
+
+@contextlib.contextmanager
+def waiting(path, on_wait=None, poll_s: float = 0.5):
+    """Hold an exclusive lock on the file ``path`` for a ``with`` block, waiting
+    while another process (or another open of it in this one) holds it.
+
+    Unlike :class:`OutputLock` this waits instead of refusing, and leaves the
+    file in place: it serialises work that others then reuse, such as the one
+    compile of the trial kernel (:func:`ftc_mc.sim.compiling.compiled_once`).
+    A holder that dies drops the lock with its file descriptor.
+
+    Parameters
+    ----------
+    path : str or Path
+        The lock file; created with its folders if missing.
+    on_wait : callable, optional
+        Called once, without arguments, when the lock is busy at first.
+    poll_s : float
+        How often a busy lock is tried again [s].
+
+    Yields
+    ------
+    bool
+        True when the lock is held; False when the file cannot be opened or
+        locked (a read-only folder, a file system without locks), in which case
+        the block runs unguarded.
+    """
+    try:
+        Path(path).parent.mkdir(parents=True, exist_ok=True)
+        fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o644)
+    except OSError:
+        yield False
+        return
+    try:
+        try:
+            held = _try_lock(fd)
+            if not held and on_wait is not None:
+                on_wait()
+            while not held:
+                time.sleep(poll_s)
+                held = _try_lock(fd)
+        except OSError:  # no locks on this file system
+            held = False
+        yield held
+    finally:
+        os.close(fd)  # drops the lock

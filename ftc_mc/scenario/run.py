@@ -20,9 +20,9 @@ import pandas as pd
 
 from ..config.schema import ScenarioConfig
 from ..conventions import CONTROLLER_NAMES, MODE_NAMES, STATUS_NAMES
-from ..core.jit import announce_compile
 from ..core.trial import run_trials
 from ..model.faults import mode_of
+from ..sim.compiling import compiled_once
 from ..sim.inputs import scenario_inputs
 from ..sim.lanes import HISTORY_RESETS, run_alone
 from ..sim.setup import SimSetup, build_setup, runs_of
@@ -75,8 +75,8 @@ def run_scenario(sc: ScenarioConfig, seed: int | None = None,
         setup = build_setup(sc)
     name = runs_of(sc)[0]
     inp = scenario_inputs(setup, sc.scenario)
-    announce_compile(run_trials)
-    rec = run_alone(setup, name, setup.det[name], inp, HISTORY_RESETS, history=True)
+    with compiled_once(run_trials):
+        rec = run_alone(setup, name, setup.det[name], inp, HISTORY_RESETS, history=True)
     k_sw, b0, b1 = inp.k_switch, inp.b0[:, :, 0], inp.b1[:, :, 0]
     modes = np.array([int(mode_of(b, *setup.beta)) for b in b1], dtype=np.int64)
     ts = _timeseries(setup, sc, rec, k_sw, b0, b1)

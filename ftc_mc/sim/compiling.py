@@ -1,0 +1,64 @@
+"""One compile of the trial kernel at a time on a machine.
+
+A cold compile of :func:`ftc_mc.core.trial.run_trials` takes about two minutes
+(``scripts/bench_campaign.py``).  Processes that start together on an empty
+cache (two runs launched at once, Dask or test workers on one machine) would
+each compile it, on cores they then share.  :func:`compiled_once` makes the
+first one compile while the others wait for it and then load the result from
+Numba's cache.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import sys
+from pathlib import Path
+
+import numba
+
+from ..core import jit
+from ..io.lock import waiting
+
+WAIT_NOTICE = ("ftc-mc: another process is compiling the simulation kernels; waiting "
+               "for it, then loading them")
+"""Printed to stderr when the compile lock is busy."""
+
+
+def lock_path(dispatcher) -> Path:
+    """The compile lock of ``dispatcher``: a file beside its cached overloads
+    (the folder of :func:`ftc_mc.core.jit.cache_dir`, or ``NUMBA_CACHE_DIR``)."""
+    return Path(numba.config.CACHE_DIR) / f"{dispatcher.py_func.__name__}.compile.lock"
+
+
+@contextlib.contextmanager
+def compiled_once(dispatcher, stream=None):
+    """Run the ``with`` block, which calls ``dispatcher`` first in this process,
+    as the machine's only compile of it.
+
+    When the call would compile (:func:`ftc_mc.core.jit.needs_compile`), the
+    block waits for the compile lock (:func:`lock_path`), saying so on
+    ``stream`` (stderr) if another process holds it; holding the lock, it
+    announces the compile (:func:`ftc_mc.core.jit.announce_compile`), which
+    says nothing if the holder before it has filled the cache meanwhile.
+    Without a disk cache (``FTC_MC_NUMBA_CACHE=0``) there is nothing to share:
+    the block only announces.
+
+    Parameters
+    ----------
+    dispatcher : numba dispatcher
+        The kernel the block calls (``run_trials``).
+    stream : file, optional
+        Where the notices go (default stderr).
+    """
+    if not jit.CACHE or jit.needs_compile(dispatcher) is not True:
+        jit.announce_compile(dispatcher, stream=stream)
+        yield
+        return
+    out = sys.stderr if stream is None else stream
+
+    def say_wait():
+        print(WAIT_NOTICE, file=out, flush=True)
+
+    with waiting(lock_path(dispatcher), on_wait=say_wait):
+        jit.announce_compile(dispatcher, stream=stream)
+        yield
