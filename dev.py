@@ -5,6 +5,7 @@ nothing but Python 3.11::
 
     python3 dev.py run     # create .venv if needed, install, run the main job
     python3 dev.py test    # create .venv if needed, install with test extras, run pytest
+                           # (-q -n auto: one pytest-xdist worker per core)
 
 Extra arguments after ``run`` go to ``ftc-mc``; after ``test`` to ``pytest``.
 The install is repeated only when ``pyproject.toml`` changes.
@@ -57,7 +58,9 @@ def main(argv: list[str]) -> int:
         args = [str(BIN / "ftc-mc")] + (rest or MAIN_JOB)
     else:
         ensure_venv("test")
-        args = [str(PY), "-m", "pytest"] + (rest or ["-q"])
+        # one worker per core; tests/conftest.py orders the tests so that the
+        # workers share the trial kernel's cold compile
+        args = [str(PY), "-m", "pytest"] + (rest or ["-q", "-n", "auto"])
     return subprocess.run(args, cwd=ROOT).returncode
 
 

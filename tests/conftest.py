@@ -1,9 +1,55 @@
-"""Shared fixtures: the linear plant and paper-default estimator settings."""
+"""Shared fixtures: the linear plant and paper-default estimator settings; the
+order that lets two test workers share the trial kernel's one cold compile."""
+
+from pathlib import Path
 
 import pytest
 
 from ftc_mc.model.linear import build_plant
 from ftc_mc.sim.estimator import EstimatorSettings
+
+ROOT = Path(__file__).resolve().parents[1]
+
+TRIAL_KERNEL_FILES = {
+    "test_airframe_runs.py", "test_api.py", "test_campaign.py", "test_compile_notice.py",
+    "test_dask.py", "test_designs.py", "test_fuzz_configs.py", "test_golden.py",
+    "test_lock.py", "test_operating.py", "test_report.py", "test_report_plant.py",
+    "test_resume.py", "test_scenario.py", "test_sensor_faults.py", "test_sweep.py",
+    "test_trial_validity.py", "test_truth_plant.py",
+}
+"""Test files that run campaigns, sweeps or scenarios (the trial kernel
+``run_trials``); the other files test kernels and models piece by piece."""
+
+
+def pytest_collection_modifyitems(config, items):
+    """Tests of the trial kernel after the piecewise ones (otherwise in file
+    order).  ``python3 dev.py test`` runs two pytest-xdist workers: the first
+    compiles the trial kernel before its first test (:func:`_compile_first`,
+    about two minutes cold) while the second runs piecewise tests, instead of
+    both reaching the kernel at once and one waiting for the other
+    (:func:`ftc_mc.sim.compiling.compiled_once`).  Only the order changes."""
+    def late(item):
+        return item.path.name in TRIAL_KERNEL_FILES or "trial_kernel" in item.fixturenames
+    items.sort(key=late)
+
+
+@pytest.fixture(scope="session")
+def trial_kernel():
+    """The trial kernel compiled, or loaded from Numba's cache, in this process;
+    a compile in another process is waited for.  Tests that call
+    ``core.trial.advance`` directly use it, so that they load what
+    ``run_trials`` compiled instead of compiling ``advance`` alone."""
+    from ftc_mc.campaign.chunk import chunk_spec, warm_up
+    from ftc_mc.config import load_config
+    cfg = load_config(ROOT / "configs" / "paper_tables.yaml")
+    warm_up(chunk_spec(cfg), cfg.campaign.transitions[0])
+
+
+@pytest.fixture(scope="session", autouse=True)
+def _compile_first(request):
+    """The first xdist worker gets the trial kernel before any test."""
+    if getattr(request.config, "workerinput", {}).get("workerid") == "gw0":
+        request.getfixturevalue("trial_kernel")
 
 
 @pytest.fixture(scope="session")

@@ -190,6 +190,7 @@ def test_glr_against_direct_window():
     np.testing.assert_allclose(stat, e ** 2, rtol=1e-15)
 
 
+@pytest.mark.usefixtures("trial_kernel")
 def test_gust_glr_whole_loop(linear_gusts):
     """25 steps of ``advance`` with the gust-aware filter, the GLR test and the
     reconfiguring controller, against ``naive.advance_ref``."""
@@ -357,6 +358,7 @@ def test_relinearised_at_trim_is_the_trim_model(nonlinear_gusts):
             assert err <= 1e-4, (f, l, err)
 
 
+@pytest.mark.usefixtures("trial_kernel")
 def test_relinearised_whole_loop(nonlinear_gusts):
     """12 steps of ``advance`` on the nonlinear plant in moderate turbulence with
     the extended filter re-linearised every 5 steps (from the trim Jacobians of

@@ -580,6 +580,7 @@ def test_reconfigure(fixture, request):
 
 
 # ================================================================== the whole loop
+@pytest.mark.usefixtures("trial_kernel")
 @pytest.mark.parametrize("fixture", ["linear", "nonlinear_gusts"])
 def test_advance_matches_the_chained_twins(fixture, request):
     """The trial loop against the twins chained in NumPy over 25 steps (two
