@@ -207,6 +207,7 @@ def test_gust_glr_whole_loop(linear_gusts):
     assert rec.n_resets.sum() > 0
 
 
+@pytest.mark.usefixtures("trial_kernel")
 def test_gust_aware_residuals_are_chi_square(linear_gusts):
     """Without faults in moderate turbulence (linear truth, nominal controller),
     the gust-aware filter's normalised residuals average 1 (chi-square, one

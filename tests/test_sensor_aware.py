@@ -132,6 +132,7 @@ def test_builder_matches_definition(linear_gusts, estimator):
     assert d.key != base.key
 
 
+@pytest.mark.usefixtures("trial_kernel")
 def test_sensor_aware_names_biases():
     """16 trials each of a q bias and an n_x bias (linear plant, still air): the
     sensor-aware design estimates the bias within 25 % with a nominal belief at
