@@ -135,9 +135,15 @@ def test_sweep_reuses_the_trial_kernels_advance(tmp_path):
            "controller": {"kind": "nominal"},
            "timing": {"fault_time_s": 5.0, "window_s": 5.0, "duration_s": 15.0}}
     ftc_mc.run_campaign(cfg, trials=2, jobs=1, progress=False, out=tmp_path / "run")
+    before = set(advance._cache._cache_file._load_index())
     ftc_mc.run_sweep(cfg, "10,25", trials=2, jobs=1, progress=False, out=tmp_path / "sweep")
-    index = advance._cache._cache_file._load_index()
-    assert len(index) == 1, [str(key[0])[-60:] for key in index]
+    after = set(advance._cache._cache_file._load_index())
+    assert after == before, "the sweep compiled advance again"
+    # and no signature of this machine's was compiled for a literal step (a
+    # cache filled before this test could hold both)
+    magic = advance.targetctx.codegen().magic_tuple()
+    mine = [str(key[0]) for key in after if key[1] == magic]
+    assert mine and not any("Literal" in sig for sig in mine), [s[-60:] for s in mine]
 
 
 def _in_thread(fn):
@@ -167,6 +173,11 @@ def test_waiting_lock_waits_for_the_holder(tmp_path):
     t.join(10)
     with waiting(path, on_wait=waited.clear) as held:  # free again: no wait
         assert held and waited.is_set()
+        # a holder that never lets go is waited for at most timeout_s, then the
+        # block runs unguarded
+        gave_up = threading.Event()
+        with waiting(path, poll_s=0.01, timeout_s=0.05, on_timeout=gave_up.set) as second:
+            assert not second and gave_up.is_set()
 
 
 @pytest.mark.parametrize("holder_compiles", [True, False])
@@ -182,10 +193,13 @@ def test_compiled_once_waits_then_loads(tmp_path, monkeypatch, holder_compiles):
     index = {}
     fake = _FakeDispatcher(index)
     out = io.StringIO()
-    inside = threading.Event()
+    inside, busy = threading.Event(), threading.Event()
 
     def waiter():
         with compiled_once(fake, stream=out):
+            # the lock is kept only while this process compiles
+            with waiting(lock_path(fake), on_wait=busy.set, timeout_s=0.0):
+                pass
             inside.set()
 
     with waiting(lock_path(fake)):
@@ -201,6 +215,7 @@ def test_compiled_once_waits_then_loads(tmp_path, monkeypatch, holder_compiles):
     t.join(10)
     lines = out.getvalue().splitlines()
     assert lines[0] == WAIT_NOTICE
+    assert busy.is_set() is not holder_compiles
     if holder_compiles:
         assert lines == [WAIT_NOTICE]
     else:

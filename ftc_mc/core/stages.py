@@ -165,8 +165,8 @@ def filter_update(scheme, st, k, work):
         Step (the GLR window's ring position).
     work : TrialWork
         Reads ``u``, ``z``; writes ``res`` (the decision statistics: one-step
-        residuals or GLR), ``innov`` and ``block``; filter work ``phi``, ``T``,
-        ``fwork``, ``crow``.
+        residuals or GLR), ``block`` and, for the GLR test or the general
+        filter, ``innov``; filter work ``phi``, ``T``, ``fwork``, ``crow``.
     """
     fm = scheme.filter
     det = scheme.detection

@@ -290,7 +290,8 @@ def holder(directory) -> dict | None:
 
 
 @contextlib.contextmanager
-def waiting(path, on_wait=None, poll_s: float = 0.5):
+def waiting(path, on_wait=None, poll_s: float = 0.5, timeout_s: float | None = None,
+            on_timeout=None):
     """Hold an exclusive lock on the file ``path`` for a ``with`` block, waiting
     while another process (or another open of it in this one) holds it.
 
@@ -307,13 +308,18 @@ def waiting(path, on_wait=None, poll_s: float = 0.5):
         Called once, without arguments, when the lock is busy at first.
     poll_s : float
         How often a busy lock is tried again [s].
+    timeout_s : float, optional
+        Longest wait [s]; then the block runs unguarded (a holder stopped in a
+        debugger, or a file system whose locks always look busy).  None: no limit.
+    on_timeout : callable, optional
+        Called once, without arguments, when ``timeout_s`` runs out.
 
     Yields
     ------
     bool
         True when the lock is held; False when the file cannot be opened or
-        locked (a read-only folder, a file system without locks), in which case
-        the block runs unguarded.
+        locked (a read-only folder, a file system without locks) or the wait
+        ran out, in which case the block runs unguarded.
     """
     try:
         Path(path).parent.mkdir(parents=True, exist_ok=True)
@@ -326,7 +332,12 @@ def waiting(path, on_wait=None, poll_s: float = 0.5):
             held = _try_lock(fd)
             if not held and on_wait is not None:
                 on_wait()
+            deadline = None if timeout_s is None else time.monotonic() + timeout_s
             while not held:
+                if deadline is not None and time.monotonic() >= deadline:
+                    if on_timeout is not None:
+                        on_timeout()
+                    break
                 time.sleep(poll_s)
                 held = _try_lock(fd)
         except OSError:  # no locks on this file system

@@ -301,7 +301,7 @@ def zoh(Ac: np.ndarray, Bc: np.ndarray, dt: float):
     Both come from one matrix exponential of the block matrix
     ``[[Ac, Bc], [0, 0]] dt`` (Van Loan 1978), computed exactly as
     ``scipy.signal.cont2discrete(..., method="zoh")`` does (scipy 1.17), so the
-    results are the same to the bit (``tests/test_linear.py``); calling
+    results are the same to the bit (``tests/test_model.py``); calling
     ``scipy.linalg.expm`` directly spares every run the import of
     ``scipy.signal``, about 0.5 s.
 
