@@ -132,8 +132,8 @@ def needs_compile(dispatcher) -> bool | None:
 def announce_compile(dispatcher, duration="2 min", stream=None) -> bool:
     """Print :data:`COMPILE_NOTICE` to stderr if ``dispatcher`` is about to be
     compiled (:func:`needs_compile`); return whether it was printed.  The
-    duration is measured by ``scripts/bench_campaign.py`` (121 s after the
-    designs' kernels of issue 13 joined the trial loop)."""
+    duration is measured by ``scripts/bench_campaign.py`` (120-144 s since the
+    designs' kernels of issues 13-14 joined the trial loop)."""
     import sys
     if needs_compile(dispatcher) is not True:
         return False

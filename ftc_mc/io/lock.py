@@ -13,6 +13,10 @@ On release the holder deletes the file while still holding it, and only if the
 path still names the file it locked.  A process that locked a file which was
 meanwhile deleted from the path sees so and tries again, so two processes never
 both hold one directory.
+
+:func:`waiting` is the same ``flock`` for work that others wait for rather than
+refuse, such as the one compile of the trial kernel: it blocks (with a time
+limit) while the file is held, and leaves the file in place.
 """
 
 from __future__ import annotations
