@@ -18,7 +18,7 @@ TRIAL_KERNEL_FILES = {
     "test_trial_validity.py", "test_truth_plant.py",
 }
 """Test files that run campaigns, sweeps or scenarios (the trial kernel
-``run_trials``); the other files test kernels and models piece by piece."""
+``core.trial.advance``); the other files test kernels and models piece by piece."""
 
 
 def _late(item) -> bool:
@@ -39,9 +39,9 @@ def pytest_collection_modifyitems(config, items):
 @pytest.fixture(scope="session")
 def trial_kernel():
     """The trial kernel compiled, or loaded from Numba's cache, in this process;
-    a compile in another process is waited for.  Tests that call
-    ``core.trial.advance`` directly use it, so that they load what
-    ``run_trials`` compiled instead of compiling ``advance`` alone."""
+    a compile in another process is waited for.  Tests elsewhere that run
+    ``core.trial.advance`` use it, so that they load what the first worker
+    compiled instead of compiling it too."""
     from ftc_mc.campaign.chunk import chunk_spec, warm_up
     from ftc_mc.config import load_config
     cfg = load_config(ROOT / "configs" / "paper_tables.yaml")

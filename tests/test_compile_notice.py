@@ -15,7 +15,7 @@ import numba
 import pytest
 
 from ftc_mc.core import jit
-from ftc_mc.core.trial import run_trials
+from ftc_mc.core.trial import advance
 
 MAGIC = ("x86_64-unknown-linux-gnu", "znver4", "+avx512f")
 CODE = hashlib.sha256(b"code").hexdigest()
@@ -45,12 +45,12 @@ class _FakeDispatcher:
     def __init__(self, index, signatures=()):
         self.signatures = list(signatures)
         self._cache = type("C", (), {"_cache_file": _FakeCacheFile(index)})()
-        self.targetctx = run_trials.targetctx
-        self.py_func = run_trials.py_func
+        self.targetctx = advance.targetctx
+        self.py_func = advance.py_func
 
 
 def _key(dispatcher):
-    magic = run_trials.targetctx.codegen().magic_tuple()
+    magic = advance.targetctx.codegen().magic_tuple()
     code = hashlib.sha256(dispatcher.py_func.__code__.co_code).hexdigest()
     return ((numba.float64,), magic, (code, ""))
 
@@ -85,13 +85,13 @@ def test_real_trial_kernel_cache(tmp_path, monkeypatch):
     """Numba's own index reader on the trial kernel: an empty cache folder is
     cold; after the kernel was compiled or loaded in this process its index
     is warm."""
-    cache_file = run_trials._cache._cache_file
+    cache_file = advance._cache._cache_file
     with monkeypatch.context() as m:
         m.setattr(cache_file, "_index_path", str(tmp_path / "none.nbi"))
-        assert jit.in_disk_cache(run_trials) is False
-    if run_trials.signatures:  # compiled or loaded by an earlier test
-        assert jit.in_disk_cache(run_trials) is True
-        assert jit.needs_compile(run_trials) is False
+        assert jit.in_disk_cache(advance) is False
+    if advance.signatures:  # compiled or loaded by an earlier test
+        assert jit.in_disk_cache(advance) is True
+        assert jit.needs_compile(advance) is False
 
 
 def test_the_kernel_cache_follows_every_kernel_module(tmp_path, monkeypatch):
@@ -122,12 +122,13 @@ def test_the_kernel_cache_follows_every_kernel_module(tmp_path, monkeypatch):
 
 @pytest.mark.skipif(not jit.CACHE, reason="FTC_MC_NUMBA_CACHE=0")
 def test_sweep_reuses_the_trial_kernels_advance(tmp_path):
-    """The sweep's shared start calls ``advance`` from Python; ``run_trials``
-    compiles it as a callee.  Both must ask for one signature, or a user's first
-    sweep compiles ``advance`` a second time (about 50 s cold): a constant
-    ``0`` for its start step was typed ``Literal[int](0)`` inside ``run_trials``.
-    Read from Numba's on-disk index of ``advance``, which holds every signature
-    compiled from this source (the folder is named after it, core/jit.py)."""
+    """The campaign (``sim.lanes.run_trials``) and the sweep's shared start both
+    call ``advance`` from Python.  Both must ask for one signature, or a user's
+    first sweep compiles ``advance`` a second time (about 50 s cold): when a
+    compiled ``run_trials`` called it, its constant ``0`` for the start step was
+    typed ``Literal[int](0)``.  Read from Numba's on-disk index of
+    ``advance``, which holds every signature compiled from this source (the
+    folder is named after it, core/jit.py)."""
     import ftc_mc
     from ftc_mc.core.trial import advance
 

@@ -25,7 +25,7 @@ from ftc_mc.campaign.chunk import chunk_spec, trial_inputs
 from ftc_mc.campaign.runner import run_campaign
 from ftc_mc.cli import cli
 from ftc_mc.config import Config, parse_config
-from ftc_mc.core.trial import run_trials
+from ftc_mc.sim.lanes import run_trials
 from ftc_mc.errors import UserError
 from ftc_mc.model import dynamics
 from ftc_mc.model.turbulence import dryden_model

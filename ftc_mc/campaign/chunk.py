@@ -21,7 +21,7 @@ from ..config.schema import Config
 from ..conventions import (BLOCK_NAMES, C_NOMINAL, MODE_NAMES, MODE_NOMINAL, STATUS_AIRSPEED,
                            STATUS_ALPHA, STATUS_NAMES, STATUS_NONFINITE, STATUS_NOT_PSD)
 from ..core.settings import TrialInputs, TrialRecord
-from ..core.trial import run_trials
+from ..core.trial import advance
 from ..sim.compiling import compiled_once
 from ..sim.inputs import build_inputs, draw_lanes, flight_inputs, sensor_faults
 from ..sim.lanes import simulate
@@ -469,6 +469,6 @@ def warm_up(spec: ChunkSpec, tr_name: str) -> None:
     in the cache yet, one line on stderr says that it is being compiled
     (:func:`ftc_mc.core.jit.announce_compile`); another process compiling it
     is waited for (:func:`ftc_mc.sim.compiling.compiled_once`)."""
-    with compiled_once(run_trials):
+    with compiled_once(advance):
         run_chunk(dataclasses.replace(spec, variants=spec.variants[:1], max_resets=4,
                                       window=1, points=None), tr_name, np.arange(1))

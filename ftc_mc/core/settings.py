@@ -113,7 +113,7 @@ TrialInputs = namedtuple("TrialInputs", [
     "sensor_size",  # (L,) bias [unit], drift [unit/s] or noise factor [-]; stuck: unused
     "sensor_k",     # (L,) int64 onset step: z_{k+1} is faulty from truth step k on
 ])
-"""Per-lane inputs of :func:`ftc_mc.core.trial.run_trials` (a fault schedule)."""
+"""Per-lane inputs of :func:`ftc_mc.sim.lanes.run_trials` (a fault schedule)."""
 
 TrialRecord = namedtuple("TrialRecord", [
     "reset_k",      # (R, L) int64 step of each reset (time = k dt)
@@ -140,7 +140,7 @@ TrialRecord = namedtuple("TrialRecord", [
     "hist_block",   # (n_hist, L) int64 block reset at each step
     "hist_wind",    # (n_hist, 3, L) gust u_g, w_g [m/s], q_g [rad/s] held over each step
 ])
-"""Per-lane outputs of :func:`ftc_mc.core.trial.run_trials`."""
+"""Per-lane outputs of :func:`ftc_mc.sim.lanes.run_trials`."""
 
 Validity = namedtuple("Validity", [
     "va_trim",     # trim airspeed [m/s]

@@ -167,19 +167,3 @@ def init_jacobians(fm, st):
                 st.JC[r, j, l] = fm.C[r, j]
             for j in range(N_WIND):
                 st.JHW[r, j, l] = fm.Dw[r, j]
-
-
-@kernel
-def run_trials(scheme, flight, inp, rec):
-    """Simulate ``L`` trials from the start to the end (see :func:`advance`).
-
-    Parameters are those of :func:`advance` without the state and step range;
-    ``rec`` is overwritten.
-    """
-    st = new_state(inp.w.shape[2], inp.xa0.shape[0], scheme.detection.window)
-    init_state(inp, st, rec)
-    init_jacobians(scheme.filter, st)
-    # np.int64(0), not a bare 0: Numba types a constant argument as Literal[int](0)
-    # and would compile advance for it apart from the int64 start that the
-    # sweep's shared start passes from Python (a second cold compile of ~50 s)
-    advance(scheme, flight, inp, rec, st, np.int64(0), flight.timing.n_steps)

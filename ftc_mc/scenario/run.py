@@ -20,7 +20,7 @@ import pandas as pd
 
 from ..config.schema import ScenarioConfig
 from ..conventions import CONTROLLER_NAMES, MODE_NAMES, STATUS_NAMES
-from ..core.trial import run_trials
+from ..core.trial import advance
 from ..model.faults import mode_of
 from ..sim.compiling import compiled_once
 from ..sim.inputs import scenario_inputs
@@ -75,7 +75,7 @@ def run_scenario(sc: ScenarioConfig, seed: int | None = None,
         setup = build_setup(sc)
     name = runs_of(sc)[0]
     inp = scenario_inputs(setup, sc.scenario)
-    with compiled_once(run_trials):
+    with compiled_once(advance):
         rec = run_alone(setup, name, setup.det[name], inp, HISTORY_RESETS, history=True)
     k_sw, b0, b1 = inp.k_switch, inp.b0[:, :, 0], inp.b1[:, :, 0]
     modes = np.array([int(mode_of(b, *setup.beta)) for b in b1], dtype=np.int64)

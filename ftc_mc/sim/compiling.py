@@ -1,6 +1,6 @@
 """One compile of the trial kernel at a time per kernel cache.
 
-A cold compile of :func:`ftc_mc.core.trial.run_trials` takes about two minutes
+A cold compile of :func:`ftc_mc.core.trial.advance` takes about two minutes
 (``scripts/bench_campaign.py``).  Processes that start together on an empty
 cache (two runs launched at once, Dask or test workers on one machine) would
 each compile it, on cores they then share.  :func:`compiled_once` makes the
@@ -56,7 +56,7 @@ def compiled_once(dispatcher, stream=None):
     Parameters
     ----------
     dispatcher : numba dispatcher
-        The kernel the block calls (``run_trials``).
+        The kernel the block calls (``advance``).
     stream : file, optional
         Where the notices go (default stderr).
     """

@@ -2,7 +2,7 @@
 
 :func:`simulate` runs the same inputs under several designs and Table 1
 detections (the designs run, and in a sweep each at every threshold point).  Alone, each
-detection runs every lane from the start (:func:`ftc_mc.core.trial.run_trials`).
+detection runs every lane from the start (:func:`run_trials`).
 Shared, the runs are grouped by design key (designs differing at most in Table
 1's signature and thresholds: :class:`ftc_mc.sim.designs.Design`); per
 group, the lanes are first advanced once to a step ``k_share`` with resets
@@ -26,16 +26,41 @@ import math
 import numpy as np
 
 from ..core.settings import TrialInputs, TrialRecord
-from ..core.trial import advance, init_jacobians, init_state, new_state, run_trials
+from ..core.trial import advance, init_jacobians, init_state, new_state
 from .inputs import design_inputs
 
 HISTORY_RESETS = 100_000
 """Resets stored per lane when every step is kept (a scenario)."""
 
 
+def start_lanes(scheme, inp: TrialInputs, rec: TrialRecord):
+    """The lane state of every trial of ``inp`` at step 0, and ``rec``'s per-lane
+    fields initialised (:func:`ftc_mc.core.trial.init_state`; the extended
+    filter's Jacobians at trim, :func:`~ftc_mc.core.trial.init_jacobians`)."""
+    st = new_state(inp.w.shape[2], inp.xa0.shape[0], scheme.detection.window)
+    init_state(inp, st, rec)
+    init_jacobians(scheme.filter, st)
+    return st
+
+
+def run_trials(scheme, flight, inp: TrialInputs, rec: TrialRecord) -> None:
+    """Simulate the ``L`` trials of ``inp`` from the start to the end, writing
+    ``rec`` (overwritten): :func:`start_lanes`, then
+    :func:`ftc_mc.core.trial.advance` over every step.
+
+    Parameters are those of :func:`~ftc_mc.core.trial.advance` without the
+    state and step range.  The step kernel is called from Python, not from a
+    compiled wrapper: Numba re-optimises and re-emits all the code a compiled
+    caller links in, so a wrapper kernel cost the cold compile about 20 s
+    (``docs/performance.md``, lesson 6).
+    """
+    st = start_lanes(scheme, inp, rec)
+    advance(scheme, flight, inp, rec, st, 0, flight.timing.n_steps)
+
+
 def new_record(setup, L: int, max_resets: int, history: bool = False,
                n_est: int = 14) -> TrialRecord:
-    """Preallocated outputs of :func:`ftc_mc.core.trial.run_trials`.
+    """Preallocated outputs of :func:`run_trials`.
 
     ``history=True`` keeps every step's state, estimate, commands, residuals
     and excitation (for scenarios); campaigns keep only the per-period arrays.
@@ -130,11 +155,9 @@ def _shared_start(setup, name: str, inp: TrialInputs, max_resets: int, k_share: 
     L = inp.w.shape[2]
     dinp = design_inputs(inp, setup.designs[name])
     rec0 = new_record(setup, L, max_resets, n_est=setup.designs[name].n_aug)
-    no_resets = setup.detection(name, math.inf, math.inf)
-    st0 = new_state(L, dinp.xa0.shape[0], no_resets.window)
-    init_state(dinp, st0, rec0)
-    init_jacobians(setup.designs[name].fm, st0)
-    advance(setup.scheme(name, no_resets), setup.flight, dinp, rec0, st0, 0, k_share)
+    scheme = setup.scheme(name, setup.detection(name, math.inf, math.inf))
+    st0 = start_lanes(scheme, dinp, rec0)
+    advance(scheme, setup.flight, dinp, rec0, st0, 0, k_share)
     return rec0, st0
 
 
