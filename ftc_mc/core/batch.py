@@ -254,7 +254,7 @@ def _predict(xa, P, Pn, u, fm, phi, T, l0, l1):
                 Pn[k, i, l] = Pn[i, k, l]
 
 
-@kernel
+@kernel(inline="always")
 def predict_lanes(xa, P, u, fm, phi, T):
     """Time update of every lane (eq. 5), as :func:`ftc_mc.core.kalman.predict`.
 
@@ -320,7 +320,7 @@ def _normalised_lanes(xa, P, z, fm, out, signed):
                     out[o, l] = mu * mu / s
 
 
-@kernel
+@kernel(inline="always")
 def residuals_lanes(xa, P, z, fm, res):
     """Normalised residuals ``r_q, r_nx, r_nz`` of every lane (eqs. 9-11).
 
@@ -343,7 +343,7 @@ def residuals_lanes(xa, P, z, fm, res):
     _normalised_lanes(xa, P, z, fm, res, False)
 
 
-@kernel
+@kernel(inline="always")
 def innovations_lanes(xa, P, z, fm, innov):
     """Signed normalised innovations ``mu_i / sqrt(S_ii)`` of every lane, on the
     same prediction as :func:`residuals_lanes` (``r_i = innov_i^2`` up to
@@ -364,7 +364,7 @@ def innovations_lanes(xa, P, z, fm, innov):
 
 
 # ------------------------------------------------------------------ signature
-@kernel
+@kernel(inline="always")
 def signature_lanes(res, det, block):
     """Table 1 on every lane, as :func:`ftc_mc.core.signature.signature`.
 
@@ -537,7 +537,7 @@ def _update(xa, P, z, fm, h):
             r += 1
 
 
-@kernel
+@kernel(inline="always")
 def update_lanes(xa, P, z, fm, h):
     """Measurement update of every lane with its 12 outputs (eq. 5, R diagonal).
 
@@ -587,7 +587,7 @@ def project_lanes(xa, fm):
 
 
 # ------------------------------------------------------------------ step
-@kernel
+@kernel(inline="always")
 def filter_predict_lanes(xa, P, u, z, fm, phi, T, work, res):
     """First half of :func:`filter_step_lanes`: predict (eq. 5) into ``work[:n]``
     and the residuals (eqs. 9-11); ``x_{k|k}`` is kept in ``work`` for a re-prediction.
@@ -607,7 +607,7 @@ def filter_predict_lanes(xa, P, u, z, fm, phi, T, work, res):
     residuals_lanes(xa, Pn, z, fm, res)
 
 
-@kernel
+@kernel(inline="always")
 def filter_correct_lanes(xa, P, u, z, fm, det, phi, T, work, block):
     """Second half of :func:`filter_step_lanes`, once ``block`` is decided: reset
     and re-predict the lanes that reset, update, projection.  Parameters as

@@ -302,7 +302,7 @@ def _lane_commands(c, xs, K, eng, u0, lo, hi, U, xl, Ul):
             U[i, l] = saturate(U[i, l], 0.0, 0.0, lo_i, hi_i)
 
 
-@kernel
+@kernel(inline="always")
 def _predicted_cost_lanes(c, xs, Ps, fm, rc, eng, K, lo, hi, sw):
     """:func:`_predicted_cost` for every lane at once (lane-last ``xs``, ``Ps``).
 
@@ -346,7 +346,7 @@ def _predicted_cost_lanes(c, xs, Ps, fm, rc, eng, K, lo, hi, sw):
             cost[l] += disc * stage
 
 
-@kernel
+@kernel(inline="always")
 def controller_objectives_lanes(cur, xa, P, belief, scheme, sw):
     """:func:`controller_objectives` of every lane, into ``sw.obj`` (3, L).
 
@@ -400,7 +400,7 @@ def controller_objectives_lanes(cur, xa, P, belief, scheme, sw):
             sw.obj[a, l] = obj
 
 
-@kernel
+@kernel(inline="always")
 def select_controllers_lanes(cur, xa, P, belief, scheme, sw):
     """:func:`select_controller` for every lane; ``cur`` is updated in place.
 

@@ -375,7 +375,7 @@ def _gpredict(xa, P, Pn, u, fm, phi, T, xn, tw, st):
                 Pn[k, i, l] = Pn[i, k, l]
 
 
-@kernel
+@kernel(inline="always")
 def gust_residuals_lanes(xa, P, z, fm, crow, hpred, res, innov, st, cl):
     """Normalised residuals ``r_q, r_nx, r_nz`` (eqs. 9-11) with the gust columns
     of ``C_aug``: ``r_i = mu_i^2 / (c_i P c_i^T + R_ii)``, ``mu_i = z_i - c_i X``.
@@ -505,7 +505,7 @@ def _gupdate(xa, P, z, fm, crow, h, v, gs, hpred, xp, st, cl):
         _apply_gain(xa, P, h, v, gs)
 
 
-@kernel
+@kernel(inline="always")
 def gust_predict_lanes(xa, P, fm, tw, st, k):
     """First half of a general filter step: predict into ``tw.fwork[:n]`` and the
     residuals; ``X_{k|k}`` is kept in ``tw.fwork`` for a re-prediction.
@@ -581,7 +581,7 @@ def reset_extra_lanes(P, block, reset_g):
                 P[i, i, l] = v
 
 
-@kernel
+@kernel(inline="always")
 def gust_correct_lanes(xa, P, fm, det, tw, st):
     """Second half, once ``tw.block`` is decided: reset the block of ``P_{k|k}``
     (section 3.2.2, with the extra states that go with it,
