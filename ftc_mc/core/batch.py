@@ -420,7 +420,7 @@ def reset_lanes(P, block, reset_var):
 
 
 # ------------------------------------------------------------------ update
-@kernel
+@kernel(inline="always")
 def _unit_group(xa, P, z, fm, hk, vk, gs, r0, q_max):
     """Sequential updates with the unit rows ``r0 .. r0+q-1`` of ``C`` (q <= GROUP).
 
@@ -480,7 +480,7 @@ def _unit_group(xa, P, z, fm, hk, vk, gs, r0, q_max):
     return q
 
 
-@kernel
+@kernel(inline="always")
 def _dense_row(xa, P, z, fm, h, v, gs, r):
     """Scalar update with a dense row ``r`` of ``C`` (upper triangle of ``P`` kept)."""
     n = xa.shape[0]
