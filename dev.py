@@ -5,7 +5,8 @@ nothing but Python 3.11::
 
     python3 dev.py run     # create .venv if needed, install, run the main job
     python3 dev.py test    # create .venv if needed, install with test extras, run pytest
-                           # (-q -n auto: one pytest-xdist worker per core)
+                           # (-q -n auto --dist worksteal: one pytest-xdist
+                           # worker per core, idle ones take queued tests)
 
 Extra arguments after ``run`` go to ``ftc-mc``; after ``test`` to ``pytest``.
 The install is repeated only when ``pyproject.toml`` changes.
@@ -59,8 +60,9 @@ def main(argv: list[str]) -> int:
     else:
         ensure_venv("test")
         # one worker per core; tests/conftest.py orders the tests so that the
-        # workers share the trial kernel's cold compile
-        args = [str(PY), "-m", "pytest"] + (rest or ["-q", "-n", "auto"])
+        # workers share the trial kernel's cold compile, and worksteal lets the
+        # other worker take the first one's queued tests meanwhile
+        args = [str(PY), "-m", "pytest"] + (rest or ["-q", "-n", "auto", "--dist", "worksteal"])
     return subprocess.run(args, cwd=ROOT).returncode
 
 

@@ -29,9 +29,10 @@ def pytest_collection_modifyitems(config, items):
     """Tests of the trial kernel after the piecewise ones (otherwise in file
     order).  ``python3 dev.py test`` runs a pytest-xdist worker per core: the
     first compiles the trial kernel before its first test
-    (:func:`_compile_first`, about two minutes cold) while the others run
-    piecewise tests, instead of all reaching the kernel at once and waiting for
-    one of them (:func:`ftc_mc.sim.compiling.compiled_once`).  Only the order
+    (:func:`_compile_first`, about 1.5 minutes cold) while the others run
+    piecewise tests (``--dist worksteal`` hands them the tests queued for the
+    first), instead of all reaching the kernel at once and waiting for one of
+    them (:func:`ftc_mc.sim.compiling.compiled_once`).  Only the order
     changes."""
     items.sort(key=_late)
 

@@ -129,11 +129,13 @@ def needs_compile(dispatcher) -> bool | None:
     return None if cached is None else not cached
 
 
-def announce_compile(dispatcher, duration="2 min", stream=None) -> bool:
+def announce_compile(dispatcher, duration="1.5 min", stream=None) -> bool:
     """Print :data:`COMPILE_NOTICE` to stderr if ``dispatcher`` is about to be
     compiled (:func:`needs_compile`); return whether it was printed.  The
-    duration is measured by ``scripts/bench_campaign.py`` (120-144 s since the
-    designs' kernels of issues 13-14 joined the trial loop)."""
+    duration is measured by ``scripts/bench_campaign.py``: 91-100 s since the
+    trial kernel is no longer wrapped in a compiled ``run_trials`` and the
+    kernels between it and the leaves are inlined (120-144 s before,
+    ``docs/performance.md`` lesson 6)."""
     import sys
     if needs_compile(dispatcher) is not True:
         return False

@@ -1,6 +1,6 @@
 """One compile of the trial kernel at a time per kernel cache.
 
-A cold compile of :func:`ftc_mc.core.trial.advance` takes about two minutes
+A cold compile of :func:`ftc_mc.core.trial.advance` takes about 1.5 minutes
 (``scripts/bench_campaign.py``).  Processes that start together on an empty
 cache (two runs launched at once, Dask or test workers on one machine) would
 each compile it, on cores they then share.  :func:`compiled_once` makes the
@@ -26,7 +26,7 @@ WAIT_NOTICE = ("ftc-mc: another process is compiling the simulation kernels; wai
 
 WAIT_LIMIT_S = 900.0
 """Longest wait for another process's compile [s] (a cold compile takes about
-two minutes); a holder stopped for longer is no longer waited for."""
+1.5 minutes); a holder stopped for longer is no longer waited for."""
 
 GAVE_UP_NOTICE = ("ftc-mc: the other process has not finished compiling after {:.0f} s; "
                   "compiling here")
