@@ -25,16 +25,62 @@ def _late(item) -> bool:
     return item.path.name in TRIAL_KERNEL_FILES or "trial_kernel" in item.fixturenames
 
 
+@pytest.hookimpl(optionalhook=True)
+def pytest_configure_node(node):
+    """pytest-xdist, in the controller: tell each worker how tests are shared
+    (a worker's own ``dist`` option reads ``"no"``)."""
+    node.workerinput["ftc_mc_dist"] = node.config.getoption("dist")
+
+
+def _worksteal_workers(config) -> int:
+    """The number of pytest-xdist workers when they share the tests by
+    ``--dist worksteal`` (``python3 dev.py test``), else 0."""
+    workerinput = getattr(config, "workerinput", {})
+    workers = workerinput.get("workercount", 0)
+    return workers if workers > 1 and workerinput.get("ftc_mc_dist") == "worksteal" else 0
+
+
+def _worksteal_order(items, workers: int) -> list:
+    """``items`` arranged for pytest-xdist's worksteal scheduler.
+
+    It hands each worker a contiguous part of the list (the first
+    ``N // workers`` tests, then ``N // (workers - 1)`` of the rest, ...) and
+    later moves queued tests from busy workers to idle ones.  The first part
+    starts with the trial kernel's tests, so its worker compiles the kernel at
+    once; every other part starts with piecewise tests, so their workers run
+    those meanwhile and reach the kernel's tests once it is cached."""
+    late = [item for item in items if _late(item)]
+    piece = [item for item in items if not _late(item)]
+    sizes, left = [], len(items)
+    for i in range(workers):
+        sizes.append(left // (workers - i))
+        left -= sizes[-1]
+    n_late = min(len(late), sizes[0])
+    order = late[:n_late] + piece[:sizes[0] - n_late]
+    late, piece = late[n_late:], piece[sizes[0] - n_late:]
+    for i in range(1, workers):
+        n_piece = min(len(piece) // (workers - i), sizes[i])
+        n_late = sizes[i] - n_piece
+        order += piece[:n_piece] + late[:n_late]
+        piece, late = piece[n_piece:], late[n_late:]
+    return order + piece + late
+
+
 def pytest_collection_modifyitems(config, items):
-    """Tests of the trial kernel after the piecewise ones (otherwise in file
-    order).  ``python3 dev.py test`` runs a pytest-xdist worker per core: the
-    first compiles the trial kernel before its first test
-    (:func:`_compile_first`, about 1.5 minutes cold) while the others run
-    piecewise tests (``--dist worksteal`` hands them the tests queued for the
-    first), instead of all reaching the kernel at once and waiting for one of
-    them (:func:`ftc_mc.sim.compiling.compiled_once`).  Only the order
-    changes."""
+    """Order the tests so that two or more test workers share the trial
+    kernel's one cold compile (about 1.5 minutes) instead of all reaching the
+    kernel at once and waiting for one of them
+    (:func:`ftc_mc.sim.compiling.compiled_once`).  Only the order changes.
+
+    * ``--dist worksteal`` (``python3 dev.py test``): :func:`_worksteal_order`.
+    * Otherwise the tests of the trial kernel run after the piecewise ones
+      (otherwise in file order); with pytest-xdist's default ``load`` order
+      every worker takes tests from the front of the list, and the first
+      compiles the kernel before its first test (:func:`_compile_first`)."""
     items.sort(key=_late)
+    workers = _worksteal_workers(config)
+    if workers:
+        items[:] = _worksteal_order(items, workers)
 
 
 @pytest.fixture(scope="session")
@@ -52,9 +98,11 @@ def trial_kernel():
 @pytest.fixture(scope="session", autouse=True)
 def _compile_first(request):
     """The first xdist worker gets the trial kernel before any test, when the
-    session has tests that need it.  A failure here is left to those tests to
+    session has tests that need it (the ``load`` order; the worksteal order
+    needs no head start, its first part starts with those tests).  A failure here is left to those tests to
     report (they compile it again), so the piecewise tests still run."""
-    if getattr(request.config, "workerinput", {}).get("workerid") != "gw0":
+    if (getattr(request.config, "workerinput", {}).get("workerid") != "gw0"
+            or _worksteal_workers(request.config)):
         return
     if any(_late(item) for item in request.session.items):
         try:
