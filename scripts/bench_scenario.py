@@ -108,10 +108,9 @@ def main():
     import numpy as np
 
     from ftc_mc.config import load_scenario
-    from ftc_mc.sim.lanes import run_trials
     from ftc_mc.io.results import provenance
     from ftc_mc.scenario import run_scenario, write_scenario
-    from ftc_mc.sim.lanes import HISTORY_RESETS, new_record
+    from ftc_mc.sim.lanes import HISTORY_RESETS, new_record, run_trials
     from ftc_mc.sim.setup import build_setup
 
     sc = load_scenario(args.config)

@@ -66,6 +66,7 @@ def _worksteal_order(items, workers: int) -> list:
     return order + piece + late
 
 
+@pytest.hookimpl(trylast=True)
 def pytest_collection_modifyitems(config, items):
     """Order the tests so that two or more test workers share the trial
     kernel's one cold compile (about 1.5 minutes) instead of all reaching the
@@ -76,7 +77,12 @@ def pytest_collection_modifyitems(config, items):
     * Otherwise the tests of the trial kernel run after the piecewise ones
       (otherwise in file order); with pytest-xdist's default ``load`` order
       every worker takes tests from the front of the list, and the first
-      compiles the kernel before its first test (:func:`_compile_first`)."""
+      compiles the kernel before its first test (:func:`_compile_first`).
+
+    Runs last (``trylast``), after ``-k``, ``-m`` and ``--deselect`` have
+    removed tests, so that the parts match what xdist hands out; ``--lf`` and
+    ``--ff`` still change the list afterwards (the order is then only less
+    good)."""
     items.sort(key=_late)
     workers = _worksteal_workers(config)
     if workers:
@@ -99,8 +105,9 @@ def trial_kernel():
 def _compile_first(request):
     """The first xdist worker gets the trial kernel before any test, when the
     session has tests that need it (the ``load`` order; the worksteal order
-    needs no head start, its first part starts with those tests).  A failure here is left to those tests to
-    report (they compile it again), so the piecewise tests still run."""
+    needs no head start, its first part starts with those tests).  A failure
+    here is left to those tests to report (they compile it again), so the
+    piecewise tests still run."""
     if (getattr(request.config, "workerinput", {}).get("workerid") != "gw0"
             or _worksteal_workers(request.config)):
         return

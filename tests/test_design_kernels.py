@@ -215,8 +215,7 @@ def test_gust_aware_residuals_are_chi_square(linear_gusts):
     those a gust carries out of the envelope) after a 10 s transient; the
     paper's filter on the same flights is far above 1 (measured here 644 / 28 /
     3586; DESIGN.md section 9's prototype 190 / 19 / 1220)."""
-    from ftc_mc.sim.lanes import run_trials
-    from ftc_mc.sim.lanes import new_record
+    from ftc_mc.sim.lanes import new_record, run_trials
 
     setup = _setup(turbulence="moderate", controller="nominal",
                    timing={"fault_time_s": 70.0, "window_s": 1.0, "duration_s": 71.0})

@@ -9,8 +9,7 @@ import pytest
 from ftc_mc.campaign.chunk import chunk_spec, classify, run_chunk, trial_inputs
 from ftc_mc.campaign.summary import summarize
 from ftc_mc.config import Config
-from ftc_mc.sim.lanes import run_trials
-from ftc_mc.sim.lanes import new_record
+from ftc_mc.sim.lanes import new_record, run_trials
 
 CFG = Config.model_validate({"campaign": {"transitions": ["elevon_lock"], "trials": 4},
                              "timing": {"fault_time_s": 2.0, "window_s": 2.0,
