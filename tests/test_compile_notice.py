@@ -69,6 +69,10 @@ def test_cold_then_warm(monkeypatch):
     assert not jit.announce_compile(warm, stream=out) and out.getvalue() == ""
     # already compiled in this process: nothing to announce
     assert jit.needs_compile(_FakeDispatcher({}, signatures=["sig"])) is False
+    # a caller that has just asked needs_compile passes its answer on
+    out = io.StringIO()
+    assert not jit.announce_compile(cold, stream=out, needed=False) and out.getvalue() == ""
+    assert jit.announce_compile(warm, stream=out, needed=True) and out.getvalue()
 
 
 def test_unknown_cache_layout_announces_nothing(monkeypatch):

@@ -129,15 +129,16 @@ def needs_compile(dispatcher) -> bool | None:
     return None if cached is None else not cached
 
 
-def announce_compile(dispatcher, duration="1.5 min", stream=None) -> bool:
+def announce_compile(dispatcher, duration="1.5 min", stream=None, needed=None) -> bool:
     """Print :data:`COMPILE_NOTICE` to stderr if ``dispatcher`` is about to be
-    compiled (:func:`needs_compile`); return whether it was printed.  The
+    compiled (:func:`needs_compile`, or ``needed`` when the caller has just
+    asked it); return whether it was printed.  The
     duration is measured by ``scripts/bench_campaign.py``: 91-100 s since the
     trial kernel is no longer wrapped in a compiled ``run_trials`` and the
     kernels between it and the leaves are inlined (120-144 s before,
     ``docs/performance.md`` lesson 6)."""
     import sys
-    if needs_compile(dispatcher) is not True:
+    if (needs_compile(dispatcher) if needed is None else needed) is not True:
         return False
     text = COMPILE_NOTICE if CACHE else COMPILE_NOTICE_NO_CACHE
     print(text.format(duration), file=sys.stderr if stream is None else stream, flush=True)

@@ -60,8 +60,9 @@ def compiled_once(dispatcher, stream=None):
     stream : file, optional
         Where the notices go (default stderr).
     """
-    if not jit.CACHE or jit.needs_compile(dispatcher) is not True:
-        jit.announce_compile(dispatcher, stream=stream)
+    needed = jit.needs_compile(dispatcher)
+    if not jit.CACHE or needed is not True:
+        jit.announce_compile(dispatcher, stream=stream, needed=needed)
         yield
         return
     out = sys.stderr if stream is None else stream
@@ -75,7 +76,8 @@ def compiled_once(dispatcher, stream=None):
     with contextlib.ExitStack() as stack:
         stack.enter_context(waiting(lock_path(dispatcher), on_wait=say_wait,
                                     timeout_s=WAIT_LIMIT_S, on_timeout=give_up))
-        if jit.needs_compile(dispatcher) is not True:
+        needed = jit.needs_compile(dispatcher)  # again: the holder may have filled it
+        if needed is not True:
             stack.close()  # the holder filled the cache: load it without the lock
-        jit.announce_compile(dispatcher, stream=stream)
+        jit.announce_compile(dispatcher, stream=stream, needed=needed)
         yield
