@@ -1,7 +1,9 @@
 """The one-line notice before the first run that compiles the trial kernel
-(core/jit.py: ``needs_compile``, ``announce_compile``).
+(core/jit.py: ``needs_compile``, ``announce_compile``), and the lock that lets
+one process compile it while others wait (io/lock.py ``waiting``,
+sim/compiling.py ``compiled_once``).
 
-A real cold compile takes about a minute, so the decision is tested on fake
+A real cold compile takes about 1.5 minutes, so the decision is tested on fake
 cache indexes and on the real trial kernel's cache pointed at an empty folder.
 """
 
@@ -9,6 +11,7 @@ from __future__ import annotations
 
 import hashlib
 import io
+import threading
 from pathlib import Path
 
 import numba
@@ -16,6 +19,8 @@ import pytest
 
 from ftc_mc.core import jit
 from ftc_mc.core.trial import advance
+from ftc_mc.io.lock import waiting
+from ftc_mc.sim.compiling import WAIT_NOTICE, compiled_once, lock_path
 
 MAGIC = ("x86_64-unknown-linux-gnu", "znver4", "+avx512f")
 CODE = hashlib.sha256(b"code").hexdigest()
@@ -104,8 +109,6 @@ def test_the_kernel_cache_follows_every_kernel_module(tmp_path, monkeypatch):
     # kernel inlines (core/stages.py into core/trial.py) starts a new folder
     import shutil
 
-    from ftc_mc.core import jit
-
     src = Path(jit.__file__).resolve().parent
     copy = tmp_path / "ftc_mc"
     shutil.copytree(src, copy / "core", ignore=shutil.ignore_patterns("__pycache__"))
@@ -134,7 +137,6 @@ def test_sweep_reuses_the_trial_kernels_advance(tmp_path):
     ``advance``, which holds every signature compiled from this source (the
     folder is named after it, core/jit.py)."""
     import ftc_mc
-    from ftc_mc.core.trial import advance
 
     cfg = {"campaign": {"transitions": ["elevon_lock"], "trials": 2},
            "controller": {"kind": "nominal"},
@@ -152,15 +154,12 @@ def test_sweep_reuses_the_trial_kernels_advance(tmp_path):
 
 
 def _in_thread(fn):
-    import threading
     t = threading.Thread(target=fn, daemon=True)
     t.start()
     return t
 
 
 def test_waiting_lock_waits_for_the_holder(tmp_path):
-    import threading
-    from ftc_mc.io.lock import waiting
     path = tmp_path / "sub" / "x.lock"
     waited, inside = threading.Event(), threading.Event()
 
@@ -190,9 +189,6 @@ def test_compiled_once_waits_then_loads(tmp_path, monkeypatch, holder_compiles):
     """A second process finds the compile lock busy: it says it waits, and once
     the holder has filled the cache it announces no compile of its own; if the
     holder ended without filling it, the waiter compiles and says so."""
-    import threading
-    from ftc_mc.io.lock import waiting
-    from ftc_mc.sim.compiling import WAIT_NOTICE, compiled_once, lock_path
     monkeypatch.setattr(jit, "CACHE", True)
     monkeypatch.setattr(numba.config, "CACHE_DIR", str(tmp_path))
     index = {}
