@@ -18,6 +18,8 @@ shapes, never from a literal.
 
 from __future__ import annotations
 
+import dataclasses
+
 # ------------------------------------------------------------------ plant
 STATE_NAMES = ("u", "w", "q", "x", "z", "theta", "thrust", "elevon_left", "elevon_right")
 """States of the linear plant (body velocities [m/s], pitch rate [rad/s],
@@ -141,3 +143,93 @@ NO_SENSOR_FAULT = -1
 """``TrialInputs.sensor_out`` of a lane without a sensor fault."""
 SENSOR_PREFIX = "sensor_"
 """Campaign transitions ``sensor_<kind>:<output>``, e.g. ``sensor_bias:q``."""
+
+
+# ------------------------------------------------------------------ the family's layout
+@dataclasses.dataclass(frozen=True)
+class Layout:
+    """Names and index maps of one plant family (a plant structure with its
+    filter, residuals and blocks), for the code outside the kernels.
+
+    The kernels of a family read the same numbers as module constants (Numba
+    compiles them in); the rest of the package reads them here, never as
+    literals.  Today's family is the longitudinal one (:data:`LONGITUDINAL`).
+
+    Attributes
+    ----------
+    name : str
+    states, outputs, inputs, actuators, params : tuple of str
+        Plant states, outputs, commands, actuators (command order) and the
+        filter's fault parameters.
+    residuals : tuple of str
+        Table 1's residual channels; ``residual_outputs`` the output each reads.
+    residual_outputs : tuple of int
+    blocks : tuple of str
+        Table 1's covariance blocks by code (code 0: none).
+    block_params : tuple of tuple of int
+        Per block code, the fault parameters (indices into ``params``) it resets.
+    actuator_block : tuple of int
+        Per actuator, the block code of its fault parameters.
+    b0_index, b1_index : tuple of int
+        Per actuator, the index of its lock offset and effectiveness in the
+        augmented estimate ``[x, b]``.
+    """
+
+    name: str
+    states: tuple
+    outputs: tuple
+    inputs: tuple
+    actuators: tuple
+    params: tuple
+    residuals: tuple
+    residual_outputs: tuple
+    blocks: tuple
+    block_params: tuple
+    actuator_block: tuple
+    b0_index: tuple
+    b1_index: tuple
+
+    @property
+    def n_x(self) -> int:
+        """Plant states."""
+        return len(self.states)
+
+    @property
+    def n_z(self) -> int:
+        """Outputs."""
+        return len(self.outputs)
+
+    @property
+    def n_u(self) -> int:
+        """Commands."""
+        return len(self.inputs)
+
+    @property
+    def n_aug(self) -> int:
+        """The augmented estimate ``[x, b]`` of the family's own filter."""
+        return len(self.states) + len(self.params)
+
+    @property
+    def faults(self) -> slice:
+        """The fault parameters' rows of the augmented estimate."""
+        return slice(self.n_x, self.n_aug)
+
+    def output(self, name: str) -> int:
+        """Index of the output ``name``."""
+        return self.outputs.index(name)
+
+    def state(self, name: str) -> int:
+        """Index of the plant state ``name``."""
+        return self.states.index(name)
+
+
+LONGITUDINAL = Layout(
+    name="longitudinal", states=STATE_NAMES, outputs=OUTPUT_NAMES, inputs=INPUT_NAMES,
+    actuators=ACTUATOR_NAMES, params=PARAM_NAMES, residuals=RESIDUAL_NAMES,
+    residual_outputs=RESIDUAL_OUTPUTS, blocks=BLOCK_NAMES,
+    block_params=((), THRUST_BLOCK, ELEVON_BLOCK),
+    actuator_block=(RESET_THRUST, RESET_ELEVONS, RESET_ELEVONS),
+    b0_index=(I_B0_THRUST, I_B0_ELEVONS, I_B0_ELEVONS),
+    b1_index=(I_B1_THRUST, I_B1_LEFT, I_B1_RIGHT))
+"""The longitudinal family: the paper's plant, filter and Table 1 (the elevons'
+lock offsets enter as their sum, ``b0_elevons``)."""

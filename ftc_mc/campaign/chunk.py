@@ -18,11 +18,13 @@ import numpy as np
 import pandas as pd
 
 from ..config.schema import Config
-from ..conventions import (BLOCK_NAMES, C_NOMINAL, MODE_NAMES, MODE_NOMINAL, STATUS_AIRSPEED,
-                           STATUS_ALPHA, STATUS_NAMES, STATUS_NONFINITE, STATUS_NOT_PSD)
+from ..conventions import (BLOCK_NAMES, C_NOMINAL, LONGITUDINAL, MODE_NAMES, MODE_NOMINAL,
+                           STATUS_AIRSPEED, STATUS_ALPHA, STATUS_NAMES, STATUS_NONFINITE,
+                           STATUS_NOT_PSD)
 from ..core.settings import TrialInputs, TrialRecord
 from ..core.trial import advance
 from ..sim.compiling import compiled_once
+from ..sim.paths import path_of
 from ..sim.inputs import build_inputs, draw_lanes, flight_inputs, sensor_faults
 from ..sim.lanes import simulate
 from ..sim.setup import SimSetup, build_setup, runs_of
@@ -200,8 +202,8 @@ def classify(spec: ChunkSpec, tr_name: str, variant: str, trial_ids, values,
     numeric_fail = (rec.status == STATUS_NONFINITE) | (rec.status == STATUS_NOT_PSD)
     judged = (rec.status == 0) | (~numeric_fail & (rec.stop_k > kf + window_steps))
     xa = rec.xa_end
-    b1_idx = 11 if a == 0 else 12
-    b0_idx = 9 if a == 0 else 10
+    b1_idx = LONGITUDINAL.b1_index[a]
+    b0_idx = LONGITUDINAL.b0_index[a]
     trials = {
         "transition": np.full(L, tr_name, dtype=object),
         "variant": np.full(L, variant, dtype=object),
@@ -465,10 +467,18 @@ def run_chunk(spec: ChunkSpec, name: str, trial_ids) -> dict:
 
 def warm_up(spec: ChunkSpec, tr_name: str) -> None:
     """Compile (or load from Numba's cache) the kernels before fanning out: one
-    trial of ``tr_name`` under the first variant.  When the trial kernel is not
-    in the cache yet, one line on stderr says that it is being compiled
-    (:func:`ftc_mc.core.jit.announce_compile`); another process compiling it
-    is waited for (:func:`ftc_mc.sim.compiling.compiled_once`)."""
-    with compiled_once(advance):
-        run_chunk(dataclasses.replace(spec, variants=spec.variants[:1], max_resets=4,
-                                      window=1, points=None), tr_name, np.arange(1))
+    trial of ``tr_name`` under the first variant of each compile path the
+    variants take (``core/paths.py``).  When a path is not in the cache yet,
+    one line on stderr says that it is being compiled, and another how long it
+    took (:func:`ftc_mc.core.jit.announce_compile`); another process compiling
+    it is waited for (:func:`ftc_mc.sim.compiling.compiled_once`)."""
+    setup = spec.setup
+    seen = set()
+    for v in spec.variants:
+        path = path_of(setup.scheme(v), setup.flight)
+        if path in seen:
+            continue
+        seen.add(path)
+        with compiled_once(advance, path):
+            run_chunk(dataclasses.replace(spec, variants=(v,), max_resets=4, window=1,
+                                          points=None), tr_name, np.arange(1))

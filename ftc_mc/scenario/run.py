@@ -19,10 +19,12 @@ import numpy as np
 import pandas as pd
 
 from ..config.schema import ScenarioConfig
-from ..conventions import CONTROLLER_NAMES, MODE_NAMES, STATUS_NAMES
+from ..conventions import CONTROLLER_NAMES, LONGITUDINAL, MODE_NAMES, STATUS_NAMES
 from ..core.trial import advance
-from ..model.faults import mode_of
+from ..core.workspace import EXC_3211, EXC_3211_START, EXC_DOUBLET, EXC_DOUBLET_START
+from ..model.faults import estimator_params, mode_of
 from ..sim.compiling import compiled_once
+from ..sim.paths import path_of
 from ..sim.inputs import scenario_inputs
 from ..sim.lanes import HISTORY_RESETS, run_alone
 from ..sim.setup import SimSetup, build_setup, runs_of
@@ -75,7 +77,7 @@ def run_scenario(sc: ScenarioConfig, seed: int | None = None,
         setup = build_setup(sc)
     name = runs_of(sc)[0]
     inp = scenario_inputs(setup, sc.scenario)
-    with compiled_once(advance):
+    with compiled_once(advance, path_of(setup.scheme(name), setup.flight)):
         rec = run_alone(setup, name, setup.det[name], inp, HISTORY_RESETS, history=True)
     k_sw, b0, b1 = inp.k_switch, inp.b0[:, :, 0], inp.b1[:, :, 0]
     modes = np.array([int(mode_of(b, *setup.beta)) for b in b1], dtype=np.int64)
@@ -97,24 +99,25 @@ def _timeseries(setup, sc, rec, k_sw, b0, b1) -> pd.DataFrame:
     dt = plant.dt
     n = rec.hist_x.shape[0]
     t = (np.arange(n) + 1) * dt
-    names = ("u", "w", "q", "x", "z", "theta", "thrust", "elevon_left", "elevon_right")
+    lay = LONGITUDINAL
     cols = {"time_s": t}
-    for i, nm in enumerate(names):
+    for i, nm in enumerate(lay.states):
         cols[f"{nm}_true"] = rec.hist_x[:, i, 0]
         cols[f"{nm}_est"] = rec.hist_xa[:, i, 0]
     g = plant.trim.gamma0
-    x, z = rec.hist_x[:, 3, 0], rec.hist_x[:, 4, 0]
+    ix, iz = lay.state("x"), lay.state("z")
+    x, z = rec.hist_x[:, ix, 0], rec.hist_x[:, iz, 0]
     cols["along_track_error_m"] = x * math.cos(g) - z * math.sin(g)
     cols["cross_track_error_m"] = x * math.sin(g) + z * math.cos(g)
-    cols["x_est_error_m"] = rec.hist_xa[:, 3, 0] - x
-    cols["z_est_error_m"] = rec.hist_xa[:, 4, 0] - z
+    cols["x_est_error_m"] = rec.hist_xa[:, ix, 0] - x
+    cols["z_est_error_m"] = rec.hist_xa[:, iz, 0] - z
     idx = np.searchsorted(k_sw, np.arange(n), side="right") - 1  # entry in force at step k
-    truth = np.column_stack([b0[:, 0], b0[:, 1] + b0[:, 2], b1[:, 0], b1[:, 1], b1[:, 2]])
-    for j, nm in enumerate(("b0_thrust", "b0_elevons", "b1_thrust", "b1_left", "b1_right")):
+    truth = estimator_params(b0.T, b1.T).T  # (entries, parameters)
+    for j, nm in enumerate(lay.params):
         cols[f"{nm}_true"] = truth[idx, j]
-        cols[f"{nm}_est"] = rec.hist_xa[:, 9 + j, 0]
+        cols[f"{nm}_est"] = rec.hist_xa[:, lay.n_x + j, 0]
         cols[f"{nm}_sd"] = np.sqrt(np.maximum(rec.hist_pdiag[:, j, 0], 0.0))
-    for j, nm in enumerate(("r_q", "r_nx", "r_nz")):
+    for j, nm in enumerate(lay.residuals):
         cols[nm] = rec.hist_res[:, j, 0]
     det = setup.det[runs_of(sc)[0]]
     cols["t_q"] = np.full(n, det.t_q)
@@ -134,10 +137,10 @@ def _timeseries(setup, sc, rec, k_sw, b0, b1) -> pd.DataFrame:
     for i, nm in enumerate(("throttle", "elevon_left", "elevon_right")):
         cols[f"cmd_{nm}"] = plant.u0[i] + rec.hist_u[:, i, 0]
         cols[f"cmd_{nm}_dev"] = rec.hist_u[:, i, 0]
-    cols["excitation_doublet"] = rec.hist_exc[:, 0, 0]
-    cols["excitation_3211"] = rec.hist_exc[:, 1, 0]
-    cols["excitation_doublet_start"] = rec.hist_exc[:, 2, 0] != 0.0
-    cols["excitation_3211_start"] = rec.hist_exc[:, 3, 0] != 0.0
+    cols["excitation_doublet"] = rec.hist_exc[:, EXC_DOUBLET, 0]
+    cols["excitation_3211"] = rec.hist_exc[:, EXC_3211, 0]
+    cols["excitation_doublet_start"] = rec.hist_exc[:, EXC_DOUBLET_START, 0] != 0.0
+    cols["excitation_3211_start"] = rec.hist_exc[:, EXC_3211_START, 0] != 0.0
     cols["reset_block"] = rec.hist_block[:, 0]
     cols["schedule_entry"] = idx
     df = pd.DataFrame(cols)

@@ -19,9 +19,8 @@ import math
 import numpy as np
 
 from ..config.schema import EstimatorConfig
-from ..conventions import TEST_ONE_STEP, VARIANTS
+from ..conventions import LONGITUDINAL, N_AUG, TEST_ONE_STEP, VARIANTS
 from ..core.settings import Belief, Detection, FilterModel
-from ..conventions import N_AUG
 from ..model.faults import bias_matrix, fault_bounds
 from ..model.linear import LinearPlant
 
@@ -183,7 +182,7 @@ def initial_covariance(fm: FilterModel, det: Detection) -> np.ndarray:
     starts as if every fault parameter had just been suspected.
     """
     P = np.diag(10.0 * fm.q_diag)
-    P[9:, 9:] = np.diag(det.reset_var)
+    P[LONGITUDINAL.faults, LONGITUDINAL.faults] = np.diag(det.reset_var)
     return P
 
 

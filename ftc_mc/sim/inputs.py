@@ -35,7 +35,8 @@ from collections import namedtuple
 
 import numpy as np
 
-from ..conventions import ACTUATOR_NAMES, NO_SENSOR_FAULT, OUTPUT_NAMES, SENSOR_FAULT_KINDS
+from ..conventions import (ACTUATOR_NAMES, LONGITUDINAL, NO_SENSOR_FAULT, OUTPUT_NAMES,
+                           SENSOR_FAULT_KINDS)
 from ..core.settings import TrialInputs
 from ..model.faults import estimator_params, mode_of
 
@@ -172,8 +173,8 @@ def build_inputs(setup, schedule: Schedule, draws: LaneDraws,
     assert schedule.k_switch.shape == (E,) and schedule.k_switch[0] == 0
     assert draws.w.shape[2] == L
     modes = entry_modes(schedule, setup.beta)
-    xa0 = np.zeros((14, L))
-    xa0[9:] = estimator_params(schedule.b0[0], schedule.b1[0])
+    xa0 = np.zeros((LONGITUDINAL.n_aug, L))
+    xa0[LONGITUDINAL.faults] = estimator_params(schedule.b0[0], schedule.b1[0])
     sensor = no_sensor_faults(L) if sensor is None else sensor
     return TrialInputs(k_switch=schedule.k_switch, b0=schedule.b0, b1=schedule.b1,
                        mode_pre=modes[0].copy(), mode_post=modes[-1].copy(), xa0=xa0,

@@ -21,7 +21,7 @@ import math
 import numpy as np
 
 from ..config.schema import Config, ScenarioConfig
-from ..conventions import VARIANTS
+from ..conventions import LONGITUDINAL, VARIANTS
 from ..core.interp import EngineTables
 from ..core.settings import (Belief, Controller, Detection, Excitation, FilterModel, Flight,
                              Reconfig, Scheme, Timing, TruthPlant, Validity)
@@ -189,7 +189,7 @@ def build_setup(cfg: Config | ScenarioConfig) -> SimSetup:
                      s3211_unit=cfg.steps(x.s3211_unit_s),
                      resend_delay=cfg.steps(x.resend_delay_s),
                      resend_b1=float(x.resend_b1_threshold))
-    val = Validity(va_trim=float(plant.trim.y0[11]), va_min=vc.airspeed_min_mps,
+    val = Validity(va_trim=float(plant.trim.y0[LONGITUDINAL.output("Va")]), va_min=vc.airspeed_min_mps,
                    va_max=vc.airspeed_max_mps, alpha_trim=plant.trim.alpha,
                    alpha_min=math.radians(vc.alpha_min_deg),
                    alpha_max=math.radians(vc.alpha_max_deg),
@@ -203,7 +203,7 @@ def build_setup(cfg: Config | ScenarioConfig) -> SimSetup:
         # the paper's thresholds set the initial fault variances whatever thresholds
         # are run, so trials share their pre-fault part across a threshold sweep
         P0=initial_covariance(fm, detection(plant, EstimatorSettings())),
-        q_std=cfg.noise.process_scale * np.sqrt(fm.q_diag[:9]),
+        q_std=cfg.noise.process_scale * np.sqrt(fm.q_diag[:LONGITUDINAL.n_x]),
         r_std=cfg.noise.measurement_scale * np.sqrt(fm.r_diag),
         beta=(cfg.estimator.beta_engine, cfg.estimator.beta_elevon),
         truth=truth, gust=gust, gust_chol=None if gust is None else gust.P0_chol)
