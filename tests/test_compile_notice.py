@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import hashlib
 import io
+import re
 import threading
 from pathlib import Path
 
@@ -18,6 +19,9 @@ import numba
 import pytest
 
 from ftc_mc.core import jit
+from ftc_mc.core.paths import (DENSE_FILTER, LINEAR_PLANT, ONE_STEP_TEST, PAPER_FILTER,
+                               RECONFIGURING, describe)
+from ftc_mc.core.paths import Path as Path_
 from ftc_mc.core.trial import advance
 from ftc_mc.io.lock import waiting
 from ftc_mc.sim.compiling import WAIT_NOTICE, compiled_once, lock_path
@@ -66,7 +70,7 @@ def test_cold_then_warm(monkeypatch):
     out = io.StringIO()
     assert jit.needs_compile(cold) is True
     assert jit.announce_compile(cold, stream=out)
-    assert out.getvalue().startswith("ftc-mc: compiling the simulation kernels once")
+    assert out.getvalue().startswith("ftc-mc: compiling the simulation kernels of this path")
     assert out.getvalue().count("\n") == 1
     warm = _FakeDispatcher({_key(cold): "file.nbc"})
     out = io.StringIO()
@@ -220,4 +224,27 @@ def test_compiled_once_waits_then_loads(tmp_path, monkeypatch, holder_compiles):
     if holder_compiles:
         assert lines == [WAIT_NOTICE]
     else:
-        assert len(lines) == 2 and lines[1].startswith("ftc-mc: compiling the simulation")
+        assert len(lines) == 3 and lines[1].startswith("ftc-mc: compiling the simulation")
+        assert re.fullmatch(r"ftc-mc: compiled in \d+\.\d s", lines[2]), lines[2]
+
+
+def test_each_path_is_announced_on_its_own(monkeypatch):
+    """A path is compiled (and announced, with its name) when neither this
+    process nor the disk cache holds the trial kernel's signature for that
+    path, whatever other paths they hold."""
+    monkeypatch.setattr(jit, "CACHE", True)
+    paper = Path_(LINEAR_PLANT, PAPER_FILTER, ONE_STEP_TEST, RECONFIGURING)
+    dense = paper._replace(filter=DENSE_FILTER)
+    t_paper, t_dense = numba.typeof(paper), numba.typeof(dense)
+    assert t_paper != t_dense
+    key = _key(advance)
+    cached = _FakeDispatcher({((t_paper, numba.float64), key[1], key[2]): "file.nbc"})
+    assert jit.needs_compile(cached, t_paper) is False
+    assert jit.needs_compile(cached, t_dense) is True
+    loaded = _FakeDispatcher({}, signatures=[(t_dense, numba.float64)])
+    assert jit.needs_compile(loaded, t_dense) is False
+    assert jit.needs_compile(loaded, t_paper) is True
+    out = io.StringIO()
+    assert jit.announce_compile(cached, describe(dense), stream=out,
+                                needed=jit.needs_compile(cached, t_dense))
+    assert "linear plant, dense filter, one-step test, reconfiguring controller" in out.getvalue()

@@ -31,6 +31,7 @@ from ftc_mc.core.workspace import new_trial_work
 from ftc_mc.model.turbulence import dryden_model
 from ftc_mc.model.wind import plant_wind_matrices
 from ftc_mc.sim.inputs import flight_inputs
+from ftc_mc.sim.paths import path_of
 
 NG = 4
 N = N_AUG + NG
@@ -100,7 +101,7 @@ def compare_steps(scheme, st, rng, scales, k0, n, tol_res=1e-11, tol=1e-9, tol_j
         xa, P, res, block, rmax, ebuf, ecount, last_k, last_block = naive.filter_update_ref(
             scheme, st, work.u, work.z, k)
         jac = naive.lane_jacobians_ref(scheme, st, work.u, k) if tol_jac else None
-        stages.filter_update(scheme, st, k, work)
+        stages.filter_update(path_of(scheme), scheme, st, k, work)
         if tol_jac:
             for f, J in jac.items():
                 for l in range(L):
@@ -298,8 +299,8 @@ def test_extended_equals_linear_small_signal(nonlinear_gusts):
             st = copy_nt(st0._replace(xa=xa))
             work = new_trial_work(L, N)
             work.u[:], work.z[:] = u, z
-            stages.filter_update(nonlinear_gusts.scheme("paper", det)._replace(filter=fm),
-                                 st, 10, work)
+            scheme = nonlinear_gusts.scheme("paper", det)._replace(filter=fm)
+            stages.filter_update(path_of(scheme), scheme, st, 10, work)
             out.append(st.xa.copy())
         diffs.append(rel(out[1] - xa, out[0] - xa))
     assert diffs[0] > 10 * diffs[2] and diffs[-1] < 1e-3, diffs
@@ -307,8 +308,8 @@ def test_extended_equals_linear_small_signal(nonlinear_gusts):
     st = copy_nt(with_gust_states(random_lanes(nonlinear_gusts, rng, 10), rng, d, P0)
                  ._replace(xa=np.zeros((N, L))))
     work = new_trial_work(L, N)
-    stages.filter_update(nonlinear_gusts.scheme("paper", det)._replace(filter=fm_n), st, 10,
-                         work)
+    scheme = nonlinear_gusts.scheme("paper", det)._replace(filter=fm_n)
+    stages.filter_update(path_of(scheme), scheme, st, 10, work)
     assert np.abs(work.fwork[N + 5]).max() < 1e-9  # the prediction, before the update
 
 

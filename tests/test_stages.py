@@ -43,6 +43,7 @@ from ftc_mc.core.settings import LaneState, TrialInputs, TrialRecord
 from ftc_mc.core.workspace import (new_lane_selection_work, new_selection_work,
                                    new_trial_work)
 from ftc_mc.config import Config
+from ftc_mc.sim.paths import path_of
 
 L = 7  # not a multiple of the vector width: remainders run too
 TIMING = {"fault_time_s": 2.0, "window_s": 2.0, "duration_s": 5.0}
@@ -369,7 +370,7 @@ def test_commands(fixture, request):
         st = random_lanes(setup, rng, k)
         st.xa[:N_X, :2] *= 60.0  # far from trim: saturation
         work = new_trial_work(L, N_AUG)
-        stages.commands(scheme, st, k, work)
+        stages.commands(path_of(scheme), scheme, st, k, work)
         u_n, exc_n = naive.commands_ref(scheme, st, k)
         assert np.array_equal(work.exc, exc_n)
         assert_lanes(work.u, u_n, 1e-12, "u")
@@ -399,7 +400,7 @@ def test_truth_step(fixture, request):
         work.u[:] = rng.uniform(setup.ctl.lo_dev[:, None], setup.ctl.hi_dev[:, None], (3, L))
         want = naive.truth_step_ref(scheme, flight, inp, k, st, work.u)
         x0, g0 = st.x.copy(), st.gust.copy()
-        kplant.truth_step(setup.fm, flight, inp, k, st, work)
+        kplant.truth_step(path_of(scheme, flight), setup.fm, flight, inp, k, st, work)
         assert np.array_equal(work.e, want["e"])
         for name, got in (("x", st.x), ("z", work.z), ("gust", st.gust), ("zhold", st.zhold),
                           ("wind", work.wind), ("wind_next", work.wind_next)):
@@ -439,7 +440,7 @@ def test_filter_update(linear, variant):
             work.z[:, l] = -mu0 + scale[l] * np.sqrt(np.diag(S)) * rng.standard_normal(12)
         xa, P, res, block, rmax, *_ = naive.filter_update_ref(scheme, st, work.u, work.z)
         Pk = st.P.copy()
-        stages.filter_update(scheme, st, 10, work)
+        stages.filter_update(path_of(scheme), scheme, st, 10, work)
         assert np.array_equal(work.block, block)
         assert_lanes(work.res, res, 1e-12, "residuals")
         assert rel(st.rmax, rmax) <= 1e-12
@@ -566,7 +567,7 @@ def test_reconfigure(fixture, request):
         want = naive.reconfigure_ref(scheme, setup.tim, inp, st, kn, period, rec)
         cur0 = st.cur.copy()
         work = new_trial_work(L, N_AUG)
-        stages.reconfigure(scheme, setup.tim, inp, st, kn, period, work, rec)
+        stages.reconfigure(path_of(scheme), scheme, setup.tim, inp, st, kn, period, work, rec)
         assert_lanes(st.belief, want["belief"], 1e-10, "belief")
         assert_lanes(rec.belief[period], want["rec_belief"][period], 1e-10, "recorded belief")
         assert np.array_equal(rec.bhat, want["rec_bhat"])
@@ -611,7 +612,7 @@ def assert_loop_matches(scheme, flight, inp, n_steps, tol):
     trial.init_jacobians(scheme.filter, st)
     rec_n, st_n = naive.advance_ref(scheme, flight, inp, copy_nt(rec), copy_nt(st), 0,
                                     n_steps)
-    trial.advance(scheme, flight, inp, rec, st, 0, n_steps)
+    trial.advance(path_of(scheme, flight), scheme, flight, inp, rec, st, 0, n_steps)
     for f in TrialRecord._fields:
         a, b = getattr(rec, f), getattr(rec_n, f)
         if a.dtype.kind in "iub":

@@ -37,6 +37,7 @@ from ..conventions import N_FAULT as N_F
 from .batch import UPDATE_ROWS, project_lanes, reset_lanes
 from .jit import kernel
 from .nonlinear import outputs_nb, propagate
+from .paths import EXTENDED_FILTER, on_path
 
 N_WIND = 3
 """Gust outputs ``u_g, w_g, q_g`` of the gust states (``FilterModel.Cg``)."""
@@ -222,8 +223,28 @@ def _nl_outputs(xa, fm, hpred, xp, tw):
             hpred[r, l] = acc
 
 
+# ------------------------------------------------------------------ path dispatch
+# The airframe's equations run only on the extended filter's path (core/paths.py):
+# on the dense path these calls compile to nothing, and the airframe is never
+# compiled.
+
+@on_path("filter", {EXTENDED_FILTER: _nl_state})
+def nl_state(path, xa, u, fm, xn, tw):
+    """:func:`_nl_state` on the extended filter's path."""
+
+
+@on_path("filter", {EXTENDED_FILTER: _nl_outputs})
+def nl_outputs(path, xa, fm, hpred, xp, tw):
+    """:func:`_nl_outputs` on the extended filter's path."""
+
+
+@on_path("filter", {EXTENDED_FILTER: relinearise_lanes})
+def relinearise(path, xa, u, fm, st, tw):
+    """:func:`relinearise_lanes` on the extended filter's path."""
+
+
 @kernel
-def _gpredict(xa, P, Pn, u, fm, phi, T, xn, tw, st):
+def _gpredict(path, xa, P, Pn, u, fm, phi, T, xn, tw, st):
     """Time update of every lane: ``X <- F X + B_aug u``, ``Pn <- F P F^T + Q``.
 
     ``F = [[A, Phi(u), G], [0, I, 0], [0, 0, A_d]]`` and ``Q`` block-diagonal
@@ -283,7 +304,7 @@ def _gpredict(xa, P, Pn, u, fm, phi, T, xn, tw, st):
                 acc += fm.Ad[a, g] * xa[N_AUG + g, l]
             xn[N_AUG + a, l] = acc
     if fm.nl != 0:
-        _nl_state(xa, u, fm, xn, tw)
+        nl_state(path, xa, u, fm, xn, tw)
     for i in range(N_X):
         for l in range(L):
             xa[i, l] = xn[i, l]
@@ -506,7 +527,7 @@ def _gupdate(xa, P, z, fm, crow, h, v, gs, hpred, xp, st, cl):
 
 
 @kernel(inline="always")
-def gust_predict_lanes(xa, P, fm, tw, st, k):
+def gust_predict_lanes(path, xa, P, fm, tw, st, k):
     """First half of a general filter step: predict into ``tw.fwork[:n]`` and the
     residuals; ``X_{k|k}`` is kept in ``tw.fwork`` for a re-prediction.
 
@@ -539,10 +560,10 @@ def gust_predict_lanes(xa, P, fm, tw, st, k):
         for l in range(xa.shape[1]):
             x_prev[i, l] = xa[i, l]
     if fm.relin > 0 and k % fm.relin == 0:
-        relinearise_lanes(xa, tw.u, fm, st, tw)
-    _gpredict(xa, P, work[0:n], tw.u, fm, tw.phi, tw.T, work[n + 3], tw, st)
+        relinearise(path, xa, tw.u, fm, st, tw)
+    _gpredict(path, xa, P, work[0:n], tw.u, fm, tw.phi, tw.T, work[n + 3], tw, st)
     if fm.nl != 0:
-        _nl_outputs(xa, fm, work[n + 4], work[n + 5], tw)
+        nl_outputs(path, xa, fm, work[n + 4], work[n + 5], tw)
     gust_residuals_lanes(xa, work[0:n], tw.z, fm, tw.crow, work[n + 4], tw.res, tw.innov,
                          st, tw.jc)
 
@@ -582,7 +603,7 @@ def reset_extra_lanes(P, block, reset_g):
 
 
 @kernel(inline="always")
-def gust_correct_lanes(xa, P, fm, det, tw, st):
+def gust_correct_lanes(path, xa, P, fm, det, tw, st):
     """Second half, once ``tw.block`` is decided: reset the block of ``P_{k|k}``
     (section 3.2.2, with the extra states that go with it,
     :func:`reset_extra_lanes`) of every lane that resets and predict all lanes again from
@@ -605,9 +626,9 @@ def gust_correct_lanes(xa, P, fm, det, tw, st):
         for i in range(n):
             for l in range(L):
                 xa[i, l] = x_prev[i, l]
-        _gpredict(xa, P, Pn, tw.u, fm, tw.phi, tw.T, work[n + 3], tw, st)
+        _gpredict(path, xa, P, Pn, tw.u, fm, tw.phi, tw.T, work[n + 3], tw, st)
         if fm.nl != 0:
-            _nl_outputs(xa, fm, work[n + 4], work[n + 5], tw)
+            nl_outputs(path, xa, fm, work[n + 4], work[n + 5], tw)
     _gupdate(xa, Pn, tw.z, fm, tw.crow, work[n], work[n + 1], work[n + 2], work[n + 4],
              work[n + 5], st, tw.jc)
     for i in range(n):

@@ -64,12 +64,17 @@ def kernel(func=None, **overrides):
     return numba.njit(**opts)(func)
 
 
-COMPILE_NOTICE = ("ftc-mc: compiling the simulation kernels once (about {} on 2 cores; "
-                  "later runs start at once)")
-"""Printed to stderr before the first run that compiles the trial kernel."""
+COMPILE_NOTICE = ("ftc-mc: compiling the simulation kernels of this path once: {} "
+                  "(about {} on 2 cores; later runs start at once)")
+"""Printed to stderr before the first run that compiles a path of the trial kernel
+(``core/paths.py``)."""
 
-COMPILE_NOTICE_NO_CACHE = ("ftc-mc: compiling the simulation kernels (about {} on 2 "
-                           "cores; FTC_MC_NUMBA_CACHE=0, so every run compiles)")
+COMPILE_NOTICE_NO_CACHE = ("ftc-mc: compiling the simulation kernels of this path: {} "
+                           "(about {} on 2 cores; FTC_MC_NUMBA_CACHE=0, so every run "
+                           "compiles)")
+
+COMPILED_NOTICE = "ftc-mc: compiled in {:.1f} s"
+"""Printed to stderr when that compile is done, with its measured duration."""
 
 
 def index_has_overload(index_keys, magic, code_hash) -> bool:
@@ -96,16 +101,17 @@ def index_has_overload(index_keys, magic, code_hash) -> bool:
     return False
 
 
-def in_disk_cache(dispatcher) -> bool | None:
+def in_disk_cache(dispatcher, first=None) -> bool | None:
     """Whether Numba's on-disk cache holds an overload of ``dispatcher`` for this
     machine and source (so calling it loads instead of compiling).
 
     Reads the cache index the way Numba's ``FunctionCache`` does (the source
-    stamp of the function's file, then the key's target and bytecode hash); the
-    signature itself is not checked, since the campaign, sweep and scenario
-    paths call the trial kernel with one and the same signature.  Returns
-    ``None`` when the cache's layout is not the expected one (a Numba version
-    that changed it).
+    stamp of the function's file, then the key's target and bytecode hash).
+    Of the signature, only the first argument's type is checked, when
+    ``first`` gives it (the trial kernel's compile path, ``core/paths.py``):
+    the campaign, sweep and scenario call each path with one and the same
+    signature.  Returns ``None`` when the cache's layout is not the expected
+    one (a Numba version that changed it).
     """
     import hashlib
     try:
@@ -114,32 +120,45 @@ def in_disk_cache(dispatcher) -> bool | None:
     except Exception:  # noqa: BLE001 -- numba internals; the notice is optional
         return None
     code_hash = hashlib.sha256(dispatcher.py_func.__code__.co_code).hexdigest()
-    return index_has_overload(index.keys(), magic, code_hash)
+    keys = [k for k in index.keys() if first is None or _first_arg(k) == first]
+    return index_has_overload(keys, magic, code_hash)
 
 
-def needs_compile(dispatcher) -> bool | None:
+def _first_arg(key):
+    """The first argument's type of a cache index key's signature, or None."""
+    try:
+        return key[0][0]
+    except (TypeError, IndexError):
+        return None
+
+
+def needs_compile(dispatcher, first=None) -> bool | None:
     """Whether calling ``dispatcher`` will compile it: no overload in this
-    process and none in the on-disk cache (:func:`in_disk_cache`).  ``None``
-    when that cannot be told (then nothing is announced)."""
-    if dispatcher.signatures:
+    process and none in the on-disk cache (:func:`in_disk_cache`); with
+    ``first``, none whose first argument has that Numba type.  ``None`` when
+    that cannot be told (then nothing is announced)."""
+    if any(first is None or sig[0] == first for sig in dispatcher.signatures):
         return False
     if not CACHE:
         return True
-    cached = in_disk_cache(dispatcher)
+    cached = in_disk_cache(dispatcher, first)
     return None if cached is None else not cached
 
 
-def announce_compile(dispatcher, duration="1.5 min", stream=None, needed=None) -> bool:
+def announce_compile(dispatcher, what="", duration="1 min", stream=None,
+                     needed=None) -> bool:
     """Print :data:`COMPILE_NOTICE` to stderr if ``dispatcher`` is about to be
     compiled (:func:`needs_compile`, or ``needed`` when the caller has just
-    asked it); return whether it was printed.  The
-    duration is measured by ``scripts/bench_campaign.py``: 91-100 s since the
-    trial kernel is no longer wrapped in a compiled ``run_trials`` and the
-    kernels between it and the leaves are inlined (120-144 s before,
-    ``docs/performance.md`` lesson 6)."""
+    asked it); return whether it was printed.
+
+    ``what`` names the path compiled, ``duration`` the time it takes
+    (``scripts/bench_campaign.py`` and ``docs/performance.md`` lesson 10
+    measure each path).
+    """
     import sys
     if (needs_compile(dispatcher) if needed is None else needed) is not True:
         return False
     text = COMPILE_NOTICE if CACHE else COMPILE_NOTICE_NO_CACHE
-    print(text.format(duration), file=sys.stderr if stream is None else stream, flush=True)
+    print(text.format(what, duration), file=sys.stderr if stream is None else stream,
+          flush=True)
     return True

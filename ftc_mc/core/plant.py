@@ -33,6 +33,7 @@ from ..conventions import (N_U, N_X, N_Z, OUT_ALPHA, OUT_VA, SENSOR_BIAS, SENSOR
 from .dryden import N_GUST_OUT, N_GUST_STATE, gust_step
 from .jit import kernel
 from .nonlinear import outputs_nb, propagate
+from .paths import LINEAR_PLANT, NONLINEAR_PLANT, on_path
 
 
 @kernel
@@ -280,11 +281,25 @@ def sensor_fault(inp, k, dt, v, zhold, z):
 
 
 @kernel(inline="always")
-def truth_step(model, flight, inp, k, st, work):
+def nonlinear_truth(model, flight, w, v, x, work):
+    """:func:`nonlinear_step` with :func:`linear_step`'s parameters."""
+    nonlinear_step(model.u0, flight.plant, w, v, x, work)
+
+
+@on_path("plant", {LINEAR_PLANT: linear_step, NONLINEAR_PLANT: nonlinear_truth})
+def plant_step(path, model, flight, w, v, x, work):
+    """The path's truth plant over one step: :func:`linear_step` or the
+    nonlinear X8 (:func:`nonlinear_step`)."""
+
+
+@kernel(inline="always")
+def truth_step(path, model, flight, inp, k, st, work):
     """Stage 2: the truth plant over step ``k -> k+1`` on every lane (module docstring).
 
     Parameters
     ----------
+    path : Path
+        The compile path (``core/paths.py``): its ``plant``.
     model : FilterModel
         The linear model (``A``, ``B``, ``C``) and the trim commands ``u0``.
     flight : Flight
@@ -307,8 +322,5 @@ def truth_step(model, flight, inp, k, st, work):
     actuator_effect(model.u0, inp.b0[ev], inp.b1[ev], work.u, work.e)
     if pl.turb != 0:
         gust_lanes(pl, inp.eta[k], st.gust, work.wind, work.wind_next, work)
-    if pl.kind == 0:
-        linear_step(model, flight, inp.w[k], inp.v[k], st.x, work)
-    else:
-        nonlinear_step(model.u0, pl, inp.w[k], inp.v[k], st.x, work)
+    plant_step(path, model, flight, inp.w[k], inp.v[k], st.x, work)
     sensor_fault(inp, k, pl.dt, inp.v[k], st.zhold, work.z)

@@ -37,8 +37,7 @@ import numpy as np
 
 from ..conventions import (C_ELEVON, I_B1_LEFT, I_B1_THRUST, N_AUG, N_FAULT, N_MODES,
                            N_U, N_X, NO_RESET, RESET_THRUST, STATUS_AIRSPEED,
-                           STATUS_ALPHA, STATUS_NONFINITE, STATUS_NOT_PSD, STATUS_OK,
-                           TEST_GLR)
+                           STATUS_ALPHA, STATUS_NONFINITE, STATUS_NOT_PSD, STATUS_OK)
 from .batch import (filter_correct_lanes, filter_predict_lanes, innovations_lanes,
                     signature_lanes)
 from .glr import glr_lanes, glr_restart
@@ -49,6 +48,8 @@ from .control import (U_LEFT, U_RIGHT, U_THRUST, controller_command,
 from .excitation import (doublet, doublet_length, running, saturate, signal_3211,
                          signal_3211_length)
 from .jit import kernel
+from .paths import (DENSE_FILTER, EXTENDED_FILTER, GLR_TEST, NOMINAL_CONTROL, ONE_STEP_TEST,
+                    PAPER_FILTER, RECONFIGURING, on_path)
 from .workspace import EXC_3211, EXC_3211_START, EXC_DOUBLET, EXC_DOUBLET_START
 
 R_Q, R_NX = 0, 1
@@ -57,22 +58,64 @@ R_Q, R_NX = 0, 1
 
 # ------------------------------------------------------------------ 1. commands
 @kernel(inline="always")
-def commands(scheme, st, k, work):
+def nominal_output(scheme, st, work):
+    """The nominal controller's output ``U = -K x_hat`` (c0, eq. 19) of every
+    lane into ``work.u``."""
+    K = scheme.controller.K
+    xa = st.xa
+    u = work.u
+    L = xa.shape[1]
+    for i in range(N_U):
+        for l in range(L):
+            u[i, l] = 0.0
+        for j in range(N_X):
+            kij = K[i, j]
+            for l in range(L):
+                u[i, l] -= kij * xa[j, l]
+
+
+@kernel(inline="always")
+def reconfiguring_output(scheme, st, work):
+    """The output of each lane's controller in use into ``work.u``
+    (:func:`ftc_mc.core.control.controller_command`: c0, c1 of eq. 44 or c2 of
+    eqs. 20-25); one-lane buffers ``xl``, ``Ul``."""
+    xa = st.xa
+    xl = work.xl
+    Ul = work.Ul
+    for l in range(xa.shape[1]):
+        for i in range(xa.shape[0]):
+            xl[i] = xa[i, l]
+        controller_command(st.cur[l], xl, scheme.controller.K, scheme.engine,
+                           scheme.filter.u0, Ul)
+        for i in range(N_U):
+            work.u[i, l] = Ul[i]
+
+
+@on_path("control", {NOMINAL_CONTROL: nominal_output, RECONFIGURING: reconfiguring_output})
+def controller_output(path, scheme, st, work):
+    """The controller output of the path's scheme: :func:`nominal_output` or
+    :func:`reconfiguring_output`."""
+
+
+@kernel(inline="always")
+def commands(path, scheme, st, k, work):
     """Stage 1: the commands ``u_k`` of every lane (deviations from trim).
 
-    Controller output ``U`` from the estimate ``x_hat_k``: ``-K x_hat`` (c0,
-    eq. 19) for the nominal scheme (``reconfig.kind == 0``), else the lane's
-    controller in use (:func:`ftc_mc.core.control.controller_command`: c0, c1
-    of eq. 44 or c2 of eqs. 20-25).  Then the saturation with excitation
+    Controller output ``U`` from the estimate ``x_hat_k``
+    (:func:`controller_output`): ``-K x_hat`` (c0, eq. 19) on the nominal
+    controller's path, else the lane's controller in use (c0, c1 of eq. 44 or
+    c2 of eqs. 20-25).  Then the saturation with excitation
     headroom (eq. 15, eq. 16 without a signal): the doublet on the engine while
     one runs; the 3211 on the left elevon and its negative on the right while
     one runs, scaled by ``1 - b1_left_hat`` under c2 (eq. 23).
 
     Parameters
     ----------
+    path : Path
+        The compile path (``core/paths.py``): its ``control``.
     scheme : Scheme
-        Reads ``controller`` (gain, limits), ``excitation``, ``reconfig.kind``,
-        ``engine`` and ``filter.u0``.
+        Reads ``controller`` (gain, limits), ``excitation``, ``engine`` and
+        ``filter.u0``.
     st : LaneState
         Reads ``xa``, ``cur``, ``d_start``, ``s_start``.
     k : int
@@ -86,25 +129,8 @@ def commands(scheme, st, k, work):
     xa = st.xa
     u = work.u
     out = work.exc
-    n = xa.shape[0]
     L = xa.shape[1]
-    if scheme.reconfig.kind == 0:
-        for i in range(N_U):
-            for l in range(L):
-                u[i, l] = 0.0
-            for j in range(N_X):
-                kij = ctl.K[i, j]
-                for l in range(L):
-                    u[i, l] -= kij * xa[j, l]
-    else:
-        xl = work.xl
-        Ul = work.Ul
-        for l in range(L):
-            for i in range(n):
-                xl[i] = xa[i, l]
-            controller_command(st.cur[l], xl, ctl.K, scheme.engine, scheme.filter.u0, Ul)
-            for i in range(N_U):
-                u[i, l] = Ul[i]
+    controller_output(path, scheme, st, work)
     d_len = doublet_length(exc.doublet_half)
     s_len = signal_3211_length(exc.s3211_unit)
     lo = ctl.lo_dev
@@ -137,15 +163,88 @@ def commands(scheme, st, k, work):
 
 # ------------------------------------------------------------------ 3. filter
 @kernel(inline="always")
-def filter_update(scheme, st, k, work):
+def paper_predict(scheme, st, k, work):
+    """The paper filter's prediction and one-step residuals
+    (:func:`ftc_mc.core.batch.filter_predict_lanes`)."""
+    filter_predict_lanes(st.xa, st.P, work.u, work.z, scheme.filter, work.phi, work.T,
+                         work.fwork, work.res)
+
+
+@kernel(inline="always")
+def paper_predict_glr(scheme, st, k, work):
+    """:func:`paper_predict` and the signed innovations the GLR test reads
+    (:func:`ftc_mc.core.batch.innovations_lanes`)."""
+    paper_predict(scheme, st, k, work)
+    innovations_lanes(st.xa, work.fwork[0:st.xa.shape[0]], work.z, scheme.filter, work.innov)
+
+
+@on_path("test", {ONE_STEP_TEST: paper_predict, GLR_TEST: paper_predict_glr})
+def paper_predict_on(path, scheme, st, k, work):
+    """The paper filter's prediction, with the innovations on the GLR test's path."""
+
+
+@kernel(inline="always")
+def general_predict(path, scheme, st, k, work):
+    """The general filter's prediction and residuals
+    (:func:`ftc_mc.core.gustfilter.gust_predict_lanes`)."""
+    gust_predict_lanes(path, st.xa, st.P, scheme.filter, work, st, k)
+
+
+@on_path("filter", {PAPER_FILTER: paper_predict_on, DENSE_FILTER: general_predict,
+                    EXTENDED_FILTER: general_predict}, with_path=True)
+def predict(path, scheme, st, k, work):
+    """The first half of the path's filter step."""
+
+
+@kernel(inline="always")
+def paper_correct(path, scheme, st, work):
+    """Reset, update and projection of the paper's filter
+    (:func:`ftc_mc.core.batch.filter_correct_lanes`; ``path`` unused)."""
+    filter_correct_lanes(st.xa, st.P, work.u, work.z, scheme.filter, scheme.detection,
+                         work.phi, work.T, work.fwork, work.block)
+
+
+@kernel(inline="always")
+def general_correct(path, scheme, st, work):
+    """Reset, re-prediction, update and projection of the general filter
+    (:func:`ftc_mc.core.gustfilter.gust_correct_lanes`)."""
+    gust_correct_lanes(path, st.xa, st.P, scheme.filter, scheme.detection, work, st)
+
+
+@on_path("filter", {PAPER_FILTER: paper_correct, DENSE_FILTER: general_correct,
+                    EXTENDED_FILTER: general_correct}, with_path=True)
+def correct(path, scheme, st, work):
+    """The second half of the path's filter step."""
+
+
+@kernel(inline="always")
+def glr_statistics(det, st, k, work):
+    """The GLR statistics of the window (:func:`ftc_mc.core.glr.glr_lanes`) in
+    place of the one-step residuals ``work.res``."""
+    glr_lanes(work.innov, st.ebuf, st.ecount, k, det.min_window, work.res)
+
+
+@on_path("test", {GLR_TEST: glr_statistics})
+def decision_statistics(path, det, st, k, work):
+    """The GLR test's statistics on its path; the one-step residuals stand
+    otherwise."""
+
+
+@on_path("test", {GLR_TEST: glr_restart})
+def restart_window(path, block, ecount):
+    """A reset restarts the lane's GLR window (on the GLR test's path)."""
+
+
+@kernel(inline="always")
+def filter_update(path, scheme, st, k, work):
     """Stage 3: one step of every lane's augmented filter (eqs. 5-11, Table 1).
 
     Predict with ``u_k`` and the residuals on ``z_{k+1}``
-    (:func:`ftc_mc.core.batch.filter_predict_lanes` for the paper's 14-state
-    filter, :func:`ftc_mc.core.gustfilter.gust_predict_lanes` when the estimate
-    carries gust states or the airframe predicts, ``filter.nl``); with the GLR
-    test (``detection.test == TEST_GLR``) the statistics of
-    :func:`ftc_mc.core.glr.glr_lanes` replace the one-step residuals; Table 1
+    (:func:`predict`: :func:`ftc_mc.core.batch.filter_predict_lanes` on the
+    paper filter's path, :func:`ftc_mc.core.gustfilter.gust_predict_lanes` on
+    the dense and extended filters' paths); on the GLR test's path the
+    statistics of :func:`ftc_mc.core.glr.glr_lanes` replace the one-step
+    residuals; Table 1
     on them, a decision for the other block withheld within
     ``detection.settle`` steps of a reset (:func:`settle_lanes`); reset, update
     and projection (the ``*_correct_lanes`` halves); a reset restarts the
@@ -154,6 +253,8 @@ def filter_update(scheme, st, k, work):
 
     Parameters
     ----------
+    path : Path
+        The compile path (``core/paths.py``): its ``filter`` and ``test``.
     scheme : Scheme
         Reads ``filter`` and ``detection``.
     st : LaneState
@@ -168,29 +269,15 @@ def filter_update(scheme, st, k, work):
         residuals or GLR), ``block`` and, for the GLR test or the general
         filter, ``innov``; filter work ``phi``, ``T``, ``fwork``, ``crow``.
     """
-    fm = scheme.filter
     det = scheme.detection
     res = work.res
-    paper = st.xa.shape[0] == N_AUG and fm.nl == 0
-    if paper:
-        filter_predict_lanes(st.xa, st.P, work.u, work.z, fm, work.phi, work.T, work.fwork,
-                             res)
-        if det.test == TEST_GLR:
-            innovations_lanes(st.xa, work.fwork[0:st.xa.shape[0]], work.z, fm, work.innov)
-    else:
-        gust_predict_lanes(st.xa, st.P, fm, work, st, k)
-    if det.test == TEST_GLR:
-        glr_lanes(work.innov, st.ebuf, st.ecount, k, det.min_window, res)
+    predict(path, scheme, st, k, work)
+    decision_statistics(path, det, st, k, work)
     signature_lanes(res, det, work.block)
     if det.settle > 0:
         settle_lanes(work.block, st.last_k, st.last_block, k, det.settle)
-    if paper:
-        filter_correct_lanes(st.xa, st.P, work.u, work.z, fm, det, work.phi, work.T,
-                             work.fwork, work.block)
-    else:
-        gust_correct_lanes(st.xa, st.P, fm, det, work, st)
-    if det.test == TEST_GLR:
-        glr_restart(work.block, st.ecount)
+    correct(path, scheme, st, work)
+    restart_window(path, work.block, st.ecount)
     if det.settle > 0:
         for l in range(st.xa.shape[1]):
             if work.block[l] != 0:
@@ -407,12 +494,39 @@ def record_step(k, st, work, rec):
 
 # ------------------------------------------------------------------ 7. reconfigure
 @kernel(inline="always")
-def reconfigure(scheme, timing, inp, st, kn, period, work, rec):
+def select_lanes(scheme, st, work):
+    """The controller selection (eqs. 45-47) of every lane
+    (:func:`ftc_mc.core.control.select_controllers_lanes`) on the estimate's
+    first 14 states (a design's extra states are left out); ``st.cur``
+    updated."""
+    xa = st.xa
+    P = st.P
+    L = xa.shape[1]
+    if xa.shape[0] == N_AUG:
+        select_controllers_lanes(st.cur, xa, P, st.belief, scheme, work.lsel)
+    else:  # the selection predicts with the paper's model: the first 14 states
+        for i in range(N_AUG):
+            for l in range(L):
+                work.xsel[i, l] = xa[i, l]
+            for j in range(N_AUG):
+                for l in range(L):
+                    work.Psel[i, j, l] = P[i, j, l]
+        select_controllers_lanes(st.cur, work.xsel, work.Psel, st.belief, scheme, work.lsel)
+
+
+@on_path("control", {RECONFIGURING: select_lanes})
+def select(path, scheme, st, work):
+    """The controller selection on the reconfiguring path (:func:`select_lanes`);
+    c0 stays in use on the nominal one."""
+
+
+@kernel(inline="always")
+def reconfigure(path, scheme, timing, inp, st, kn, period, work, rec):
     """Stage 7, every reconfiguration period: belief, controller, detection.
 
     Per lane: the belief update (eqs. 13-14) with the fault-parameter estimate
-    and its marginal variances (eq. 12); for the reconfiguring scheme
-    (``reconfig.kind != 0``) the controller selection (eqs. 45-47) on the
+    and its marginal variances (eq. 12); on the reconfiguring controller's
+    path the controller selection (eqs. 45-47, :func:`select`) on the
     estimate's first 14 states (a design's gust states are left out), for every
     lane at once (:func:`ftc_mc.core.control.select_controllers_lanes`, per
     lane bit-identical to :func:`~ftc_mc.core.control.select_controller`; the
@@ -423,8 +537,10 @@ def reconfigure(scheme, timing, inp, st, kn, period, work, rec):
 
     Parameters
     ----------
+    path : Path
+        The compile path (``core/paths.py``): its ``control``.
     scheme : Scheme
-        Reads ``belief``, ``reconfig`` (and, when reconfiguring, ``filter``,
+        Reads ``belief`` (and, when reconfiguring, ``reconfig``, ``filter``,
         ``controller``, ``engine``).
     timing : Timing
         ``k_fault``, ``detect_prob``.
@@ -465,18 +581,7 @@ def reconfigure(scheme, timing, inp, st, kn, period, work, rec):
         if (st.alive[l] and kn > timing.k_fault and rec.detect_k[l] < 0 and best == mp
                 and bl[mp] >= timing.detect_prob):
             rec.detect_k[l] = kn
-    if scheme.reconfig.kind != 0:
-        if xa.shape[0] == N_AUG:
-            select_controllers_lanes(st.cur, xa, P, st.belief, scheme, work.lsel)
-        else:  # the selection predicts with the paper's model: the first 14 states
-            for i in range(N_AUG):
-                for l in range(L):
-                    work.xsel[i, l] = xa[i, l]
-                for j in range(N_AUG):
-                    for l in range(L):
-                        work.Psel[i, j, l] = P[i, j, l]
-            select_controllers_lanes(st.cur, work.xsel, work.Psel, st.belief, scheme,
-                                     work.lsel)
+    select(path, scheme, st, work)
     for l in range(L):
         rec.controller[period, l] = st.cur[l]
 

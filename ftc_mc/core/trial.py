@@ -49,11 +49,18 @@ N_RMAX = 2
 
 
 @kernel
-def advance(scheme, flight, inp, rec, st, k0, k1):
+def advance(path, scheme, flight, inp, rec, st, k0, k1):
     """Advance ``L`` trials from step ``k0`` to ``k1``, writing their records.
+
+    Each compile path is its own signature, compiled on its first call
+    (``core/paths.py``).
 
     Parameters
     ----------
+    path : Path
+        The compile path: the truth plant, filter, residual test and
+        controller kinds of ``scheme`` and ``flight``
+        (:func:`ftc_mc.sim.paths.path_of`).
     scheme : Scheme
         The FTC scheme: ``filter`` (FilterModel), ``detection`` (Detection),
         ``belief`` (Belief), ``controller`` (Controller), ``excitation``
@@ -80,14 +87,14 @@ def advance(scheme, flight, inp, rec, st, k0, k1):
     period = k0 // every
     for k in range(k0, k1):
         kn = k + 1
-        commands(scheme, st, k, work)
-        truth_step(scheme.filter, flight, inp, k, st, work)
-        filter_update(scheme, st, k, work)
+        commands(path, scheme, st, k, work)
+        truth_step(path, scheme.filter, flight, inp, k, st, work)
+        filter_update(path, scheme, st, k, work)
         check_validity(flight.validity, st, kn, work, rec)
         handle_resets(scheme.excitation, st, kn, work, rec)
         record_step(k, st, work, rec)
         if kn % every == 0:
-            reconfigure(scheme, flight.timing, inp, st, kn, period, work, rec)
+            reconfigure(path, scheme, flight.timing, inp, st, kn, period, work, rec)
             period += 1
     record_end(st, rec)
 

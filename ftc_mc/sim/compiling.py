@@ -1,6 +1,7 @@
-"""One compile of the trial kernel at a time per kernel cache.
+"""One compile of each path of the trial kernel at a time per kernel cache.
 
-A cold compile of :func:`ftc_mc.core.trial.advance` takes about 1.5 minutes
+A cold compile of a path of :func:`ftc_mc.core.trial.advance`
+(``core/paths.py``) takes from a quarter of a minute to a minute
 (``scripts/bench_campaign.py``).  Processes that start together on an empty
 cache (two runs launched at once, Dask or test workers on one machine) would
 each compile it, on cores they then share.  :func:`compiled_once` makes the
@@ -12,12 +13,15 @@ processes that would share the compiled kernel.
 from __future__ import annotations
 
 import contextlib
+import re
 import sys
+import time
 from pathlib import Path
 
 import numba
 
 from ..core import jit
+from ..core.paths import describe
 from ..io.lock import waiting
 
 WAIT_NOTICE = ("ftc-mc: another process is compiling the simulation kernels; waiting "
@@ -32,16 +36,19 @@ GAVE_UP_NOTICE = ("ftc-mc: the other process has not finished compiling after {:
                   "compiling here")
 
 
-def lock_path(dispatcher) -> Path:
-    """The compile lock of ``dispatcher``: a file beside its cached overloads
-    (the folder of :func:`ftc_mc.core.jit.cache_dir`, or ``NUMBA_CACHE_DIR``)."""
-    return Path(numba.config.CACHE_DIR) / f"{dispatcher.py_func.__name__}.compile.lock"
+def lock_path(dispatcher, path=None) -> Path:
+    """The compile lock of ``dispatcher`` (of its compile ``path``): a file beside
+    its cached overloads (the folder of :func:`ftc_mc.core.jit.cache_dir`, or
+    ``NUMBA_CACHE_DIR``)."""
+    tag = "" if path is None else "." + re.sub(r"[^a-z0-9]+", "-", describe(path).lower())
+    return Path(numba.config.CACHE_DIR) / f"{dispatcher.py_func.__name__}{tag}.compile.lock"
 
 
 @contextlib.contextmanager
-def compiled_once(dispatcher, stream=None):
-    """Run the ``with`` block, which calls ``dispatcher`` first in this process,
-    as the machine's only compile of it.
+def compiled_once(dispatcher, path=None, stream=None):
+    """Run the ``with`` block, which calls ``dispatcher`` (on the compile
+    ``path``, its first argument) first in this process, as the machine's only
+    compile of it.
 
     When the call would compile (:func:`ftc_mc.core.jit.needs_compile`), the
     block waits for the compile lock (:func:`lock_path`), saying so on
@@ -57,15 +64,20 @@ def compiled_once(dispatcher, stream=None):
     ----------
     dispatcher : numba dispatcher
         The kernel the block calls (``advance``).
+    path : Path, optional
+        The compile path the block calls it on (``core/paths.py``); the notice
+        names it, and when the compile is done says how long it took.
     stream : file, optional
         Where the notices go (default stderr).
     """
-    needed = jit.needs_compile(dispatcher)
-    if not jit.CACHE or needed is not True:
-        jit.announce_compile(dispatcher, stream=stream, needed=needed)
-        yield
-        return
+    first = None if path is None else numba.typeof(path)
+    what = "" if path is None else describe(path)
     out = sys.stderr if stream is None else stream
+    needed = jit.needs_compile(dispatcher, first)
+    if not jit.CACHE or needed is not True:
+        with _timed(jit.announce_compile(dispatcher, what, stream=out, needed=needed), out):
+            yield
+        return
 
     def say_wait():
         print(WAIT_NOTICE, file=out, flush=True)
@@ -74,10 +86,20 @@ def compiled_once(dispatcher, stream=None):
         print(GAVE_UP_NOTICE.format(WAIT_LIMIT_S), file=out, flush=True)
 
     with contextlib.ExitStack() as stack:
-        stack.enter_context(waiting(lock_path(dispatcher), on_wait=say_wait,
+        stack.enter_context(waiting(lock_path(dispatcher, path), on_wait=say_wait,
                                     timeout_s=WAIT_LIMIT_S, on_timeout=give_up))
-        needed = jit.needs_compile(dispatcher)  # again: the holder may have filled it
+        needed = jit.needs_compile(dispatcher, first)  # again: the holder may have filled it
         if needed is not True:
             stack.close()  # the holder filled the cache: load it without the lock
-        jit.announce_compile(dispatcher, stream=stream, needed=needed)
-        yield
+        with _timed(jit.announce_compile(dispatcher, what, stream=out, needed=needed), out):
+            yield
+
+
+@contextlib.contextmanager
+def _timed(announced: bool, out):
+    """Say how long the block took (:data:`ftc_mc.core.jit.COMPILED_NOTICE`)
+    when a compile was announced before it."""
+    t0 = time.perf_counter()
+    yield
+    if announced:
+        print(jit.COMPILED_NOTICE.format(time.perf_counter() - t0), file=out, flush=True)

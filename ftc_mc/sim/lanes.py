@@ -28,6 +28,7 @@ import numpy as np
 from ..core.settings import TrialInputs, TrialRecord
 from ..core.trial import advance, init_jacobians, init_state, new_state
 from .inputs import design_inputs
+from .paths import path_of
 
 HISTORY_RESETS = 100_000
 """Resets stored per lane when every step is kept (a scenario)."""
@@ -55,7 +56,7 @@ def run_trials(scheme, flight, inp: TrialInputs, rec: TrialRecord) -> None:
     (``docs/performance.md``, lesson 6).
     """
     st = start_lanes(scheme, inp, rec)
-    advance(scheme, flight, inp, rec, st, 0, flight.timing.n_steps)
+    advance(path_of(scheme, flight), scheme, flight, inp, rec, st, 0, flight.timing.n_steps)
 
 
 def new_record(setup, L: int, max_resets: int, history: bool = False,
@@ -157,7 +158,7 @@ def _shared_start(setup, name: str, inp: TrialInputs, max_resets: int, k_share: 
     rec0 = new_record(setup, L, max_resets, n_est=setup.designs[name].n_aug)
     scheme = setup.scheme(name, setup.detection(name, math.inf, math.inf))
     st0 = start_lanes(scheme, dinp, rec0)
-    advance(scheme, setup.flight, dinp, rec0, st0, 0, k_share)
+    advance(path_of(scheme, setup.flight), scheme, setup.flight, dinp, rec0, st0, 0, k_share)
     return rec0, st0
 
 
@@ -168,8 +169,9 @@ def _continue(setup, run, inp: TrialInputs, rec0, st0, max_resets: int, k_share:
     rec, st = _copy(rec0), _copy(st0)
     simulated = 0
     if k_share < n:
-        advance(setup.scheme(name, det), setup.flight, design_inputs(inp, setup.designs[name]),
-                rec, st, k_share, n)
+        scheme = setup.scheme(name, det)
+        advance(path_of(scheme, setup.flight), scheme, setup.flight,
+                design_inputs(inp, setup.designs[name]), rec, st, k_share, n)
         simulated += L * (n - k_share)
     dirty = np.flatnonzero((st0.rmax[0] >= det.t_q) | (st0.rmax[1] >= det.t_nx))
     if len(dirty):

@@ -1,0 +1,38 @@
+"""The compile path of a scheme flying a flight (``ftc_mc/core/paths.py``).
+
+The one place where the settings decide which kernels a trial reaches: the
+truth plant's kind, the filter (the paper's 14 states with a linear
+prediction, any other estimate, or a prediction by the airframe's equations),
+the residual test and the controller.
+"""
+
+from __future__ import annotations
+
+from ..conventions import TEST_GLR
+from ..core.paths import (DENSE_FILTER, EXTENDED_FILTER, GLR_TEST, LINEAR_PLANT,
+                          NOMINAL_CONTROL, NONLINEAR_PLANT, ONE_STEP_TEST, PAPER_FILTER,
+                          RECONFIGURING, Path)
+from ..core.settings import Flight, Scheme
+
+
+def path_of(scheme: Scheme, flight: Flight | None = None) -> Path:
+    """The :class:`~ftc_mc.core.paths.Path` of ``scheme`` flying ``flight``
+    (``None``: the linear plant, for the stages that do not fly it).
+
+    The filter is the paper's when its estimate has the paper's 14 states
+    (``FilterModel.G`` has no column: no gust or bias states) and it predicts
+    with the linear model; extended when it predicts with the airframe
+    (``FilterModel.nl``); dense otherwise.
+    """
+    fm = scheme.filter
+    if fm.nl != 0:
+        filt = EXTENDED_FILTER
+    elif fm.G.shape[1] == 0:
+        filt = PAPER_FILTER
+    else:
+        filt = DENSE_FILTER
+    linear = flight is None or flight.plant.kind == 0
+    return Path(plant=LINEAR_PLANT if linear else NONLINEAR_PLANT,
+                filter=filt,
+                test=GLR_TEST if scheme.detection.test == TEST_GLR else ONE_STEP_TEST,
+                control=NOMINAL_CONTROL if scheme.reconfig.kind == 0 else RECONFIGURING)
