@@ -93,7 +93,7 @@ def kernel_sources(core: Path | None = None) -> list[Path]:
     their own imports (``conventions.py`` today).  Sorted by path."""
     core = CORE if core is None else Path(core).resolve()
     package = core.parent
-    files = {p.resolve() for p in core.rglob("*.py") if "__pycache__" not in p.parts}
+    files = {p for p in core.rglob("*.py") if "__pycache__" not in p.parts}  # core: resolved
     queue = sorted(files)
     while queue:
         path = queue.pop()
@@ -114,7 +114,7 @@ def full_source_digest(core: Path | None = None) -> str:
     modification time) or the list of files changes."""
     core = CORE if core is None else Path(core).resolve()
     files = kernel_sources(core)
-    stats = tuple((str(p), p.stat().st_size, p.stat().st_mtime_ns) for p in files)
+    stats = tuple((str(p), st.st_size, st.st_mtime_ns) for p in files for st in [p.stat()])
     key = (str(core), stats)
     if key not in _DIGESTS:
         h = hashlib.sha256()
