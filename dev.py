@@ -44,7 +44,8 @@ def ensure_venv(extras: str) -> None:
     stamp = VENV / f".installed-{extras or 'base'}"
     if stamp.exists() and stamp.read_text() == digest:
         return
-    print(f"dev.py: installing ftc-mc[{extras}] into {VENV}", flush=True)
+    name = f"ftc-mc[{extras}]" if extras else "ftc-mc"
+    print(f"dev.py: installing {name} into {VENV} (about a minute)", flush=True)
     target = f".[{extras}]" if extras else "."
     # -qq: pip's errors only (see the module docstring)
     for args in (["--upgrade", "pip"], ["-e", target]):
