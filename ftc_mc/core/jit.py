@@ -262,8 +262,7 @@ def in_disk_cache(dispatcher) -> bool | None:
     machine and source (so calling it loads instead of compiling).
 
     Reads the cache index the way Numba's ``FunctionCache`` does (the source
-    stamp, :func:`full_source_digest` for a kernel of ``core/``
-    (:class:`ContentCacheLocator`), then the key's target and bytecode hash); the
+    stamp of the function's file, then the key's target and bytecode hash); the
     signature itself is not checked, since the campaign, sweep and scenario
     paths call the trial kernel with one and the same signature.  Returns
     ``None`` when the cache's layout is not the expected one (a Numba version
