@@ -9,7 +9,10 @@ nothing but Python 3.11::
                            # worker per core, idle ones take queued tests)
 
 Extra arguments after ``run`` go to ``ftc-mc``; after ``test`` to ``pytest``.
-The install is repeated only when ``pyproject.toml`` changes.
+The install is repeated only when ``pyproject.toml`` changes.  It is editable
+(the sources stay in this folder, so an edit is run and tested at once), and
+pip runs with ``-qq``: its errors are shown, its warnings are not (setuptools
+boxes every editable install with a warning meant for package authors).
 """
 
 from __future__ import annotations
@@ -30,7 +33,8 @@ MAIN_JOB = ["run", "configs/paper_tables.yaml"]
 
 
 def ensure_venv(extras: str) -> None:
-    """Create ``.venv`` and install the package (editable) with ``extras``."""
+    """Create ``.venv`` and install the package (editable) with ``extras``,
+    unless already installed from this ``pyproject.toml``."""
     if sys.version_info < (3, 11):
         sys.exit(f"dev.py: Python >= 3.11 is required, this is {sys.version.split()[0]}")
     if not PY.exists():
@@ -40,12 +44,15 @@ def ensure_venv(extras: str) -> None:
     stamp = VENV / f".installed-{extras or 'base'}"
     if stamp.exists() and stamp.read_text() == digest:
         return
-    print(f"dev.py: installing ftc-mc[{extras}] into {VENV}", flush=True)
+    name = f"ftc-mc[{extras}]" if extras else "ftc-mc"
+    print(f"dev.py: installing {name} into {VENV} (about a minute)", flush=True)
     target = f".[{extras}]" if extras else "."
-    subprocess.run([str(PY), "-m", "pip", "install", "--quiet", "--upgrade", "pip"],
-                   check=True, cwd=ROOT)
-    subprocess.run([str(PY), "-m", "pip", "install", "--quiet", "-e", target],
-                   check=True, cwd=ROOT)
+    # -qq: pip's errors only (see the module docstring)
+    for args in (["--upgrade", "pip"], ["-e", target]):
+        done = subprocess.run([str(PY), "-m", "pip", "install", "-qq", *args], cwd=ROOT)
+        if done.returncode:
+            sys.exit(f"dev.py: 'pip install {' '.join(args)}' failed (exit code "
+                     f"{done.returncode}); pip's errors are above")
     stamp.write_text(digest)
 
 

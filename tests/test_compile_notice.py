@@ -111,6 +111,7 @@ def test_the_kernel_cache_follows_every_kernel_module(tmp_path, monkeypatch):
     # Numba checks a cached kernel only against its own file; the cache folder is
     # named after all of core/ and conventions.py, so an edit of a module that a
     # kernel inlines (core/stages.py into core/trial.py) starts a new folder
+    # (tests/test_kernel_cache.py: subpackages, and a second copy of the sources)
     import shutil
 
     src = Path(jit.__file__).resolve().parent
@@ -128,7 +129,10 @@ def test_the_kernel_cache_follows_every_kernel_module(tmp_path, monkeypatch):
     conv.write_text(conv.read_text() + "\n")
     assert jit.source_digest(copy / "core") != same
     monkeypatch.setenv("FTC_MC_CACHE_DIR", str(tmp_path / "c"))
+    monkeypatch.delenv("NUMBA_CACHE_DIR", raising=False)
     assert jit.cache_dir() == tmp_path / "c" / "numba" / same
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path / "n"))  # takes precedence
+    assert jit.cache_dir() == tmp_path / "n" / same
 
 
 @pytest.mark.skipif(not jit.CACHE, reason="FTC_MC_NUMBA_CACHE=0")

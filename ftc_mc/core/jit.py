@@ -1,49 +1,210 @@
 """The one place that sets how every kernel is compiled.
 
-Compiled kernels are cached on disk (``docs/performance.md``, lesson 6).  Numba
-checks a cached kernel only against its own file, so a kernel that inlines
-others would be loaded stale after an edit of theirs.  The cache therefore lives
-in a folder named after a digest of every kernel module's source
-(:func:`source_digest`): ``$FTC_MC_CACHE_DIR/numba/<digest>``
-(``~/.cache/ftc-mc/numba/<digest>`` by default); any edit of ``ftc_mc/core/`` or
-``ftc_mc/conventions.py`` starts a new folder.  ``NUMBA_CACHE_DIR`` in the
-environment takes precedence (the benchmarks point it at an empty folder), and
-``FTC_MC_NUMBA_CACHE=0`` turns caching off.  ``fastmath`` stays off: it was no
-faster here (``scripts/bench_core.py``) and breaks bit-for-bit agreement with the
-NumPy references.
+Compiled kernels are cached on disk (``docs/performance.md``, lesson 6), keyed
+on the content of every kernel source.  Numba on its own keys a cached kernel on
+its own file only (its folder on the file's absolute path, its stamp on that
+file alone), so a kernel that inlines others would be loaded stale after an edit of
+theirs, and a second clone of the same sources would compile everything again.
+Here instead (:class:`ContentCacheLocator`, placed first in Numba's list of cache
+locators), a kernel defined under ``ftc_mc/core/`` is cached in a folder named
+after a digest of the kernel sources (:func:`source_digest`: every ``.py`` file
+under ``core/``, read recursively, and the modules outside it that they import,
+such as ``conventions.py``), and its index is stamped with that digest:
+``$FTC_MC_CACHE_DIR/numba/<digest>/core/`` (``~/.cache/ftc-mc/numba/<digest>``
+by default).  No path of the clone enters the folder or the stamp, so another
+clone or install of identical sources loads the kernels, while any edit of a
+kernel source starts a new folder.  ``NUMBA_CACHE_DIR`` in the environment takes
+precedence over ``$FTC_MC_CACHE_DIR/numba`` (``$NUMBA_CACHE_DIR/<digest>``; the
+benchmarks point it at an empty folder), and ``FTC_MC_NUMBA_CACHE=0`` turns caching off.  ``fastmath`` stays
+off: it was no faster here (``scripts/bench_core.py``) and breaks bit-for-bit
+agreement with the NumPy references.
 """
 
 from __future__ import annotations
 
+import ast
+import functools
 import hashlib
 import os
 from pathlib import Path
 
 import numba
+from numba.core import caching
 
 CACHE = os.environ.get("FTC_MC_NUMBA_CACHE", "1") != "0"
 
+CORE = Path(__file__).resolve().parent
+"""This package's kernel folder, ``ftc_mc/core``."""
+
+
+def _module_file(target: Path) -> Path | None:
+    """The file of the module at ``target`` (a path without suffix): the
+    module ``target.py`` or the package ``target/__init__.py``."""
+    for cand in (target.parent / (target.name + ".py"), target / "__init__.py"):
+        if cand.is_file():
+            return cand
+    return None
+
+
+@functools.lru_cache(maxsize=None)
+def _imported_files(path: Path, package: Path, size: int, mtime_ns: int) -> frozenset:
+    """The files of modules inside ``package`` (the ``ftc_mc`` folder) that the
+    module at ``path`` imports anywhere in its body: relative imports, and
+    absolute ones that start with the package's name.  (``size`` and
+    ``mtime_ns``, the file's stamp, key the memo.)"""
+    try:
+        tree = ast.parse(path.read_bytes(), filename=str(path))
+    except (OSError, SyntaxError, ValueError):
+        return frozenset()
+    found = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = path.parent
+                for _ in range(node.level - 1):
+                    base = base.parent
+            elif node.module and node.module.split(".")[0] == package.name:
+                base = package.parent
+            else:
+                continue
+            module = base.joinpath(*node.module.split(".")) if node.module else base
+            # ``from module import name``: a submodule, or a name defined in module
+            names_in_module = False
+            for alias in node.names:
+                sub = _module_file(module / alias.name) if alias.name != "*" else None
+                if sub is not None:
+                    found.add(sub)
+                else:
+                    names_in_module = True
+            if names_in_module and _module_file(module) is not None:
+                found.add(_module_file(module))
+        elif isinstance(node, ast.Import):
+            for alias in node.names:
+                parts = alias.name.split(".")
+                if parts[0] == package.name and _module_file(package.parent.joinpath(*parts)):
+                    found.add(_module_file(package.parent.joinpath(*parts)))
+    return frozenset(f.resolve() for f in found if f.resolve().is_relative_to(package))
+
+
+def kernel_sources(core: Path | None = None) -> list[Path]:
+    """Every file the kernels compile from: each ``.py`` file under ``core``
+    (this package's ``ftc_mc/core`` by default), read recursively, and every
+    module inside the package that one of them imports, followed on through
+    their own imports (``conventions.py`` today).  Sorted by path."""
+    core = CORE if core is None else Path(core).resolve()
+    package = core.parent
+    files = {p for p in core.rglob("*.py") if "__pycache__" not in p.parts}  # core: resolved
+    queue = sorted(files)
+    while queue:
+        path = queue.pop()
+        st = path.stat()
+        for dep in _imported_files(path, package, st.st_size, st.st_mtime_ns):
+            if dep not in files:
+                files.add(dep)
+                queue.append(dep)
+    return sorted(files, key=lambda p: p.relative_to(package).as_posix())
+
+
+_DIGESTS: dict = {}
+
+
+def full_source_digest(core: Path | None = None) -> str:
+    """SHA-256 (hex) of the relative path and content of every file of
+    :func:`kernel_sources`.  Read again only when a file's stamp (size,
+    modification time) or the list of files changes."""
+    core = CORE if core is None else Path(core).resolve()
+    files = kernel_sources(core)
+    stats = tuple((str(p), st.st_size, st.st_mtime_ns) for p in files for st in [p.stat()])
+    key = (str(core), stats)
+    if key not in _DIGESTS:
+        h = hashlib.sha256()
+        for path in files:
+            h.update(path.relative_to(core.parent).as_posix().encode() + b"\0")
+            data = path.read_bytes()
+            h.update(len(data).to_bytes(8, "little") + data)
+        _DIGESTS[key] = h.hexdigest()
+    return _DIGESTS[key]
+
 
 def source_digest(core: Path | None = None) -> str:
-    """SHA-256 (16 hex digits) of the source of every module kernels compile from:
-    ``core/*.py`` and ``conventions.py`` beside it (``core``: this package's)."""
-    core = Path(__file__).resolve().parent if core is None else Path(core)
-    h = hashlib.sha256()
-    for path in sorted(core.glob("*.py")) + [core.parent / "conventions.py"]:
-        h.update(path.name.encode())
-        h.update(path.read_bytes())
-    return h.hexdigest()[:16]
+    """The first 16 hex digits of :func:`full_source_digest`: the name of the
+    kernel cache folder of these sources."""
+    return full_source_digest(core)[:16]
+
+
+def cache_root() -> Path:
+    """The folder of every source's kernel cache: ``NUMBA_CACHE_DIR`` if set,
+    else ``$FTC_MC_CACHE_DIR/numba``, else ``~/.cache/ftc-mc/numba``."""
+    if os.environ.get("NUMBA_CACHE_DIR"):
+        return Path(os.environ["NUMBA_CACHE_DIR"])
+    root = os.environ.get("FTC_MC_CACHE_DIR") or Path.home() / ".cache" / "ftc-mc"
+    return Path(root) / "numba"
 
 
 def cache_dir() -> Path:
-    """The folder of the compiled kernels of this source (module docstring)."""
-    root = os.environ.get("FTC_MC_CACHE_DIR") or Path.home() / ".cache" / "ftc-mc"
-    return Path(root) / "numba" / source_digest()
+    """The folder of the compiled kernels of this source (module docstring):
+    ``cache_root() / source_digest()``."""
+    return cache_root() / source_digest()
 
 
-if CACHE and not os.environ.get("NUMBA_CACHE_DIR"):
-    # read by Numba when each kernel below is decorated (its cache locator)
-    numba.config.CACHE_DIR = str(cache_dir())
+class ContentCacheLocator(caching._CacheLocator):
+    """Numba cache locator for the kernels defined under :data:`CORE`.
+
+    The cache folder is ``cache_dir() / <the module's folder inside the
+    package>`` (``core``, ``core/<subpackage>``), and the source stamp of the
+    index is :func:`full_source_digest`: both follow the content of every
+    kernel source and neither holds the clone's path.  Functions defined
+    elsewhere are left to Numba's own locators (``from_function`` returns
+    ``None``).
+    """
+
+    def __init__(self, py_func, py_file: Path, core: Path):
+        self._lineno = py_func.__code__.co_firstlineno
+        self._stamp = full_source_digest(core)
+        sub = py_file.parent.relative_to(core.parent).as_posix()
+        self._cache_path = str(cache_root() / self._stamp[:16] / sub)
+
+    def get_cache_path(self):
+        return self._cache_path
+
+    def get_source_stamp(self):
+        return self._stamp
+
+    def get_disambiguator(self):
+        return str(self._lineno)
+
+    @classmethod
+    def from_function(cls, py_func, py_file):
+        try:
+            path = Path(py_file).resolve()
+        except (OSError, TypeError, ValueError):
+            return None
+        if not path.is_file() or not path.is_relative_to(CORE):
+            return None
+        self = cls(py_func, path, CORE)
+        try:
+            self.ensure_cache_path()
+        except OSError:  # not writable: Numba's other locators may do
+            return None
+        return self
+
+
+def _register_locator() -> None:
+    """Put :class:`ContentCacheLocator` first in Numba's list of cache
+    locators (``numba.core.caching.CacheImpl``; ``_CacheImpl`` before Numba
+    0.61), once per process and package."""
+    impl = getattr(caching, "CacheImpl", None) or getattr(caching, "_CacheImpl")
+    classes = impl._locator_classes
+    if ContentCacheLocator not in classes:
+        classes.insert(0, ContentCacheLocator)
+
+
+if CACHE:
+    _register_locator()
+    if not os.environ.get("NUMBA_CACHE_DIR"):
+        # kernels compiled with cache=True outside core/ (tests, benchmarks)
+        # and the compile lock (sim.compiling) use Numba's own setting
+        numba.config.CACHE_DIR = str(cache_dir())
 
 OPTIONS = dict(cache=CACHE, fastmath=False, nogil=True, error_model="numpy")
 

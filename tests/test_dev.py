@@ -1,0 +1,65 @@
+"""dev.py's install step: editable, pip quiet but for its errors, repeated only
+when pyproject.toml changes (README, Quick start)."""
+
+from __future__ import annotations
+
+import importlib.util
+import subprocess
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+@pytest.fixture
+def dev(tmp_path, monkeypatch):
+    """dev.py loaded as a module, pointed at a scratch project whose ``.venv``
+    python exists, with pip's calls recorded instead of run."""
+    spec = importlib.util.spec_from_file_location("dev_under_test", ROOT / "dev.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    (tmp_path / "pyproject.toml").write_text("[project]\nname = 'x'\n")
+    venv = tmp_path / ".venv"
+    (venv / "bin").mkdir(parents=True)
+    (venv / "bin" / "python").write_text("")
+    monkeypatch.setattr(mod, "ROOT", tmp_path)
+    monkeypatch.setattr(mod, "VENV", venv)
+    monkeypatch.setattr(mod, "PY", venv / "bin" / "python")
+    mod.calls, mod.returncode = [], 0
+
+    def run(cmd, **kw):
+        mod.calls.append(cmd)
+        return subprocess.CompletedProcess(cmd, mod.returncode)
+
+    monkeypatch.setattr(mod.subprocess, "run", run)
+    return mod
+
+
+def test_install_is_editable_quiet_and_once(dev, capsys):
+    dev.ensure_venv("test")
+    assert len(dev.calls) == 2
+    upgrade, install = dev.calls
+    assert upgrade[1:] == ["-m", "pip", "install", "-qq", "--upgrade", "pip"]
+    # editable (the tests import the sources in place), warnings not shown
+    assert install[1:] == ["-m", "pip", "install", "-qq", "-e", ".[test]"]
+    assert capsys.readouterr().out.startswith("dev.py: installing ftc-mc[test]")
+    dev.ensure_venv("test")
+    assert len(dev.calls) == 2  # same pyproject.toml: nothing to do
+    dev.ensure_venv("")
+    assert dev.calls[-1][-2:] == ["-e", "."]  # the run command's own install
+    (dev.ROOT / "pyproject.toml").write_text("[project]\nname = 'y'\n")
+    dev.ensure_venv("test")
+    assert len(dev.calls) == 6 and dev.calls[-1][-1] == ".[test]"
+
+
+def test_a_failed_install_is_one_line_and_not_stamped(dev):
+    dev.returncode = 1
+    with pytest.raises(SystemExit) as exc:
+        dev.ensure_venv("")
+    assert str(exc.value).startswith("dev.py: 'pip install --upgrade pip' failed (exit code 1)")
+    assert not list(dev.VENV.glob(".installed-*"))
+    dev.returncode = 0
+    dev.ensure_venv("")
+    assert len(dev.calls) == 3  # tried again
+

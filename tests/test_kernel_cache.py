@@ -1,0 +1,165 @@
+"""The compiled-kernel cache follows the content of the kernel sources
+(core/jit.py: ``source_digest``, ``ContentCacheLocator``).
+
+A copy of the package in another folder (a second clone or install) loads the
+kernels that the first compiled; an edit of any kernel source, including one
+in a subpackage of core/, starts a new cache folder and compiles, so a stale
+kernel is never loaded.  Each case runs a small kernel added to a copy of the
+package (``core/probe.py``, inlining ``core/probe_parts/scale.py``) in its own
+Python process, with ``PYTHONPATH`` at the copy and one shared
+``FTC_MC_CACHE_DIR``, and reads Numba's cache hits and misses.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from ftc_mc.core import jit
+
+PACKAGE = Path(jit.__file__).resolve().parents[1]
+
+PROBE = '''"""A small kernel for tests/test_kernel_cache.py."""
+from ..conventions import N_X
+from .jit import kernel
+from .probe_parts.scale import scaled
+
+
+@kernel
+def probe(x):
+    return scaled(x) + N_X
+'''
+
+SCALE = '''from ..jit import kernel
+
+FACTOR = {factor}
+
+
+@kernel
+def scaled(x):
+    return FACTOR * x
+'''
+
+RUN = '''
+import json
+from ftc_mc.core import jit
+from ftc_mc.core.probe import probe
+needed = jit.needs_compile(probe)
+value = probe(1.5)
+print(json.dumps({
+    "file": probe.py_func.__code__.co_filename, "needed": needed, "value": value,
+    "hits": sum(probe.stats.cache_hits.values()),
+    "misses": sum(probe.stats.cache_misses.values()),
+    "cache": probe._cache.cache_path, "digest": jit.source_digest(),
+    "in_disk": jit.in_disk_cache(probe)}))
+'''
+
+
+def _copy(root: Path, factor: float = 2.0) -> Path:
+    """A copy of the package under ``root`` with the probe kernel added; its
+    files' modification times are a minute later than the originals'."""
+    core = root / "ftc_mc" / "core"
+    shutil.copytree(PACKAGE, root / "ftc_mc", ignore=shutil.ignore_patterns("__pycache__"))
+    (core / "probe.py").write_text(PROBE)
+    (core / "probe_parts").mkdir()
+    (core / "probe_parts" / "__init__.py").write_text("")
+    (core / "probe_parts" / "scale.py").write_text(SCALE.format(factor=factor))
+    later = time.time() + 60.0
+    for path in (root / "ftc_mc").rglob("*.py"):
+        os.utime(path, (later, later))
+    return root
+
+
+def _run(root: Path, cache: Path, **env) -> dict:
+    full = {k: v for k, v in os.environ.items()
+            if k not in ("NUMBA_CACHE_DIR", "FTC_MC_NUMBA_CACHE", "PYTHONPATH")}
+    full.update(PYTHONPATH=str(root), FTC_MC_CACHE_DIR=str(cache), **env)
+    out = subprocess.run([sys.executable, "-c", RUN], cwd=root, env=full,
+                         capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr
+    res = json.loads(out.stdout.splitlines()[-1])
+    assert Path(res["file"]).resolve().is_relative_to(root.resolve())  # the copy ran
+    return res
+
+
+@pytest.mark.skipif(not jit.CACHE, reason="FTC_MC_NUMBA_CACHE=0")
+def test_a_second_copy_loads_and_an_edit_compiles(tmp_path):
+    cache = tmp_path / "cache"
+    first = _run(_copy(tmp_path / "a"), cache)
+    assert first["needed"] is True and first["misses"] == 1 and first["hits"] == 0
+    assert first["value"] == 2.0 * 1.5 + 9 and first["in_disk"] is True
+
+    # identical sources in another folder, other modification times: loaded
+    b = _copy(tmp_path / "b")
+    second = _run(b, cache)
+    assert second["digest"] == first["digest"] and second["cache"] == first["cache"]
+    assert second["needed"] is False and second["hits"] == 1 and second["misses"] == 0
+    assert second["value"] == first["value"]
+    # the folder is named after the sources' digest, not after the clone's path
+    folder = cache / "numba" / first["digest"] / "core"
+    assert Path(first["cache"]) == folder and any(folder.glob("probe.probe-*.nbi"))
+
+    # an edit in a subpackage of core/ (a kernel that probe inlines): new folder,
+    # compiled again, the new value
+    (b / "ftc_mc" / "core" / "probe_parts" / "scale.py").write_text(SCALE.format(factor=3.0))
+    edited = _run(b, cache)
+    assert edited["digest"] != first["digest"] and edited["cache"] != first["cache"]
+    assert edited["needed"] is True and edited["misses"] == 1 and edited["hits"] == 0
+    assert edited["value"] == 3.0 * 1.5 + 9
+
+    # an edit of a core module that probe does not import: compiled again too
+    glr = b / "ftc_mc" / "core" / "glr.py"
+    glr.write_text(glr.read_text() + "\n# an edit\n")
+    other = _run(b, cache)
+    assert other["digest"] not in (first["digest"], edited["digest"])
+    assert other["needed"] is True and other["misses"] == 1
+
+
+@pytest.mark.skipif(not jit.CACHE, reason="FTC_MC_NUMBA_CACHE=0")
+def test_numba_cache_dir_and_cache_off(tmp_path):
+    root = _copy(tmp_path / "a")
+    cache = tmp_path / "cache"
+    assert _run(root, cache)["misses"] == 1
+    # NUMBA_CACHE_DIR takes precedence over FTC_MC_CACHE_DIR: empty, so compiled
+    numba_dir = tmp_path / "numba"
+    res = _run(root, cache, NUMBA_CACHE_DIR=str(numba_dir))
+    assert res["needed"] is True and res["misses"] == 1
+    assert Path(res["cache"]) == numba_dir / res["digest"] / "core"
+    assert _run(root, cache, NUMBA_CACHE_DIR=str(numba_dir))["hits"] == 1
+    # FTC_MC_NUMBA_CACHE=0: no disk cache, every process compiles
+    off = _run(root, tmp_path / "off", FTC_MC_NUMBA_CACHE="0")
+    assert off["needed"] is True and off["hits"] == 0 and off["cache"] is None
+    assert not (tmp_path / "off").exists()
+
+
+def test_the_digest_reads_core_recursively_and_what_it_imports(tmp_path):
+    root = _copy(tmp_path / "a")
+    core = root / "ftc_mc" / "core"
+    files = {p.relative_to(root / "ftc_mc").as_posix() for p in jit.kernel_sources(core)}
+    assert {"core/trial.py", "core/probe.py", "core/probe_parts/scale.py",
+            "conventions.py"} <= files
+    assert "api.py" not in files and "__init__.py" not in files
+    digest = jit.source_digest(core)
+    nested = core / "probe_parts" / "deeper"
+    nested.mkdir()
+    (nested / "__init__.py").write_text("")
+    assert jit.source_digest(core) != digest  # a new file, even an empty one
+    (nested / "__init__.py").unlink()
+    nested.rmdir()
+    assert jit.source_digest(core) == digest
+    # a module outside core/ that a kernel module imports joins the digest
+    (root / "ftc_mc" / "layouts.py").write_text("N = 3\n")
+    assert jit.source_digest(core) == digest
+    scale = core / "probe_parts" / "scale.py"
+    scale.write_text("from ...layouts import N\n" + scale.read_text())
+    with_import = jit.source_digest(core)
+    assert with_import != digest
+    (root / "ftc_mc" / "layouts.py").write_text("N = 4\n")
+    assert jit.source_digest(core) != with_import
