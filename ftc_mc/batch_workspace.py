@@ -1,4 +1,4 @@
-"""Work arrays of the lane-interleaved filter kernels (:mod:`ftc_mc.core.batch`).
+"""Work arrays of the lane-interleaved filter kernels (:mod:`ftc_mc.core.longitudinal.batch`).
 
 Lives outside ``core/`` because ``core/`` holds only kernels.
 
@@ -18,7 +18,7 @@ from collections import namedtuple
 import numpy as np
 
 from .conventions import N_AUG, N_FAULT, N_X, RESIDUAL_NAMES
-from .core.batch import step_rows
+from .core.longitudinal.batch import step_rows
 
 ALIGN = 64
 """Byte alignment of the arrays made here (one cache line, one AVX-512 vector)."""
@@ -53,7 +53,7 @@ LaneWorkspace = namedtuple("LaneWorkspace", [
     "res",    # (3, L)                [r_q, r_nx, r_nz] (eqs. 9-11)
     "block",  # (L,) int64            block reset this step (Table 1)
 ])
-"""Arrays for :func:`ftc_mc.core.batch.filter_step_lanes`, in its argument order:
+"""Arrays for :func:`ftc_mc.core.longitudinal.batch.filter_step_lanes`, in its argument order:
 ``filter_step_lanes(xa, P, u, z, fm, det, ws.phi, ws.T, ws.work, ws.res, ws.block)``."""
 
 
@@ -74,7 +74,7 @@ def new_lane_workspace(L: int, n_aug: int = N_AUG) -> LaneWorkspace:
         ``phi`` (9, 5, L), ``T`` (9, n, L), ``work`` (step_rows(n), n, L),
         ``res`` (3, L) float64 and ``block`` (L,) int64.  ``work[n:n + 13]``
         can serve as the work array ``h`` of
-        :func:`~ftc_mc.core.batch.update_lanes`.
+        :func:`~ftc_mc.core.longitudinal.batch.update_lanes`.
 
     Raises
     ------

@@ -86,11 +86,11 @@ VARIANTS = ("paper", "swapped")
 TEST_ONE_STEP, TEST_GLR = 0, 1
 """Residual tests of a design (``Detection.test``): the paper's one-step test of
 the normalised residuals (eqs. 9-11), or the GLR of a persistent change of their
-mean over a sliding window (``ftc_mc/core/glr.py``)."""
+mean over a sliding window (``ftc_mc/core/shared/glr.py``)."""
 TEST_NAMES = ("one_step", "glr")
 
 N_GUST_EST = 4
-"""Gust states in a gust-aware filter (the Dryden shaping filter, ``core/dryden.py``),
+"""Gust states in a gust-aware filter (the Dryden shaping filter, ``core/shared/dryden.py``),
 appended after the fault parameters: ``[x (9), b (5), g (4)]``."""
 
 # ------------------------------------------------------------------ modes, controllers

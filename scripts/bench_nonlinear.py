@@ -6,7 +6,7 @@ small deterministic elevon excitation about trim and moderate Dryden gusts for
 the nonlinear plant (gust state advanced by ``gust_step`` every step, draws
 precomputed outside the timing):
 
-a. nonlinear: ``gust_step`` + ``ftc_mc.core.nonlinear.propagate`` (10 RK4 sub-steps,
+a. nonlinear: ``gust_step`` + ``ftc_mc.core.longitudinal.nonlinear.propagate`` (10 RK4 sub-steps,
    40 derivative evaluations per control period);
 b. linear: ``x <- A x + B u`` on the 9-state discrete model (explicit loops).
 
@@ -33,9 +33,9 @@ import numpy as np  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from ftc_mc.core.dryden import gust_step  # noqa: E402
+from ftc_mc.core.shared.dryden import gust_step  # noqa: E402
 from ftc_mc.core.jit import kernel  # noqa: E402
-from ftc_mc.core.nonlinear import make_work, propagate  # noqa: E402
+from ftc_mc.core.longitudinal.nonlinear import make_work, propagate  # noqa: E402
 from ftc_mc.model.linear import build_plant  # noqa: E402
 from ftc_mc.model.turbulence import dryden_model  # noqa: E402
 

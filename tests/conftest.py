@@ -18,7 +18,7 @@ TRIAL_KERNEL_FILES = {
     "test_trial_validity.py", "test_truth_plant.py",
 }
 """Test files that run campaigns, sweeps or scenarios (the trial kernel
-``core.trial.advance``); the other files test kernels and models piece by piece."""
+``core.longitudinal.trial.advance``); the other files test kernels and models piece by piece."""
 
 
 def _late(item) -> bool:
@@ -93,7 +93,7 @@ def pytest_collection_modifyitems(config, items):
 def trial_kernel():
     """The trial kernel compiled, or loaded from Numba's cache, in this process;
     a compile in another process is waited for.  Tests elsewhere that run
-    ``core.trial.advance`` use it, so that they load what the first worker
+    ``core.longitudinal.trial.advance`` use it, so that they load what the first worker
     compiled instead of compiling it too."""
     from ftc_mc.campaign.chunk import chunk_spec, warm_up
     from ftc_mc.config import load_config

@@ -381,7 +381,7 @@ def innovations_ref(X, P, z, model):
 
 
 def glr_ref(newest_first, m_min=1):
-    """GLR of a mean shift over a window (``ftc_mc/core/glr.py``), directly:
+    """GLR of a mean shift over a window (``ftc_mc/core/shared/glr.py``), directly:
     ``max_{m >= m_min} (sum of the m newest e)^2 / m`` per channel;
     ``newest_first`` is (m, 3).  Zero while the window holds fewer than ``m_min``."""
     e = np.asarray(newest_first, dtype=float)
@@ -392,7 +392,7 @@ def glr_ref(newest_first, m_min=1):
 
 
 def filter_step_ref(X, P, u, z, model, stat=None, gate=None):
-    """One estimator step in ``ftc_mc.core.step.filter_step``'s order:
+    """One estimator step in ``ftc_mc.core.longitudinal.step.filter_step``'s order:
     predict, residuals, Table 1; on a reset, reset the block of ``P_{k|k}`` and
     predict again; update, projection.  ``stat``: a function of the signed
     innovations giving the decision statistics (the GLR test); ``None`` for
@@ -686,7 +686,7 @@ def select_controller_ref(current, X, P, belief, scheme):
 
 
 # ------------------------------------------------------------ trial stages
-# Twins of the stage kernels of ftc_mc.core.stages and ftc_mc.core.plant, on
+# Twins of the stage kernels of ftc_mc.core.longitudinal.stages and ftc_mc.core.longitudinal.plant, on
 # copies: each takes the lane state and returns what the stage writes.  Lane l
 # of every array is one trial (lane index last).
 NO_SIGNAL = -(1 << 40)

@@ -1,4 +1,4 @@
-"""The lane-interleaved kernels of :mod:`ftc_mc.core.batch` against the
+"""The lane-interleaved kernels of :mod:`ftc_mc.core.longitudinal.batch` against the
 single-trajectory kernels, lane by lane.
 
 The batch kernels perform each lane's floating-point operations in the single
@@ -15,10 +15,10 @@ import numpy as np
 import pytest
 
 from ftc_mc.batch_workspace import LaneWorkspace, new_lane_workspace
-from ftc_mc.core import batch as kb
-from ftc_mc.core import kalman as kk
-from ftc_mc.core import signature as ks
-from ftc_mc.core.step import filter_step
+from ftc_mc.core.longitudinal import batch as kb
+from ftc_mc.core.longitudinal import kalman as kk
+from ftc_mc.core.longitudinal import signature as ks
+from ftc_mc.core.longitudinal.step import filter_step
 from ftc_mc.sim.estimator import (EstimatorSettings, Workspace, detection, filter_model,
                                   initial_covariance, unit_rows)
 from ftc_mc.model.linear import build_plant

@@ -19,10 +19,10 @@ import numba
 import pytest
 
 from ftc_mc.core import jit
-from ftc_mc.core.paths import (DENSE_FILTER, LINEAR_PLANT, ONE_STEP_TEST, PAPER_FILTER,
-                               RECONFIGURING, describe)
-from ftc_mc.core.paths import Path as Path_
-from ftc_mc.core.trial import advance
+from ftc_mc.core.shared.paths import (DENSE_FILTER, LINEAR_PLANT, ONE_STEP_TEST, PAPER_FILTER,
+                                      RECONFIGURING, describe)
+from ftc_mc.core.shared.paths import Path as Path_
+from ftc_mc.core.longitudinal.trial import advance
 from ftc_mc.io.lock import waiting
 from ftc_mc.sim.compiling import WAIT_NOTICE, compiled_once, lock_path
 
@@ -110,7 +110,7 @@ def test_real_trial_kernel_cache(tmp_path, monkeypatch):
 def test_the_kernel_cache_follows_every_kernel_module(tmp_path, monkeypatch):
     # Numba checks a cached kernel only against its own file; the cache folder is
     # named after all of core/ and conventions.py, so an edit of a module that a
-    # kernel inlines (core/stages.py into core/trial.py) starts a new folder
+    # kernel inlines (core/longitudinal/stages.py into core/longitudinal/trial.py) starts a new folder
     # (tests/test_kernel_cache.py: subpackages, and a second copy of the sources)
     import shutil
 

@@ -17,14 +17,13 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import naive
-from ftc_mc.core import belief as kb
-from ftc_mc.core import excitation as ke
-from ftc_mc.core import kalman as kk
-from ftc_mc.core import signature as ks
-from ftc_mc.core.step import filter_step
-from ftc_mc.sim.estimator import (PAPER_R_DIAG, EstimatorSettings, Workspace,
-                                  belief_settings, detection, filter_model,
-                                  initial_covariance, unit_rows)
+from ftc_mc.core.shared import belief as kb
+from ftc_mc.core.shared import excitation as ke
+from ftc_mc.core.longitudinal import kalman as kk
+from ftc_mc.core.longitudinal import signature as ks
+from ftc_mc.core.longitudinal.step import filter_step
+from ftc_mc.sim.estimator import (PAPER_R_DIAG, EstimatorSettings, Workspace, belief_settings,
+                                  detection, filter_model, initial_covariance, unit_rows)
 from ftc_mc.model.faults import bias_matrix
 from ftc_mc.model.linear import build_plant
 

@@ -1,8 +1,8 @@
 """The kernels of the detection designs (issue 13) against their twins and statistics.
 
-* the gust-aware filter step (``core/gustfilter.py``) against the dense
+* the gust-aware filter step (``core/longitudinal/gustfilter.py``) against the dense
   plain-NumPy filter of ``tests/naive.py`` (``F P F^T + Q``, Joseph update);
-* the GLR statistic (``core/glr.py``) against a direct computation over the
+* the GLR statistic (``core/shared/glr.py``) against a direct computation over the
   window from the full innovation history;
 * the filter stage with either estimator and either test, and 25 steps of the
   whole trial loop with the gust-aware filter and the GLR test, against the
@@ -25,9 +25,10 @@ import naive
 from test_stages import (L, X_SCALE, _setup, assert_lanes, assert_loop_matches, copy_nt,
                          random_cov, random_inputs, random_lanes, rel, trim_jacobians)
 from ftc_mc.conventions import N_AUG, N_X, RESET_ELEVONS, RESET_THRUST, TEST_GLR
-from ftc_mc.core import stages, trial
-from ftc_mc.core.glr import glr_lanes, glr_restart
-from ftc_mc.core.workspace import new_trial_work
+from ftc_mc.core.longitudinal import stages
+from ftc_mc.core.longitudinal import trial
+from ftc_mc.core.shared.glr import glr_lanes, glr_restart
+from ftc_mc.core.longitudinal.workspace import new_trial_work
 from ftc_mc.model.turbulence import dryden_model
 from ftc_mc.model.wind import plant_wind_matrices
 from ftc_mc.sim.inputs import flight_inputs
@@ -344,7 +345,7 @@ def test_relinearised_at_trim_is_the_trim_model(nonlinear_gusts):
     continuous linearisation, JA the RK4 map's difference quotient), ``JB`` vs
     ``B``, ``JW`` vs ``B_w``, ``JC`` vs ``C``, ``JHW`` vs ``D_w``, each to 1e-4
     relative to the matrix's largest entry."""
-    from ftc_mc.core.gustfilter import relinearise_lanes
+    from ftc_mc.core.longitudinal.gustfilter import relinearise_lanes
 
     fm, P0, d = extended(nonlinear_gusts, 1)
     rng = np.random.default_rng(67)

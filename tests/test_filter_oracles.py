@@ -18,11 +18,11 @@ import scipy.stats
 from filterpy.kalman import KalmanFilter
 
 import naive
-from ftc_mc.core.belief import belief_update
-from ftc_mc.core.excitation import saturate, signal_3211
-from ftc_mc.core.kalman import predict, update
-from ftc_mc.core.signature import NO_RESET, RESET_ELEVONS, RESET_THRUST
-from ftc_mc.core.step import filter_step
+from ftc_mc.core.shared.belief import belief_update
+from ftc_mc.core.shared.excitation import saturate, signal_3211
+from ftc_mc.core.longitudinal.kalman import predict, update
+from ftc_mc.core.longitudinal.signature import NO_RESET, RESET_ELEVONS, RESET_THRUST
+from ftc_mc.core.longitudinal.step import filter_step
 from ftc_mc.sim.estimator import (EstimatorSettings, Workspace, belief_settings, detection,
                                   filter_model, initial_covariance)
 from ftc_mc.model.faults import augmented, effect

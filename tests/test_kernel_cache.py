@@ -115,7 +115,7 @@ def test_a_second_copy_loads_and_an_edit_compiles(tmp_path):
     assert edited["value"] == 3.0 * 1.5 + 9
 
     # an edit of a core module that probe does not import: compiled again too
-    glr = b / "ftc_mc" / "core" / "glr.py"
+    glr = b / "ftc_mc" / "core" / "shared" / "glr.py"
     glr.write_text(glr.read_text() + "\n# an edit\n")
     other = _run(b, cache)
     assert other["digest"] not in (first["digest"], edited["digest"])
@@ -143,7 +143,7 @@ def test_the_digest_reads_core_recursively_and_what_it_imports(tmp_path):
     root = _copy(tmp_path / "a")
     core = root / "ftc_mc" / "core"
     files = {p.relative_to(root / "ftc_mc").as_posix() for p in jit.kernel_sources(core)}
-    assert {"core/trial.py", "core/probe.py", "core/probe_parts/scale.py",
+    assert {"core/longitudinal/trial.py", "core/probe.py", "core/probe_parts/scale.py",
             "conventions.py"} <= files
     assert "api.py" not in files and "__init__.py" not in files
     digest = jit.source_digest(core)

@@ -1,4 +1,4 @@
-"""Nonlinear truth-plant kernels (core/nonlinear.py) and Dryden gusts (core/dryden.py).
+"""Nonlinear truth-plant kernels (core/longitudinal/nonlinear.py) and Dryden gusts (core/shared/dryden.py).
 
 Tolerances:
 - Numba derivatives/outputs vs the textbook twin of tests/naive.py (with and
@@ -25,9 +25,8 @@ import scipy.integrate
 import scipy.signal
 
 import naive
-from ftc_mc.core.dryden import gust_record, gust_step
-from ftc_mc.core.nonlinear import (derivatives_nb, make_work, outputs_nb,
-                                   propagate)
+from ftc_mc.core.shared.dryden import gust_record, gust_step
+from ftc_mc.core.longitudinal.nonlinear import (derivatives_nb, make_work, outputs_nb, propagate)
 from ftc_mc.model import dynamics
 from ftc_mc.model.linear import build_plant
 from ftc_mc.model.turbulence import dryden_model, psd_q, psd_u, psd_w

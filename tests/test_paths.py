@@ -1,4 +1,4 @@
-"""Compile paths (core/paths.py, sim/paths.py): a run compiles only the
+"""Compile paths (core/shared/paths.py, sim/paths.py): a run compiles only the
 kernels its plant, filter, residual test and controller reach.
 
 The mechanism is checked on small kernels: an implementation that Numba
@@ -18,10 +18,10 @@ import pytest
 
 from ftc_mc.config import load_config, with_overrides
 from ftc_mc.core.jit import kernel
-from ftc_mc.core.paths import (DENSE_FILTER, EXTENDED_FILTER, GLR_TEST, LINEAR_PLANT,
-                               NOMINAL_CONTROL, NONLINEAR_PLANT, ONE_STEP_TEST,
-                               PAPER_FILTER, RECONFIGURING, describe, on_path, takes)
-from ftc_mc.core.paths import Path as CPath
+from ftc_mc.core.shared.paths import (DENSE_FILTER, EXTENDED_FILTER, GLR_TEST, LINEAR_PLANT,
+                                      NOMINAL_CONTROL, NONLINEAR_PLANT, ONE_STEP_TEST,
+                                      PAPER_FILTER, RECONFIGURING, describe, on_path, takes)
+from ftc_mc.core.shared.paths import Path as CPath
 from ftc_mc.sim.paths import path_of
 from ftc_mc.sim.setup import build_setup
 

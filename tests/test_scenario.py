@@ -81,7 +81,7 @@ def _unrequested_excitations(ts: pd.DataFrame, sc: ScenarioConfig) -> list:
     A doublet may start the step after a thrust reset, or the step after the
     re-check ``resend_delay_s`` after a thrust reset when the estimated thrust
     ``b1`` then exceeds ``resend_b1_threshold``; a 3211 the step after an
-    elevon reset (see ftc_mc.core.trial, step 4).
+    elevon reset (see ftc_mc.core.longitudinal.trial, step 4).
     """
     dt = sc.model.dt_s
     delay = int(round(sc.excitation.resend_delay_s / dt))

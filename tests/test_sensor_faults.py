@@ -18,7 +18,7 @@ from ftc_mc.cli import cli
 from ftc_mc.config import Config
 from ftc_mc.config.load import parse_config
 from ftc_mc.conventions import NO_SENSOR_FAULT, OUTPUT_NAMES, SENSOR_FAULT_KINDS
-from ftc_mc.core.plant import sensor_fault
+from ftc_mc.core.longitudinal.plant import sensor_fault
 from ftc_mc.errors import UserError
 from ftc_mc.sim.inputs import draw_lanes
 

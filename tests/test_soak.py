@@ -4,10 +4,9 @@ import numpy as np
 import pytest
 from numba import njit
 
-from ftc_mc.core.belief import belief_update
-from ftc_mc.core.step import filter_step
-from ftc_mc.sim.estimator import (EstimatorSettings, belief_settings, detection,
-                                  filter_model)
+from ftc_mc.core.shared.belief import belief_update
+from ftc_mc.core.longitudinal.step import filter_step
+from ftc_mc.sim.estimator import (EstimatorSettings, belief_settings, detection, filter_model)
 
 
 @njit(cache=False)

@@ -1,5 +1,5 @@
-"""The stages of a trial step (core/stages.py, core/plant.py), the controller
-kernels (core/control.py) and the whole trial loop against their plain-NumPy
+"""The stages of a trial step (core/longitudinal/stages.py, core/longitudinal/plant.py), the controller
+kernels (core/longitudinal/control.py) and the whole trial loop against their plain-NumPy
 twins in ``naive.py``.
 
 Inputs are random but valid lane states of the paper's scheme (reconfiguring
@@ -33,15 +33,17 @@ import pytest
 
 import naive
 from ftc_mc.sim.setup import build_setup
-from ftc_mc.conventions import (C_ELEVON, C_ENGINE, C_NOMINAL, I_B0_ELEVONS,
-                                I_B0_THRUST, I_B1_LEFT, I_B1_RIGHT, I_B1_THRUST, N_AUG,
-                                N_CONTROLLERS, N_X, RESET_ELEVONS, RESET_THRUST,
-                                STATUS_AIRSPEED, STATUS_ALPHA, STATUS_NONFINITE,
-                                STATUS_NOT_PSD, STATUS_OK)
-from ftc_mc.core import control, plant as kplant, stages, trial
-from ftc_mc.core.settings import LaneState, TrialInputs, TrialRecord
-from ftc_mc.core.workspace import (new_lane_selection_work, new_selection_work,
-                                   new_trial_work)
+from ftc_mc.conventions import (C_ELEVON, C_ENGINE, C_NOMINAL, I_B0_ELEVONS, I_B0_THRUST,
+                                I_B1_LEFT, I_B1_RIGHT, I_B1_THRUST, N_AUG, N_CONTROLLERS, N_X,
+                                RESET_ELEVONS, RESET_THRUST, STATUS_AIRSPEED, STATUS_ALPHA,
+                                STATUS_NONFINITE, STATUS_NOT_PSD, STATUS_OK)
+from ftc_mc.core.longitudinal import control
+from ftc_mc.core.longitudinal import plant as kplant
+from ftc_mc.core.longitudinal import stages
+from ftc_mc.core.longitudinal import trial
+from ftc_mc.core.longitudinal.settings import LaneState, TrialInputs, TrialRecord
+from ftc_mc.core.longitudinal.workspace import (new_lane_selection_work, new_selection_work,
+                                                new_trial_work)
 from ftc_mc.config import Config
 from ftc_mc.sim.paths import path_of
 

@@ -15,7 +15,7 @@ import pytest
 import scipy.linalg
 from scipy.interpolate import RegularGridInterpolator
 
-from ftc_mc.core.interp import bilinear, engine_controller
+from ftc_mc.core.shared.interp import bilinear, engine_controller
 from ftc_mc.design import theorem41 as t41
 from ftc_mc.design.lqr import discounted_lqr, paper_q_lqr
 

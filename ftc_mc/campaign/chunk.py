@@ -21,15 +21,15 @@ from ..config.schema import Config
 from ..conventions import (BLOCK_NAMES, C_NOMINAL, LONGITUDINAL, MODE_NAMES, MODE_NOMINAL,
                            STATUS_AIRSPEED, STATUS_ALPHA, STATUS_NAMES, STATUS_NONFINITE,
                            STATUS_NOT_PSD)
-from ..core.settings import TrialInputs, TrialRecord
-from ..core.trial import advance
+from ..core.longitudinal.settings import TrialInputs, TrialRecord
+from ..core.longitudinal.trial import advance
 from ..sim.compiling import compiled_once
 from ..sim.paths import path_of
 from ..sim.inputs import build_inputs, draw_lanes, flight_inputs, sensor_faults
 from ..sim.lanes import simulate
 from ..sim.setup import SimSetup, build_setup, runs_of
-from .transitions import (TRANSITION_TABLE, FaultRanges, SensorTransition, fault_ranges,
-                          is_sensor, transition_of)
+from .transitions import (TRANSITION_TABLE, FaultRanges, SensorTransition, fault_ranges, is_sensor,
+                          transition_of)
 
 FLIGHT = "fault_free"
 """Chunk name of the fault-free flights of a sweep (false resets per flight hour)."""
@@ -468,7 +468,7 @@ def run_chunk(spec: ChunkSpec, name: str, trial_ids) -> dict:
 def warm_up(spec: ChunkSpec, tr_name: str) -> None:
     """Compile (or load from Numba's cache) the kernels before fanning out: one
     trial of ``tr_name`` under the first variant of each compile path the
-    variants take (``core/paths.py``).  When a path is not in the cache yet,
+    variants take (``core/shared/paths.py``).  When a path is not in the cache yet,
     one line on stderr says that it is being compiled, and another how long it
     took (:func:`ftc_mc.core.jit.announce_compile`); another process compiling
     it is waited for (:func:`ftc_mc.sim.compiling.compiled_once`)."""

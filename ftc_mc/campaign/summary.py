@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from ..core.trial import STATUS_NAMES
+from ..core.longitudinal.trial import STATUS_NAMES
 from ..stats import median_p95, wilson
 from .transitions import PAPER_TABLES, TRANSITION_TABLE, is_sensor, transition_of
 

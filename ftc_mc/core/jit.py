@@ -228,7 +228,7 @@ def kernel(func=None, **overrides):
 COMPILE_NOTICE = ("ftc-mc: compiling the simulation kernels of this path once: {} "
                   "(about {} on 2 cores; later runs start at once)")
 """Printed to stderr before the first run that compiles a path of the trial kernel
-(``core/paths.py``)."""
+(``core/shared/paths.py``)."""
 
 COMPILE_NOTICE_NO_CACHE = ("ftc-mc: compiling the simulation kernels of this path: {} "
                            "(about {} on 2 cores; FTC_MC_NUMBA_CACHE=0, so every run "
@@ -269,7 +269,7 @@ def in_disk_cache(dispatcher, first=None) -> bool | None:
     Reads the cache index the way Numba's ``FunctionCache`` does (the source
     stamp of the function's file, then the key's target and bytecode hash).
     Of the signature, only the first argument's type is checked, when
-    ``first`` gives it (the trial kernel's compile path, ``core/paths.py``):
+    ``first`` gives it (the trial kernel's compile path, ``core/shared/paths.py``):
     the campaign, sweep and scenario call each path with one and the same
     signature.  Returns ``None`` when the cache's layout is not the expected
     one (a Numba version that changed it).

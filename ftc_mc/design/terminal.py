@@ -6,7 +6,7 @@ computes it "numerically with the indicator of performance off-line" and says
 no more; here it is the mean, over a fixed set of representative faults of mode
 ``m``, of the discounted cost of ``a`` on the noise-free linear plant over
 ``n_steps`` steps from trim, with perfect knowledge of the state and of the
-fault parameters (:func:`ftc_mc.core.control.policy_cost`):
+fault parameters (:func:`ftc_mc.core.longitudinal.control.policy_cost`):
 
 * nominal: no fault (so ``J^N(0, a)`` is zero for every ``a``: from trim, with
   no fault and no noise, no controller has anything to do);
@@ -31,7 +31,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..core.control import policy_cost
+from ..core.longitudinal.control import policy_cost
 
 ENGINE_LOCKS = (0.0, 0.2, 0.4, 0.6, 0.8, 1.0)
 ELEVON_LOCKS = (-0.4, -0.2, 0.0, 0.2, 0.4)

@@ -80,7 +80,7 @@ from typing import NamedTuple
 import numpy as np
 import scipy.linalg
 
-from ..core.interp import EngineTables
+from ..core.shared.interp import EngineTables
 from .cache import default_cache_dir, write_atomic
 from .lqr import paper_q_lqr
 
@@ -322,7 +322,7 @@ def engine_fault_tables(plant, b0_grid=None, b1_grid=None, Q=None, R=None, alpha
     -------
     EngineTables
         ``K`` (nb0, nb1, 3, 9), ``k`` (nb0, nb1, 3) with ``u = -K x - k``, and the
-        grids (C-contiguous float64, ready for :func:`ftc_mc.core.interp.engine_controller`).
+        grids (C-contiguous float64, ready for :func:`ftc_mc.core.shared.interp.engine_controller`).
 
     Raises
     ------

@@ -1,10 +1,10 @@
 """Nonlinear longitudinal equations of motion of the X8 with first-order actuators.
 
 The equations themselves are written once, in the Numba kernels of
-:mod:`ftc_mc.core.nonlinear` (which also serve the nonlinear truth plant); this
+:mod:`ftc_mc.core.longitudinal.nonlinear` (which also serve the nonlinear truth plant); this
 module packs the parameters and evaluates those kernels in still air for trim
 and numerical linearisation (:mod:`ftc_mc.model.linear`).  State, command,
-output and parameter conventions are those of :mod:`ftc_mc.core.nonlinear`:
+output and parameter conventions are those of :mod:`ftc_mc.core.longitudinal.nonlinear`:
 
 State (9, paper section 2.3.1 order)::
 
@@ -21,7 +21,7 @@ import numpy as np
 
 from .airframe import Airframe
 
-from ..core.nonlinear import (N_PARAM, P_C, P_CD0, P_CDA, P_CDA2,  # noqa: F401
+from ..core.longitudinal.nonlinear import (N_PARAM, P_C, P_CD0, P_CDA, P_CDA2,  # noqa: F401
                               P_CDDE2, P_CL0, P_CLA, P_CLDE, P_CLQ, P_CM0, P_CMA,
                               P_CMDE, P_CMQ, P_CPROP, P_G, P_GAMMA0, P_JY, P_KMOTOR,
                               P_MASS, P_RHO, P_S, P_SPROP, P_TAUE, P_TAUT, P_V0,
@@ -46,7 +46,7 @@ def pack_parameters(airframe: Airframe, V0: float, gamma0: float) -> np.ndarray:
     -------
     numpy.ndarray
         Shape (25,), in the order of the ``P_*`` indices of
-        :mod:`ftc_mc.core.nonlinear`.
+        :mod:`ftc_mc.core.longitudinal.nonlinear`.
     """
     a = airframe
     return np.array([a.mass, a.Jy, a.S, a.c, a.rho, a.g, a.CL0, a.CLa, a.CLq, a.CLde,
@@ -83,7 +83,7 @@ def forces(x, p, out):
     out : ndarray, shape (6,)
         Written with ``[X, Z, M, alpha, Va, thrust]``: body forces [N] (aerodynamic
         plus thrust, no gravity), pitch moment [N m], angle of attack [rad],
-        airspeed [m/s], thrust [N] (:func:`ftc_mc.core.nonlinear.air_forces`).
+        airspeed [m/s], thrust [N] (:func:`ftc_mc.core.longitudinal.nonlinear.air_forces`).
     """
     out[:] = air_forces(_c(x), _c(p), _STILL_AIR)
 
@@ -100,7 +100,7 @@ def derivatives(x, cmd, p, dx):
     p : ndarray, shape (25,)
         Packed parameters.
     dx : ndarray, shape (9,)
-        Written with the derivative (:func:`ftc_mc.core.nonlinear.derivatives_nb`).
+        Written with the derivative (:func:`ftc_mc.core.longitudinal.nonlinear.derivatives_nb`).
     """
     buf = _buffer(dx)
     derivatives_nb(_c(x), _c(cmd), _c(p), _STILL_AIR, buf)
@@ -118,7 +118,7 @@ def outputs(x, p, y):
         Packed parameters.
     y : ndarray, shape (12,)
         Written with ``u, w, q, x, z, theta, n_x, n_z, alpha, gamma, CAS, Va``
-        (:func:`ftc_mc.core.nonlinear.outputs_nb`).
+        (:func:`ftc_mc.core.longitudinal.nonlinear.outputs_nb`).
     """
     buf = _buffer(y)
     outputs_nb(_c(x), _c(p), _STILL_AIR, buf)

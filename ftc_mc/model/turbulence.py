@@ -1,7 +1,7 @@
 """MIL-F-8785C longitudinal Dryden turbulence, discretised exactly.
 
 Builds the matrices of the discrete gust model run by
-:func:`ftc_mc.core.dryden.gust_step`.
+:func:`ftc_mc.core.shared.dryden.gust_step`.
 
 Spectra (MIL-F-8785C section 3.7.2; one-sided in angular frequency ``omega``
 [rad/s], i.e. ``int_0^inf Phi d omega = sigma^2``; ``V`` airspeed)::
@@ -21,7 +21,7 @@ with ``b`` the wing span.  Shaping filters driven by unit-intensity white noise
 The pitch gust is the rotation of the air seen by the wing, ``q_g = -dw_g/dx``
 (frozen field, ``d/dx = (1/V) d/dt``) with the first-order lag of the span
 (``T_q``); its sign makes a uniform rotation of the air equivalent to ``-q`` of
-the aircraft, which is how :mod:`ftc_mc.core.nonlinear` uses it (the
+the aircraft, which is how :mod:`ftc_mc.core.longitudinal.nonlinear` uses it (the
 aerodynamics see ``q - q_g``).  The spectrum fixes only ``|H_q|``; the sign
 follows this definition (MIL-F-8785C and MIL-HDBK-1797 differ in sign).  It is
 realised without feed-through as ``q_g = -(w_g - s_q) / (V T_q)`` with the lag
@@ -69,7 +69,7 @@ DrydenModel = collections.namedtuple(
      "sigma_q", "L_u", "L_w", "T_q", "V", "dt", "level", "altitude_m", "span"])
 DrydenModel.__doc__ = """Discrete Dryden gust model (see :func:`dryden_model`).
 
-Ad, Bd (4, 4), Cd (3, 4): discrete recursion of :func:`ftc_mc.core.dryden.gust_step`.
+Ad, Bd (4, 4), Cd (3, 4): discrete recursion of :func:`ftc_mc.core.shared.dryden.gust_step`.
 P0 (4, 4), P0_chol: stationary state covariance and its Cholesky factor (start a
 record in stationary turbulence with ``s_0 = P0_chol @ randn(4)``).
 Ac, Bc (4, 2), Cc: continuous shaping filters (noise inputs eta_u, eta_w).

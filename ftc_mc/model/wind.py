@@ -3,7 +3,7 @@
 The linear truth plant in turbulence is ``x+ = A x + B e + B_w g`` and
 ``z = C x + D_w g`` with the gust ``g = [u_g, w_g, q_g]`` ([m/s], [m/s],
 [rad/s]) held over each control period.  ``B_w`` and ``D_w`` are the Jacobians
-of the nonlinear derivatives and outputs (:mod:`ftc_mc.core.nonlinear`) with
+of the nonlinear derivatives and outputs (:mod:`ftc_mc.core.longitudinal.nonlinear`) with
 respect to the wind at trim, the first discretised with the same zero-order hold
 as ``A`` and ``B``; a linear model read from a file brings its own.
 """
@@ -14,7 +14,7 @@ import numpy as np
 
 from ..conventions import N_X as N_STATE
 from ..conventions import N_Z as N_OUTPUT
-from ..core.nonlinear import derivatives_nb, outputs_nb
+from ..core.longitudinal.nonlinear import derivatives_nb, outputs_nb
 from .linear import LinearPlant, jacobian, zoh
 
 

@@ -20,8 +20,8 @@ import pandas as pd
 
 from ..config.schema import ScenarioConfig
 from ..conventions import CONTROLLER_NAMES, LONGITUDINAL, MODE_NAMES, STATUS_NAMES
-from ..core.trial import advance
-from ..core.workspace import EXC_3211, EXC_3211_START, EXC_DOUBLET, EXC_DOUBLET_START
+from ..core.longitudinal.trial import advance
+from ..core.longitudinal.workspace import EXC_3211, EXC_3211_START, EXC_DOUBLET, EXC_DOUBLET_START
 from ..model.faults import estimator_params, mode_of
 from ..sim.compiling import compiled_once
 from ..sim.paths import path_of
@@ -45,7 +45,7 @@ class ScenarioResult:
         One row per schedule entry: expected mode, detection delay, tracking.
     config : ScenarioConfig
     status : str
-        ``ok`` or why the run stopped being trusted (see core/trial.py).
+        ``ok`` or why the run stopped being trusted (see core/longitudinal/trial.py).
     """
 
     timeseries: pd.DataFrame

@@ -1,7 +1,7 @@
 """One compile of each path of the trial kernel at a time per kernel cache.
 
-A cold compile of a path of :func:`ftc_mc.core.trial.advance`
-(``core/paths.py``) takes from a quarter of a minute to a minute
+A cold compile of a path of :func:`ftc_mc.core.longitudinal.trial.advance`
+(``core/shared/paths.py``) takes from a quarter of a minute to a minute
 (``scripts/bench_campaign.py``).  Processes that start together on an empty
 cache (two runs launched at once, Dask or test workers on one machine) would
 each compile it, on cores they then share.  :func:`compiled_once` makes the
@@ -21,7 +21,7 @@ from pathlib import Path
 import numba
 
 from ..core import jit
-from ..core.paths import describe
+from ..core.shared.paths import describe
 from ..io.lock import waiting
 
 WAIT_NOTICE = ("ftc-mc: another process is compiling the simulation kernels; waiting "
@@ -65,7 +65,7 @@ def compiled_once(dispatcher, path=None, stream=None):
     dispatcher : numba dispatcher
         The kernel the block calls (``advance``).
     path : Path, optional
-        The compile path the block calls it on (``core/paths.py``); the notice
+        The compile path the block calls it on (``core/shared/paths.py``); the notice
         names it, and when the compile is done says how long it took.
     stream : file, optional
         Where the notices go (default stderr).

@@ -17,7 +17,7 @@ evolve as ``g+ = A_d g`` with process noise ``Q_g = B_d B_d^T`` of the design's
 turbulence level.  Its gust states start at 0 with the stationary Dryden
 covariance.  ``prediction: nonlinear`` makes it an extended filter: the airframe's
 equations predict the plant states and the outputs
-(:mod:`ftc_mc.core.gustfilter`), with or without gust states; its covariance
+(:mod:`ftc_mc.core.longitudinal.gustfilter`), with or without gust states; its covariance
 takes the Jacobians at trim, or with ``relinearise_s`` those about each lane's
 estimate, re-computed every ``relinearise_s`` seconds (``FilterModel.relin``).
 
@@ -42,9 +42,9 @@ import numpy as np
 import scipy.linalg
 
 from ..config.schema import BUILTIN_DESIGNS, DesignConfig, EstimatorConfig
-from ..conventions import (OUTPUT_NAMES, RESET_ELEVONS, RESET_THRUST, STATE_NAMES,
-                           TEST_GLR, TEST_NAMES, TEST_ONE_STEP)
-from ..core.settings import Detection, FilterModel
+from ..conventions import (OUTPUT_NAMES, RESET_ELEVONS, RESET_THRUST, STATE_NAMES, TEST_GLR,
+                           TEST_NAMES, TEST_ONE_STEP)
+from ..core.longitudinal.settings import Detection, FilterModel
 from ..model.linear import LinearPlant
 from ..model.turbulence import dryden_model
 from ..model.wind import plant_wind_matrices

@@ -20,7 +20,7 @@ import numpy as np
 
 from ..config.schema import EstimatorConfig
 from ..conventions import LONGITUDINAL, N_AUG, TEST_ONE_STEP, VARIANTS
-from ..core.settings import Belief, Detection, FilterModel
+from ..core.longitudinal.settings import Belief, Detection, FilterModel
 from ..model.faults import bias_matrix, fault_bounds
 from ..model.linear import LinearPlant
 

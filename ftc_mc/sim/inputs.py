@@ -1,4 +1,4 @@
-"""Trial inputs (:class:`~ftc_mc.core.settings.TrialInputs`) from per-lane schedules.
+"""Trial inputs (:class:`~ftc_mc.core.longitudinal.settings.TrialInputs`) from per-lane schedules.
 
 One builder, :func:`build_inputs`, lays out every kind of flight the kernels
 run: a campaign trial (two schedule entries: the initial mode, and the final
@@ -37,7 +37,7 @@ import numpy as np
 
 from ..conventions import (ACTUATOR_NAMES, LONGITUDINAL, NO_SENSOR_FAULT, OUTPUT_NAMES,
                            SENSOR_FAULT_KINDS)
-from ..core.settings import TrialInputs
+from ..core.longitudinal.settings import TrialInputs
 from ..model.faults import estimator_params, mode_of
 
 Schedule = namedtuple("Schedule", [
@@ -62,7 +62,7 @@ SensorFaults = namedtuple("SensorFaults", [
     "size",  # (L,) bias [unit], drift [unit/s], noise factor [-]; unused when stuck
     "k",     # (L,) int64 onset step
 ])
-"""Per-lane sensor faults (``TrialInputs.sensor_*``, ``core/plant.py``)."""
+"""Per-lane sensor faults (``TrialInputs.sensor_*``, ``core/longitudinal/plant.py``)."""
 
 FLIGHT_FAULT_RANGE = (0.0, 1.0)
 """Range of the fault value a fault-free flight draws and ignores."""

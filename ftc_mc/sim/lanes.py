@@ -25,8 +25,8 @@ import math
 
 import numpy as np
 
-from ..core.settings import TrialInputs, TrialRecord
-from ..core.trial import advance, init_jacobians, init_state, new_state
+from ..core.longitudinal.settings import TrialInputs, TrialRecord
+from ..core.longitudinal.trial import advance, init_jacobians, init_state, new_state
 from .inputs import design_inputs
 from .paths import path_of
 
@@ -36,8 +36,8 @@ HISTORY_RESETS = 100_000
 
 def start_lanes(scheme, inp: TrialInputs, rec: TrialRecord):
     """The lane state of every trial of ``inp`` at step 0, and ``rec``'s per-lane
-    fields initialised (:func:`ftc_mc.core.trial.init_state`; the extended
-    filter's Jacobians at trim, :func:`~ftc_mc.core.trial.init_jacobians`)."""
+    fields initialised (:func:`ftc_mc.core.longitudinal.trial.init_state`; the extended
+    filter's Jacobians at trim, :func:`~ftc_mc.core.longitudinal.trial.init_jacobians`)."""
     st = new_state(inp.w.shape[2], inp.xa0.shape[0], scheme.detection.window)
     init_state(inp, st, rec)
     init_jacobians(scheme.filter, st)
@@ -47,9 +47,9 @@ def start_lanes(scheme, inp: TrialInputs, rec: TrialRecord):
 def run_trials(scheme, flight, inp: TrialInputs, rec: TrialRecord) -> None:
     """Simulate the ``L`` trials of ``inp`` from the start to the end, writing
     ``rec`` (overwritten): :func:`start_lanes`, then
-    :func:`ftc_mc.core.trial.advance` over every step.
+    :func:`ftc_mc.core.longitudinal.trial.advance` over every step.
 
-    Parameters are those of :func:`~ftc_mc.core.trial.advance` without the
+    Parameters are those of :func:`~ftc_mc.core.longitudinal.trial.advance` without the
     state and step range.  The step kernel is called from Python, not from a
     compiled wrapper: Numba re-optimises and re-emits all the code a compiled
     caller links in, so a wrapper kernel cost the cold compile about 20 s

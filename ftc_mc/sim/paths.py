@@ -1,4 +1,4 @@
-"""The compile path of a scheme flying a flight (``ftc_mc/core/paths.py``).
+"""The compile path of a scheme flying a flight (``ftc_mc/core/shared/paths.py``).
 
 The one place where the settings decide which kernels a trial reaches: the
 truth plant's kind, the filter (the paper's 14 states with a linear
@@ -9,14 +9,14 @@ the residual test and the controller.
 from __future__ import annotations
 
 from ..conventions import TEST_GLR
-from ..core.paths import (DENSE_FILTER, EXTENDED_FILTER, GLR_TEST, LINEAR_PLANT,
-                          NOMINAL_CONTROL, NONLINEAR_PLANT, ONE_STEP_TEST, PAPER_FILTER,
-                          RECONFIGURING, Path)
-from ..core.settings import Flight, Scheme
+from ..core.shared.paths import (DENSE_FILTER, EXTENDED_FILTER, GLR_TEST, LINEAR_PLANT,
+                                 NOMINAL_CONTROL, NONLINEAR_PLANT, ONE_STEP_TEST, PAPER_FILTER,
+                                 RECONFIGURING, Path)
+from ..core.longitudinal.settings import Flight, Scheme
 
 
 def path_of(scheme: Scheme, flight: Flight | None = None) -> Path:
-    """The :class:`~ftc_mc.core.paths.Path` of ``scheme`` flying ``flight``
+    """The :class:`~ftc_mc.core.shared.paths.Path` of ``scheme`` flying ``flight``
     (``None``: the linear plant, for the stages that do not fly it).
 
     The filter is the paper's when its estimate has the paper's 14 states

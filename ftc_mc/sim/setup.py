@@ -22,9 +22,9 @@ import numpy as np
 
 from ..config.schema import Config, ScenarioConfig
 from ..conventions import LONGITUDINAL, VARIANTS
-from ..core.interp import EngineTables
-from ..core.settings import (Belief, Controller, Detection, Excitation, FilterModel, Flight,
-                             Reconfig, Scheme, Timing, TruthPlant, Validity)
+from ..core.shared.interp import EngineTables
+from ..core.longitudinal.settings import (Belief, Controller, Detection, Excitation, FilterModel,
+                                          Flight, Reconfig, Scheme, Timing, TruthPlant, Validity)
 from ..design.lqr import discounted_lqr, paper_q_lqr
 from ..design.terminal import terminal_costs
 from ..design.theorem41 import cached_engine_tables

@@ -1,8 +1,8 @@
-"""The truth plant a trial simulates (:class:`~ftc_mc.core.settings.TruthPlant`).
+"""The truth plant a trial simulates (:class:`~ftc_mc.core.longitudinal.settings.TruthPlant`).
 
 The estimator and the controllers always use the linear model of eq. (1); the
 truth they act on can be that same linear model (the paper's setting) or the
-nonlinear X8 of :mod:`ftc_mc.core.nonlinear`, each in still air or in
+nonlinear X8 of :mod:`ftc_mc.core.longitudinal.nonlinear`, each in still air or in
 MIL-F-8785C Dryden turbulence (:mod:`ftc_mc.model.turbulence`).
 
 The linear plant in turbulence needs the gust's input matrices
@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..conventions import PLANT_KINDS, TURBULENCE_LEVELS
-from ..core.settings import TruthPlant
+from ..core.longitudinal.settings import TruthPlant
 from ..model.linear import LinearPlant
 from ..model.turbulence import DrydenModel, dryden_model
 from ..model.wind import plant_wind_matrices

@@ -1,12 +1,12 @@
 """The stages of one trial step, each a kernel over every lane.
 
-:func:`ftc_mc.core.trial.advance` runs, for step ``k -> k+1``:
+:func:`ftc_mc.core.longitudinal.trial.advance` runs, for step ``k -> k+1``:
 
 1. :func:`commands` -- controller, saturation and excitation (eqs. 15-25, 44);
-2. :func:`ftc_mc.core.plant.truth_step` -- effect (eq. 2), gusts, plant,
+2. :func:`ftc_mc.core.longitudinal.plant.truth_step` -- effect (eq. 2), gusts, plant,
    measurement;
 3. :func:`filter_update` -- the augmented filter with Table 1 and resets
-   (eqs. 5-11, :func:`ftc_mc.core.batch.filter_step_lanes`);
+   (eqs. 5-11, :func:`ftc_mc.core.longitudinal.batch.filter_step_lanes`);
 4. :func:`check_validity` -- where a trial stops being trusted;
 5. :func:`handle_resets` -- reset records and excitation requests (sections
    3.2.3 and 4.1.1);
@@ -15,9 +15,9 @@
    and the controller selection (eqs. 45-47);
 
 and :func:`record_end` once at the end.  Stages communicate through the lane
-state (:class:`~ftc_mc.core.settings.LaneState`), the record
-(:class:`~ftc_mc.core.settings.TrialRecord`) and the scratch
-(:class:`~ftc_mc.core.workspace.TrialWork`); each stage's docstring says what
+state (:class:`~ftc_mc.core.longitudinal.settings.LaneState`), the record
+(:class:`~ftc_mc.core.longitudinal.settings.TrialRecord`) and the scratch
+(:class:`~ftc_mc.core.longitudinal.workspace.TrialWork`); each stage's docstring says what
 it reads and writes.  Lane ``l`` of every array is one trial, lane index last.
 
 Each stage has a plain-NumPy twin in ``tests/naive.py`` (same name with
@@ -35,21 +35,19 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..conventions import (C_ELEVON, I_B1_LEFT, I_B1_THRUST, N_AUG, N_FAULT, N_MODES,
-                           N_U, N_X, NO_RESET, RESET_THRUST, STATUS_AIRSPEED,
-                           STATUS_ALPHA, STATUS_NONFINITE, STATUS_NOT_PSD, STATUS_OK)
-from .batch import (filter_correct_lanes, filter_predict_lanes, innovations_lanes,
-                    signature_lanes)
-from .glr import glr_lanes, glr_restart
+from ...conventions import (C_ELEVON, I_B1_LEFT, I_B1_THRUST, N_AUG, N_FAULT, N_MODES, N_U, N_X,
+                            NO_RESET, RESET_THRUST, STATUS_AIRSPEED, STATUS_ALPHA,
+                            STATUS_NONFINITE, STATUS_NOT_PSD, STATUS_OK)
+from .batch import (filter_correct_lanes, filter_predict_lanes, innovations_lanes, signature_lanes)
+from ..shared.glr import glr_lanes, glr_restart
 from .gustfilter import gust_correct_lanes, gust_predict_lanes
-from .belief import belief_update
-from .control import (U_LEFT, U_RIGHT, U_THRUST, controller_command,
-                      select_controllers_lanes)
-from .excitation import (doublet, doublet_length, running, saturate, signal_3211,
-                         signal_3211_length)
-from .jit import kernel
-from .paths import (DENSE_FILTER, EXTENDED_FILTER, GLR_TEST, NOMINAL_CONTROL, ONE_STEP_TEST,
-                    PAPER_FILTER, RECONFIGURING, on_path)
+from ..shared.belief import belief_update
+from .control import (U_LEFT, U_RIGHT, U_THRUST, controller_command, select_controllers_lanes)
+from ..shared.excitation import (doublet, doublet_length, running, saturate, signal_3211,
+                                 signal_3211_length)
+from ..jit import kernel
+from ..shared.paths import (DENSE_FILTER, EXTENDED_FILTER, GLR_TEST, NOMINAL_CONTROL,
+                            ONE_STEP_TEST, PAPER_FILTER, RECONFIGURING, on_path)
 from .workspace import EXC_3211, EXC_3211_START, EXC_DOUBLET, EXC_DOUBLET_START
 
 R_Q, R_NX = 0, 1
@@ -77,7 +75,7 @@ def nominal_output(scheme, st, work):
 @kernel(inline="always")
 def reconfiguring_output(scheme, st, work):
     """The output of each lane's controller in use into ``work.u``
-    (:func:`ftc_mc.core.control.controller_command`: c0, c1 of eq. 44 or c2 of
+    (:func:`ftc_mc.core.longitudinal.control.controller_command`: c0, c1 of eq. 44 or c2 of
     eqs. 20-25); one-lane buffers ``xl``, ``Ul``."""
     xa = st.xa
     xl = work.xl
@@ -112,7 +110,7 @@ def commands(path, scheme, st, k, work):
     Parameters
     ----------
     path : Path
-        The compile path (``core/paths.py``): its ``control``.
+        The compile path (``core/shared/paths.py``): its ``control``.
     scheme : Scheme
         Reads ``controller`` (gain, limits), ``excitation``, ``engine`` and
         ``filter.u0``.
@@ -165,7 +163,7 @@ def commands(path, scheme, st, k, work):
 @kernel(inline="always")
 def paper_predict(scheme, st, k, work):
     """The paper filter's prediction and one-step residuals
-    (:func:`ftc_mc.core.batch.filter_predict_lanes`)."""
+    (:func:`ftc_mc.core.longitudinal.batch.filter_predict_lanes`)."""
     filter_predict_lanes(st.xa, st.P, work.u, work.z, scheme.filter, work.phi, work.T,
                          work.fwork, work.res)
 
@@ -173,7 +171,7 @@ def paper_predict(scheme, st, k, work):
 @kernel(inline="always")
 def paper_predict_glr(scheme, st, k, work):
     """:func:`paper_predict` and the signed innovations the GLR test reads
-    (:func:`ftc_mc.core.batch.innovations_lanes`)."""
+    (:func:`ftc_mc.core.longitudinal.batch.innovations_lanes`)."""
     paper_predict(scheme, st, k, work)
     innovations_lanes(st.xa, work.fwork[0:st.xa.shape[0]], work.z, scheme.filter, work.innov)
 
@@ -186,7 +184,7 @@ def paper_predict_on(path, scheme, st, k, work):
 @kernel(inline="always")
 def general_predict(path, scheme, st, k, work):
     """The general filter's prediction and residuals
-    (:func:`ftc_mc.core.gustfilter.gust_predict_lanes`)."""
+    (:func:`ftc_mc.core.longitudinal.gustfilter.gust_predict_lanes`)."""
     gust_predict_lanes(path, st.xa, st.P, scheme.filter, work, st, k)
 
 
@@ -199,7 +197,7 @@ def predict(path, scheme, st, k, work):
 @kernel(inline="always")
 def paper_correct(path, scheme, st, work):
     """Reset, update and projection of the paper's filter
-    (:func:`ftc_mc.core.batch.filter_correct_lanes`; ``path`` unused)."""
+    (:func:`ftc_mc.core.longitudinal.batch.filter_correct_lanes`; ``path`` unused)."""
     filter_correct_lanes(st.xa, st.P, work.u, work.z, scheme.filter, scheme.detection,
                          work.phi, work.T, work.fwork, work.block)
 
@@ -207,7 +205,7 @@ def paper_correct(path, scheme, st, work):
 @kernel(inline="always")
 def general_correct(path, scheme, st, work):
     """Reset, re-prediction, update and projection of the general filter
-    (:func:`ftc_mc.core.gustfilter.gust_correct_lanes`)."""
+    (:func:`ftc_mc.core.longitudinal.gustfilter.gust_correct_lanes`)."""
     gust_correct_lanes(path, st.xa, st.P, scheme.filter, scheme.detection, work, st)
 
 
@@ -219,7 +217,7 @@ def correct(path, scheme, st, work):
 
 @kernel(inline="always")
 def glr_statistics(det, st, k, work):
-    """The GLR statistics of the window (:func:`ftc_mc.core.glr.glr_lanes`) in
+    """The GLR statistics of the window (:func:`ftc_mc.core.shared.glr.glr_lanes`) in
     place of the one-step residuals ``work.res``."""
     glr_lanes(work.innov, st.ebuf, st.ecount, k, det.min_window, work.res)
 
@@ -240,10 +238,10 @@ def filter_update(path, scheme, st, k, work):
     """Stage 3: one step of every lane's augmented filter (eqs. 5-11, Table 1).
 
     Predict with ``u_k`` and the residuals on ``z_{k+1}``
-    (:func:`predict`: :func:`ftc_mc.core.batch.filter_predict_lanes` on the
-    paper filter's path, :func:`ftc_mc.core.gustfilter.gust_predict_lanes` on
+    (:func:`predict`: :func:`ftc_mc.core.longitudinal.batch.filter_predict_lanes` on the
+    paper filter's path, :func:`ftc_mc.core.longitudinal.gustfilter.gust_predict_lanes` on
     the dense and extended filters' paths); on the GLR test's path the
-    statistics of :func:`ftc_mc.core.glr.glr_lanes` replace the one-step
+    statistics of :func:`ftc_mc.core.shared.glr.glr_lanes` replace the one-step
     residuals; Table 1
     on them, a decision for the other block withheld within
     ``detection.settle`` steps of a reset (:func:`settle_lanes`); reset, update
@@ -254,7 +252,7 @@ def filter_update(path, scheme, st, k, work):
     Parameters
     ----------
     path : Path
-        The compile path (``core/paths.py``): its ``filter`` and ``test``.
+        The compile path (``core/shared/paths.py``): its ``filter`` and ``test``.
     scheme : Scheme
         Reads ``filter`` and ``detection``.
     st : LaneState
@@ -496,7 +494,7 @@ def record_step(k, st, work, rec):
 @kernel(inline="always")
 def select_lanes(scheme, st, work):
     """The controller selection (eqs. 45-47) of every lane
-    (:func:`ftc_mc.core.control.select_controllers_lanes`) on the estimate's
+    (:func:`ftc_mc.core.longitudinal.control.select_controllers_lanes`) on the estimate's
     first 14 states (a design's extra states are left out); ``st.cur``
     updated."""
     xa = st.xa
@@ -528,8 +526,8 @@ def reconfigure(path, scheme, timing, inp, st, kn, period, work, rec):
     and its marginal variances (eq. 12); on the reconfiguring controller's
     path the controller selection (eqs. 45-47, :func:`select`) on the
     estimate's first 14 states (a design's gust states are left out), for every
-    lane at once (:func:`ftc_mc.core.control.select_controllers_lanes`, per
-    lane bit-identical to :func:`~ftc_mc.core.control.select_controller`; the
+    lane at once (:func:`ftc_mc.core.longitudinal.control.select_controllers_lanes`, per
+    lane bit-identical to :func:`~ftc_mc.core.longitudinal.control.select_controller`; the
     horizon predictions run lane-interleaved, about 4x faster than one lane at
     a time); and the detection time: the
     first period end after the switch ``k_fault`` where the final mode is the
@@ -538,7 +536,7 @@ def reconfigure(path, scheme, timing, inp, st, kn, period, work, rec):
     Parameters
     ----------
     path : Path
-        The compile path (``core/paths.py``): its ``control``.
+        The compile path (``core/shared/paths.py``): its ``control``.
     scheme : Scheme
         Reads ``belief`` (and, when reconfiguring, ``reconfig``, ``filter``,
         ``controller``, ``engine``).

@@ -1,12 +1,12 @@
 """Scratch arrays of the trial kernels, two namedtuples built once per call.
 
-:class:`TrialWork` holds everything :func:`ftc_mc.core.trial.advance` and its
-stages (:mod:`ftc_mc.core.stages`, :mod:`ftc_mc.core.plant`) need between the
-state of a trial (:class:`~ftc_mc.core.settings.LaneState`) and its record:
-lane arrays (lane index last, see :mod:`ftc_mc.core.batch`) that one stage
+:class:`TrialWork` holds everything :func:`ftc_mc.core.longitudinal.trial.advance` and its
+stages (:mod:`ftc_mc.core.longitudinal.stages`, :mod:`ftc_mc.core.longitudinal.plant`) need between the
+state of a trial (:class:`~ftc_mc.core.longitudinal.settings.LaneState`) and its record:
+lane arrays (lane index last, see :mod:`ftc_mc.core.longitudinal.batch`) that one stage
 writes and the next reads, and small one-lane buffers for the kernels that run
 a lane at a time (nonlinear plant, belief, controller selection).
-:class:`SelectionWork` is the scratch of :func:`ftc_mc.core.control.select_controller`.
+:class:`SelectionWork` is the scratch of :func:`ftc_mc.core.longitudinal.control.select_controller`.
 
 Every size comes from :mod:`ftc_mc.conventions` or from the augmented dimension
 ``n`` passed in (taken from the state's arrays), never from a literal.  The
@@ -19,11 +19,10 @@ from collections import namedtuple
 
 import numpy as np
 
-from ..conventions import (N_AUG, N_CONTROLLERS, N_FAULT, N_MODES, N_U, N_X, N_Z,
-                           RESIDUAL_NAMES)
+from ...conventions import (N_AUG, N_CONTROLLERS, N_FAULT, N_MODES, N_U, N_X, N_Z, RESIDUAL_NAMES)
 from .batch import UPDATE_ROWS, step_rows
-from .dryden import N_GUST_NOISE, N_GUST_OUT, N_GUST_STATE
-from .jit import kernel
+from ..shared.dryden import N_GUST_NOISE, N_GUST_OUT, N_GUST_STATE
+from ..jit import kernel
 from .nonlinear import N_WORK
 
 N_RES = len(RESIDUAL_NAMES)
@@ -69,7 +68,7 @@ LaneSelectionWork = namedtuple("LaneSelectionWork", [
     "bwork",   # (2 N_MODES,) work of belief.belief_update
 ])
 """Scratch of the lane-interleaved controller selection
-(:func:`ftc_mc.core.control.select_controllers_lanes`)."""
+(:func:`ftc_mc.core.longitudinal.control.select_controllers_lanes`)."""
 
 TrialWork = namedtuple("TrialWork", [
     # lane arrays, written by one stage and read by the next
@@ -113,7 +112,7 @@ TrialWork = namedtuple("TrialWork", [
     "sel",        # SelectionWork
     "lsel",       # LaneSelectionWork
 ])
-"""Scratch of one :func:`ftc_mc.core.trial.advance` call (see module docstring)."""
+"""Scratch of one :func:`ftc_mc.core.longitudinal.trial.advance` call (see module docstring)."""
 
 
 @kernel

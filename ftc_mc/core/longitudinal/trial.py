@@ -8,20 +8,20 @@ the doublet / 3211 excitation on reset requests and the re-sent doublet
 and the controller selection (eqs. 45-47) every reconfiguration period.
 
 Lane-last storage (``a[..., L]``) lets the inner loops vectorise across trials
-(see :mod:`ftc_mc.core.batch`).  Random numbers come in from outside
-(:class:`~ftc_mc.core.settings.TrialInputs`) so each trial's stream depends only
+(see :mod:`ftc_mc.core.longitudinal.batch`).  Random numbers come in from outside
+(:class:`~ftc_mc.core.longitudinal.settings.TrialInputs`) so each trial's stream depends only
 on its own seed.
 
 A step ``k -> k+1`` (time ``t = k dt``) is a sequence of stage kernels, each
 described where it is defined:
 
-1. :func:`ftc_mc.core.stages.commands` -- ``u_k = f(U(x_hat_k), s_k, A_k)``;
-2. :func:`ftc_mc.core.plant.truth_step` -- effect, gusts, plant, ``z_{k+1}``;
-3. :func:`ftc_mc.core.stages.filter_update` -- the filter with ``u_k``, ``z_{k+1}``;
-4. :func:`ftc_mc.core.stages.check_validity`;
-5. :func:`ftc_mc.core.stages.handle_resets` -- resets and excitation requests;
-6. :func:`ftc_mc.core.stages.record_step` -- history;
-7. :func:`ftc_mc.core.stages.reconfigure` -- belief and controller, every
+1. :func:`ftc_mc.core.longitudinal.stages.commands` -- ``u_k = f(U(x_hat_k), s_k, A_k)``;
+2. :func:`ftc_mc.core.longitudinal.plant.truth_step` -- effect, gusts, plant, ``z_{k+1}``;
+3. :func:`ftc_mc.core.longitudinal.stages.filter_update` -- the filter with ``u_k``, ``z_{k+1}``;
+4. :func:`ftc_mc.core.longitudinal.stages.check_validity`;
+5. :func:`ftc_mc.core.longitudinal.stages.handle_resets` -- resets and excitation requests;
+6. :func:`ftc_mc.core.longitudinal.stages.record_step` -- history;
+7. :func:`ftc_mc.core.longitudinal.stages.reconfigure` -- belief and controller, every
    ``reconf_every`` steps.
 """
 
@@ -29,12 +29,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..conventions import (N_AUG, N_MODES, N_U, N_X, N_Z, STATUS_AIRSPEED,  # noqa: F401
+from ...conventions import (N_AUG, N_MODES, N_U, N_X, N_Z, STATUS_AIRSPEED,  # noqa: F401
                            STATUS_ALPHA, STATUS_NAMES, STATUS_NONFINITE,
                            STATUS_NOT_PSD, STATUS_OK, C_NOMINAL, RESIDUAL_OUTPUTS)
-from .dryden import N_GUST_STATE
+from ..shared.dryden import N_GUST_STATE
 from .gustfilter import N_WIND
-from .jit import kernel
+from ..jit import kernel
 from .plant import truth_step
 from .settings import LaneState
 from .stages import (check_validity, commands, filter_update, handle_resets,  # noqa: F401
@@ -53,7 +53,7 @@ def advance(path, scheme, flight, inp, rec, st, k0, k1):
     """Advance ``L`` trials from step ``k0`` to ``k1``, writing their records.
 
     Each compile path is its own signature, compiled on its first call
-    (``core/paths.py``).
+    (``core/shared/paths.py``).
 
     Parameters
     ----------
@@ -69,7 +69,7 @@ def advance(path, scheme, flight, inp, rec, st, k0, k1):
         c2) and ``engine`` (EngineTables of c1).
     flight : Flight
         ``timing`` (Timing), ``validity`` (Validity: where a lane stops being
-        recorded, :func:`ftc_mc.core.stages.check_validity`) and ``plant``
+        recorded, :func:`ftc_mc.core.longitudinal.stages.check_validity`) and ``plant``
         (TruthPlant: linear or nonlinear, still air or Dryden gusts).
     inp : TrialInputs
         Per-lane fault schedule, initial estimates and noise.

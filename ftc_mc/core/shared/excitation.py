@@ -6,7 +6,7 @@ first step of the signal); outside their support they are zero.
 
 from __future__ import annotations
 
-from .jit import kernel
+from ..jit import kernel
 
 
 S3211_UNITS = (3, 2, 1, 1)

@@ -6,7 +6,7 @@ therefore compile the dense and extended filters, the GLR test, the nonlinear
 plant and the controller selection it never calls (``docs/performance.md``,
 lesson 10).  Instead, the choices that select large kernels travel as
 *types*: a :class:`Path` of empty marker namedtuples, one per choice, passed
-as the first argument of :func:`ftc_mc.core.trial.advance` and of the stages.
+as the first argument of :func:`ftc_mc.core.longitudinal.trial.advance` and of the stages.
 At each point where the paths part, a dispatcher (a stub with a
 ``numba.extending.overload``) looks at the marker's type while the caller is
 being typed and hands over one implementation; the others are never typed,
@@ -18,12 +18,12 @@ The choices:
 * ``plant``: :data:`LINEAR_PLANT` (eq. 1) or :data:`NONLINEAR_PLANT` (the
   airframe's equations, RK4);
 * ``filter``: :data:`PAPER_FILTER` (the 14-state filter of eqs. 4-11, with
-  the block structure of :mod:`ftc_mc.core.batch`), :data:`DENSE_FILTER`
-  (the general filter with extra states, :mod:`ftc_mc.core.gustfilter`) or
+  the block structure of :mod:`ftc_mc.core.longitudinal.batch`), :data:`DENSE_FILTER`
+  (the general filter with extra states, :mod:`ftc_mc.core.longitudinal.gustfilter`) or
   :data:`EXTENDED_FILTER` (the general filter whose prediction runs the
   airframe's equations);
 * ``test``: :data:`ONE_STEP_TEST` (eqs. 9-11) or :data:`GLR_TEST`
-  (:mod:`ftc_mc.core.glr`);
+  (:mod:`ftc_mc.core.shared.glr`);
 * ``control``: :data:`NOMINAL_CONTROL` (c0 throughout) or
   :data:`RECONFIGURING` (the selection of eqs. 45-47 every period).
 
@@ -40,7 +40,7 @@ from collections import namedtuple
 from numba import types
 from numba.extending import overload
 
-from .jit import OPTIONS
+from ..jit import OPTIONS
 
 _JIT_OPTIONS = {k: v for k, v in OPTIONS.items() if k != "cache"}
 """The kernels' options for the dispatchers' chosen calls (compiled into their
@@ -95,7 +95,7 @@ def describe(path: Path) -> str:
 def _marker_class(path_type, field: str):
     if not (isinstance(path_type, types.BaseNamedTuple)
             and path_type.instance_class is Path):
-        raise TypeError(f"expected a core.paths.Path, got {path_type}")
+        raise TypeError(f"expected a core.shared.paths.Path, got {path_type}")
     t = path_type.types[Path._fields.index(field)]
     return t.instance_class if isinstance(t, types.BaseNamedTuple) else None
 

@@ -1,17 +1,17 @@
 """The truth step of a trial, on every lane: what the simulated aircraft does.
 
-Stage 2 of :func:`ftc_mc.core.trial.advance`.  With the commands ``u_k`` of the
+Stage 2 of :func:`ftc_mc.core.longitudinal.trial.advance`.  With the commands ``u_k`` of the
 step (deviations from trim, ``TrialWork.u``):
 
 1. the fault schedule's entry in force at step ``k`` gives the truth ``b0``,
    ``b1`` per actuator, and the actuators' effect is eq. (2)
    ``e_k = b0 + (1 - b1) u_k - b1 u0`` (:func:`actuator_effect`);
 2. in turbulence the Dryden filter gives the gust ``g_k`` held over the step and
-   advances (:func:`gust_lanes`, :mod:`ftc_mc.core.dryden`);
+   advances (:func:`gust_lanes`, :mod:`ftc_mc.core.shared.dryden`);
 3. linear plant (the filter's model, eq. 1):
    ``x_{k+1} = A x_k + B e_k + B_w g_k + w_k`` and
    ``z_{k+1} = C x_{k+1} + D_w g_{k+1} + v_k`` (:func:`linear_step`);
-   nonlinear X8 (:mod:`ftc_mc.core.nonlinear`, RK4 with ``n_sub`` sub-steps):
+   nonlinear X8 (:mod:`ftc_mc.core.longitudinal.nonlinear`, RK4 with ``n_sub`` sub-steps):
    ``x_{k+1} = RK4(x0 + x_k, u0 + e_k, g_k) - x0 + w_k`` and
    ``z_{k+1} = h(x0 + x_{k+1}, g_{k+1}) - y0 + v_k`` (:func:`nonlinear_step`);
 4. the true air-relative airspeed and angle of attack, for the validity check
@@ -28,12 +28,12 @@ Plain-NumPy twins: ``tests/naive.py::truth_step_ref``, ``sensor_fault_ref``.
 
 from __future__ import annotations
 
-from ..conventions import (N_U, N_X, N_Z, OUT_ALPHA, OUT_VA, SENSOR_BIAS, SENSOR_DRIFT,
-                           SENSOR_NOISE, SENSOR_STUCK)
-from .dryden import N_GUST_OUT, N_GUST_STATE, gust_step
-from .jit import kernel
+from ...conventions import (N_U, N_X, N_Z, OUT_ALPHA, OUT_VA, SENSOR_BIAS, SENSOR_DRIFT,
+                            SENSOR_NOISE, SENSOR_STUCK)
+from ..shared.dryden import N_GUST_OUT, N_GUST_STATE, gust_step
+from ..jit import kernel
 from .nonlinear import outputs_nb, propagate
-from .paths import LINEAR_PLANT, NONLINEAR_PLANT, on_path
+from ..shared.paths import LINEAR_PLANT, NONLINEAR_PLANT, on_path
 
 
 @kernel
@@ -299,7 +299,7 @@ def truth_step(path, model, flight, inp, k, st, work):
     Parameters
     ----------
     path : Path
-        The compile path (``core/paths.py``): its ``plant``.
+        The compile path (``core/shared/paths.py``): its ``plant``.
     model : FilterModel
         The linear model (``A``, ``B``, ``C``) and the trim commands ``u0``.
     flight : Flight

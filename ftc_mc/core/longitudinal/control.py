@@ -19,7 +19,7 @@ chosen.
 
 The trial loop selects for all its lanes at once
 (:func:`select_controllers_lanes`): each controller's horizon is predicted for
-every lane with the lane-interleaved filter kernels of :mod:`ftc_mc.core.batch`,
+every lane with the lane-interleaved filter kernels of :mod:`ftc_mc.core.longitudinal.batch`,
 then belief and objective follow per lane.  Per lane this is
 :func:`select_controller` bit for bit (``tests/test_stages.py``); measured on a
 chunk of 128 lanes of ``configs/paper_tables.yaml``, one core: 2.9 ms per
@@ -37,14 +37,14 @@ import math
 
 import numpy as np
 
-from .belief import belief_update
-from .excitation import saturate
-from .interp import engine_controller
-from .jit import kernel
+from ..shared.belief import belief_update
+from ..shared.excitation import saturate
+from ..shared.interp import engine_controller
+from ..jit import kernel
 from .batch import predict_lanes, project_lanes, update_lanes
 from .kalman import predict, project, update
 
-from ..conventions import (C_ELEVON, C_ENGINE, C_NOMINAL, I_B0_ELEVONS,  # noqa: F401
+from ...conventions import (C_ELEVON, C_ENGINE, C_NOMINAL, I_B0_ELEVONS,  # noqa: F401
                            I_B0_THRUST, I_B1_LEFT, I_B1_RIGHT, I_B1_THRUST, INPUT_NAMES,
                            N_AUG, N_CONTROLLERS, N_FAULT, N_MODES, N_U, N_X)
 
@@ -308,9 +308,9 @@ def _predicted_cost_lanes(c, xs, Ps, fm, rc, eng, K, lo, hi, sw):
 
     Lane ``l`` goes through the same floating-point operations, in the same
     order, as :func:`_predicted_cost` on ``xs[:, l]``, ``Ps[:, :, l]``: the
-    lane kernels of :mod:`ftc_mc.core.batch` are bit-identical per lane to
-    :func:`~ftc_mc.core.kalman.predict`, :func:`~ftc_mc.core.kalman.update` and
-    :func:`~ftc_mc.core.kalman.project`.  The discounted cost of each lane is
+    lane kernels of :mod:`ftc_mc.core.longitudinal.batch` are bit-identical per lane to
+    :func:`~ftc_mc.core.longitudinal.kalman.predict`, :func:`~ftc_mc.core.longitudinal.kalman.update` and
+    :func:`~ftc_mc.core.longitudinal.kalman.project`.  The discounted cost of each lane is
     written to ``sw.cost``.
     """
     L = xs.shape[1]

@@ -1,8 +1,8 @@
 """Many independent augmented filters at once, lane-interleaved (paper eqs. 5-11).
 
 Each kernel here is the lane-wise twin of a single-trajectory kernel of
-:mod:`ftc_mc.core.kalman`, :mod:`ftc_mc.core.signature` and
-:mod:`ftc_mc.core.step`: lane ``l`` of every array is one trajectory, stored with
+:mod:`ftc_mc.core.longitudinal.kalman`, :mod:`ftc_mc.core.longitudinal.signature` and
+:mod:`ftc_mc.core.longitudinal.step`: lane ``l`` of every array is one trajectory, stored with
 the lane index *last* (``xa[n, L]``, ``P[n, n, L]``, ``u[3, L]``, ``z[12, L]``;
 ``n = 14`` for the paper's filter, taken from the arrays' shapes)
 so that the innermost loops run over lanes and compile to 512-bit vector code
@@ -11,7 +11,7 @@ so that the innermost loops run over lanes and compile to 512-bit vector code
 
 Every lane is computed with the same floating-point operations, in the same
 order, as the single-trajectory kernel, so a lane agrees with
-:func:`ftc_mc.core.step.filter_step` bit for bit (fastmath stays off).  What
+:func:`ftc_mc.core.longitudinal.step.filter_step` bit for bit (fastmath stays off).  What
 differs is only the order in which *independent* results are produced:
 
 * lane-invariant coefficients (rows of ``A``, ``C``) are copied into tuples
@@ -46,11 +46,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from .jit import kernel
+from ..jit import kernel
 from .signature import NO_RESET, in_block, signature
 
-from ..conventions import N_AUG, N_B0, N_B1, N_U, N_X, RESIDUAL_OUTPUTS
-from ..conventions import N_FAULT as N_F
+from ...conventions import N_AUG, N_B0, N_B1, N_U, N_X, RESIDUAL_OUTPUTS
+from ...conventions import N_FAULT as N_F
 
 # Lane-invariant rows are read into tuples of a fixed length (_row_x, _row_b0,
 # _row_b, _neg_row_b): a tuple's length must be written out, so these helpers are the
@@ -145,7 +145,7 @@ def _predict(xa, P, Pn, u, fm, phi, T, l0, l1):
 
     Reads the full symmetric ``P`` and writes the full symmetric ``Pn``; ``xa``
     is advanced in place.  Operation order per lane as in
-    :func:`ftc_mc.core.kalman.predict`.
+    :func:`ftc_mc.core.longitudinal.kalman.predict`.
     """
     n = P.shape[0]
     u00 = fm.u0[0]
@@ -256,7 +256,7 @@ def _predict(xa, P, Pn, u, fm, phi, T, l0, l1):
 
 @kernel(inline="always")
 def predict_lanes(xa, P, u, fm, phi, T):
-    """Time update of every lane (eq. 5), as :func:`ftc_mc.core.kalman.predict`.
+    """Time update of every lane (eq. 5), as :func:`ftc_mc.core.longitudinal.kalman.predict`.
 
     ``X <- A_aug(u) X + B_aug u`` and ``P <- A_aug(u) P A_aug(u)^T + Q`` with
     ``A_aug(u) = [[A, Phi(u)], [0, I]]``, ``Phi(u) = [B_b0, B diag(-u - u0)]``;
@@ -324,7 +324,7 @@ def _normalised_lanes(xa, P, z, fm, out, signed):
 def residuals_lanes(xa, P, z, fm, res):
     """Normalised residuals ``r_q, r_nx, r_nz`` of every lane (eqs. 9-11).
 
-    As :func:`ftc_mc.core.kalman.residuals`: ``r_i = mu_i^2 / (C_i P C_i^T + R_ii)``
+    As :func:`ftc_mc.core.longitudinal.kalman.residuals`: ``r_i = mu_i^2 / (C_i P C_i^T + R_ii)``
     on the prediction.
 
     Parameters
@@ -347,7 +347,7 @@ def residuals_lanes(xa, P, z, fm, res):
 def innovations_lanes(xa, P, z, fm, innov):
     """Signed normalised innovations ``mu_i / sqrt(S_ii)`` of every lane, on the
     same prediction as :func:`residuals_lanes` (``r_i = innov_i^2`` up to
-    rounding); the GLR test reads them (:mod:`ftc_mc.core.glr`).
+    rounding); the GLR test reads them (:mod:`ftc_mc.core.shared.glr`).
 
     Apart from :func:`residuals_lanes` because the paper's one-step test does
     not need them: written in the same lane loop, they cost 8-15 % of
@@ -366,7 +366,7 @@ def innovations_lanes(xa, P, z, fm, innov):
 # ------------------------------------------------------------------ signature
 @kernel(inline="always")
 def signature_lanes(res, det, block):
-    """Table 1 on every lane, as :func:`ftc_mc.core.signature.signature`.
+    """Table 1 on every lane, as :func:`ftc_mc.core.longitudinal.signature.signature`.
 
     Parameters
     ----------
@@ -391,7 +391,7 @@ def signature_lanes(res, det, block):
 def reset_lanes(P, block, reset_var):
     """Reset the suspected fault block of each lane (section 3.2.2).
 
-    As :func:`ftc_mc.core.signature.reset_covariance` per lane: the rows and
+    As :func:`ftc_mc.core.longitudinal.signature.reset_covariance` per lane: the rows and
     columns of the block's fault parameters are zeroed and their variances set
     to ``reset_var``.
 
@@ -541,7 +541,7 @@ def _update(xa, P, z, fm, h):
 def update_lanes(xa, P, z, fm, h):
     """Measurement update of every lane with its 12 outputs (eq. 5, R diagonal).
 
-    As :func:`ftc_mc.core.kalman.update`: one scalar update per output,
+    As :func:`ftc_mc.core.longitudinal.kalman.update`: one scalar update per output,
     ``h = P c^T``, ``s = c h + R_rr``, ``X += h (z_r - c X) / s``,
     ``P -= (h / s) h^T``; a unit row of ``C`` (``fm.c_ident[r] >= 0``) reads a
     column of ``P`` instead of multiplying.  ``P`` stays exactly symmetric.
@@ -567,7 +567,7 @@ def update_lanes(xa, P, z, fm, h):
 def project_lanes(xa, fm):
     """Active-set projection of every lane's fault parameters (eqs. 6-8).
 
-    As :func:`ftc_mc.core.kalman.project`: each violated bound of
+    As :func:`ftc_mc.core.longitudinal.kalman.project`: each violated bound of
     ``lo <= b <= hi`` becomes an equality, which sets that parameter to its
     bound; ``P`` is not projected (semi-closed loop, Fig. 2).
 
@@ -652,13 +652,13 @@ def filter_correct_lanes(xa, P, u, z, fm, det, phi, T, work, block):
 @kernel
 def filter_step_lanes(xa, P, u, z, fm, det, phi, T, work, res, block):
     """Advance every lane's filter by one sampling period, as
-    :func:`ftc_mc.core.step.filter_step`.
+    :func:`ftc_mc.core.longitudinal.step.filter_step`.
 
     Per lane: predict (eq. 5); residuals (eqs. 9-11); Table 1 signature; on a
     reset, reset the block of ``P_{k|k}`` (section 3.2.2) and predict again from
     it; measurement update; projection of the fault parameters (eqs. 6-8).
     The halves :func:`filter_predict_lanes` and :func:`filter_correct_lanes`
-    let a windowed test decide the block in between (``core/stages.py``).
+    let a windowed test decide the block in between (``core/longitudinal/stages.py``).
 
     ``P_{k|k}`` stays in ``P`` while the prediction goes to ``work[:n]``, so
     the lanes that reset are re-predicted without a copy of ``P``: up to

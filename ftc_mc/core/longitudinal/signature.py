@@ -12,9 +12,9 @@ rule sends to the thrust block; see ``docs/paper-map.md``).
 
 from __future__ import annotations
 
-from ..conventions import (ELEVON_BLOCK, N_FAULT, N_X, NO_RESET,  # noqa: F401
+from ...conventions import (ELEVON_BLOCK, N_FAULT, N_X, NO_RESET,  # noqa: F401
                            RESET_ELEVONS, RESET_THRUST, THRUST_BLOCK)
-from .jit import kernel
+from ..jit import kernel
 
 
 @kernel
@@ -70,7 +70,7 @@ def signature(r_q, r_nx, r_nz, t_q, t_nx, swapped):
 @kernel
 def reset_covariance(P, block, reset_var):
     """Reset one fault block of a covariance (section 3.2.2; the filter step
-    applies it to ``P_{k|k}``, see :mod:`ftc_mc.core.step`).
+    applies it to ``P_{k|k}``, see :mod:`ftc_mc.core.longitudinal.step`).
 
     The rows and columns of the block's fault parameters are zeroed and their
     variances set to ``reset_var``: thrust ``((u_max - u_min)/t_nx)^2`` for b0 and

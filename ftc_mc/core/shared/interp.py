@@ -31,7 +31,7 @@ from collections import namedtuple
 
 import numpy as np
 
-from .jit import kernel
+from ..jit import kernel
 
 EngineTables = namedtuple("EngineTables", [
     "K",        # (nb0, nb1, 3, 9) gain of u = -K x - k at each grid node (eq. 42)

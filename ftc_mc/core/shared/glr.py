@@ -23,7 +23,7 @@ Plain-NumPy twin: ``tests/naive.py::glr_ref``.
 
 from __future__ import annotations
 
-from .jit import kernel
+from ..jit import kernel
 
 
 @kernel(inline="always")

@@ -17,8 +17,8 @@ from __future__ import annotations
 
 import math
 
-from ..conventions import N_MODES  # noqa: F401
-from .jit import kernel
+from ...conventions import N_MODES  # noqa: F401
+from ..jit import kernel
 
 LOG_TINY = -745.0  # log of the smallest subnormal float64
 

@@ -1,9 +1,9 @@
 """The gust-aware augmented filter on every lane (issue 13; DESIGN.md section 9).
 
-The paper's filter (:mod:`ftc_mc.core.batch`) models turbulence as white process
+The paper's filter (:mod:`ftc_mc.core.longitudinal.batch`) models turbulence as white process
 noise, which it is not: the Dryden gusts are coloured, and in moderate
 turbulence the normalised residuals average 190 / 19 / 1220 instead of 1.
-This filter carries the shaping filter's states ``g`` (``core/dryden.py``)
+This filter carries the shaping filter's states ``g`` (``core/shared/dryden.py``)
 after the fault parameters, ``X = [x (9), b (5), g (ng)]``:
 
     x_{k+1} = A x_k + B u_k + Phi(u_k) b_k + G g_k + w_k      G  = B_w C_d
@@ -32,12 +32,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..conventions import N_AUG, N_B0, N_U, N_X, N_Z, RESIDUAL_OUTPUTS
-from ..conventions import N_FAULT as N_F
+from ...conventions import N_AUG, N_B0, N_U, N_X, N_Z, RESIDUAL_OUTPUTS
+from ...conventions import N_FAULT as N_F
 from .batch import UPDATE_ROWS, project_lanes, reset_lanes
-from .jit import kernel
+from ..jit import kernel
 from .nonlinear import outputs_nb, propagate
-from .paths import EXTENDED_FILTER, on_path
+from ..shared.paths import EXTENDED_FILTER, on_path
 
 N_WIND = 3
 """Gust outputs ``u_g, w_g, q_g`` of the gust states (``FilterModel.Cg``)."""
@@ -186,7 +186,7 @@ def _nl_state(xa, u, fm, xn, tw):
     """The extended filter's state prediction: ``x_{k+1|k} = f(x0 + x, u0 + e, C_d g) - x0``.
 
     ``f`` is the nonlinear airframe over one period (RK4, ``fm.n_sub`` steps,
-    :func:`ftc_mc.core.nonlinear.propagate`), driven by the actuators' effect
+    :func:`ftc_mc.core.longitudinal.nonlinear.propagate`), driven by the actuators' effect
     under the estimated faults (eq. 2 with the estimated ``b``:
     ``e = u + [b0_T, b0_e / 2, b0_e / 2] - b1 (u + u0)``, the terms ``B_b0 b0``
     and ``Phi(u) b1`` of eq. 4) and the estimated gust ``C_d g`` held over the
@@ -224,7 +224,7 @@ def _nl_outputs(xa, fm, hpred, xp, tw):
 
 
 # ------------------------------------------------------------------ path dispatch
-# The airframe's equations run only on the extended filter's path (core/paths.py):
+# The airframe's equations run only on the extended filter's path (core/shared/paths.py):
 # on the dense path these calls compile to nothing, and the airframe is never
 # compiled.
 
@@ -576,7 +576,7 @@ def reset_extra_lanes(P, block, reset_g):
     actuator block whose residuals it shares: for each extra state ``g`` with
     ``reset_g[block, g] > 0`` the rows and columns of ``N_AUG + g`` are zeroed
     and its variance set to ``reset_g[block, g]``, as section 3.2.2 does for the
-    fault parameters (:func:`ftc_mc.core.batch.reset_lanes`).
+    fault parameters (:func:`ftc_mc.core.longitudinal.batch.reset_lanes`).
 
     Parameters
     ----------

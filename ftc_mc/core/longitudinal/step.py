@@ -24,7 +24,7 @@ printed reset variances and the zeroed correlations are kept.
 
 from __future__ import annotations
 
-from .jit import kernel
+from ..jit import kernel
 from .kalman import predict, project, residuals, update
 from .signature import NO_RESET, reset_covariance, signature
 

@@ -30,7 +30,7 @@ float64 vector (:data:`N_PARAM` entries in the order of the ``P_*`` indices,
 built by :func:`ftc_mc.model.dynamics.pack_parameters`).
 
 Wind: ``wind = [u_g, w_g, q_g]``, body-axis gust velocities [m/s] and gust pitch
-rate [rad/s] (for example from :mod:`ftc_mc.core.dryden`).  The aerodynamic and
+rate [rad/s] (for example from :mod:`ftc_mc.core.shared.dryden`).  The aerodynamic and
 propeller forces see the air-relative ``u - u_g``, ``w - w_g`` and ``q - q_g``
 (airspeed, angle of attack, ``qhat``); the kinematics (Coriolis terms, position
 and attitude rates) use the inertial ``u``, ``w``, ``q``.  The wind is frozen in
@@ -57,10 +57,10 @@ import math
 
 import numpy as np
 
-from ..conventions import N_X as N_STATE
-from ..conventions import N_Z as N_OUTPUT
-from ..conventions import OUT_ALPHA, OUT_NX, OUT_NZ, OUT_VA, OUTPUT_NAMES
-from .jit import kernel
+from ...conventions import N_X as N_STATE
+from ...conventions import N_Z as N_OUTPUT
+from ...conventions import OUT_ALPHA, OUT_NX, OUT_NZ, OUT_VA, OUTPUT_NAMES
+from ..jit import kernel
 
 OUT_GAMMA = OUTPUT_NAMES.index("gamma")
 OUT_CAS = OUTPUT_NAMES.index("CAS")

@@ -20,9 +20,9 @@ All arrays are float64; work arrays come from the caller so no kernel allocates.
 
 from __future__ import annotations
 
-from ..conventions import N_AUG, N_B0, N_B1, N_U, N_X, RESIDUAL_OUTPUTS
-from ..conventions import N_FAULT as N_F
-from .jit import kernel
+from ...conventions import N_AUG, N_B0, N_B1, N_U, N_X, RESIDUAL_OUTPUTS
+from ...conventions import N_FAULT as N_F
+from ..jit import kernel
 
 
 @kernel
@@ -35,7 +35,7 @@ def _paper_dim(xa):
     of another dimension gets a clear error here rather than wrong numbers.
     """
     if xa.shape[0] != N_AUG:
-        raise ValueError("core.kalman: the augmented state must have N_AUG entries")
+        raise ValueError("core.longitudinal.kalman: the augmented state must have N_AUG entries")
     return N_AUG
 
 

@@ -20,11 +20,11 @@ FilterModel = namedtuple("FilterModel", [
     "lo",       # (5,)  lower bounds of b0, b1 (eq. 6)
     "hi",       # (5,)  upper bounds of b0, b1 (eq. 6)
     "G",        # (9, ng)  gust-aware filter: gust states -> plant states (B_w C_d)
-    "Ad",       # (ng, ng) gust-state transition (Dryden, core/dryden.py)
+    "Ad",       # (ng, ng) gust-state transition (Dryden, core/shared/dryden.py)
     "Dg",       # (12, ng) gust states -> outputs (D_w C_d)
     "Qg",       # (ng, ng) gust-state process noise (B_d B_d^T)
     "nl",       # 0: linear prediction (eq. 5); 1: the nonlinear airframe predicts the
-                #    state and the outputs (extended filter, core/gustfilter.py)
+                #    state and the outputs (extended filter, core/longitudinal/gustfilter.py)
     "p",        # (25,) packed airframe parameters (nonlinear prediction)
     "x0",       # (9,)  trim state, absolute
     "y0",       # (12,) trim outputs, absolute
@@ -45,9 +45,9 @@ FilterModel = namedtuple("FilterModel", [
 """The augmented Kalman filter's model (paper eqs. 4-6).
 
 The estimate is ``[x (9), b (5), g (ng)]``: the paper's filter has ``ng = 0``
-(the gust arrays are empty, :mod:`ftc_mc.core.batch`); a gust-aware filter
+(the gust arrays are empty, :mod:`ftc_mc.core.longitudinal.batch`); a gust-aware filter
 carries the ``ng = 4`` Dryden states of the longitudinal gusts
-(:mod:`ftc_mc.core.gustfilter`, issue 13); a sensor-aware design appends output
+(:mod:`ftc_mc.core.longitudinal.gustfilter`, issue 13); a sensor-aware design appends output
 biases after them (``Dz``, ``reset_g``; issue 14)."""
 
 Detection = namedtuple("Detection", [
@@ -55,7 +55,7 @@ Detection = namedtuple("Detection", [
     "t_nx",       # threshold on r_nx (Table 1), > 0
     "swapped",    # 0: Table 1 as printed; 1: third clause's r_nz test swapped
     "reset_var",  # (5,) variance of each fault parameter after its block's reset
-    "test",       # conventions.TEST_ONE_STEP (eqs. 9-11) or TEST_GLR (core/glr.py)
+    "test",       # conventions.TEST_ONE_STEP (eqs. 9-11) or TEST_GLR (core/shared/glr.py)
     "window",     # GLR window [steps] (1 with the one-step test)
     "min_window", # shortest change the GLR tests [steps] (1: any; <= window)
     "settle",     # steps after a reset during which the other block is not reset (0: none)
@@ -106,7 +106,7 @@ TrialInputs = namedtuple("TrialInputs", [
     "w",          # (n_steps, 9, L) process noise, already scaled
     "v",          # (n_steps, 12, L) measurement noise, already scaled
     "eta",        # (n_steps, 4, L) standard normal gust draws, or (0, 4, L) without
-                  #           turbulence (core/dryden.py)
+                  #           turbulence (core/shared/dryden.py)
     "g0",         # (4, L) initial gust filter state (stationary draw, or zeros)
     "sensor_out",   # (L,) int64 output index of the lane's sensor fault, or -1 (none)
     "sensor_kind",  # (L,) int64 conventions.SENSOR_* kind (bias, stuck, drift, noise)
@@ -151,7 +151,7 @@ Validity = namedtuple("Validity", [
     "alpha_max",   # highest [rad]
     "psd_every",   # steps between full positive-semi-definiteness checks of P
 ])
-"""Where a trial stops as numerically or physically invalid (see core/trial.py)."""
+"""Where a trial stops as numerically or physically invalid (see core/longitudinal/trial.py)."""
 
 Reconfig = namedtuple("Reconfig", [
     "kind",      # 0: nominal controller c0 only; 1: reconfiguring (eqs. 45-47)
@@ -171,7 +171,7 @@ Scheme = namedtuple("Scheme", [
     "controller",  # Controller: nominal gain and command limits (eqs. 15-19)
     "excitation",  # Excitation: doublet and 3211 on resets (section 4.1.1)
     "reconfig",    # Reconfig: controller selection (eqs. 45-47)
-    "engine",      # EngineTables: Theorem 4.1 tables of c1 (core/interp.py)
+    "engine",      # EngineTables: Theorem 4.1 tables of c1 (core/shared/interp.py)
 ])
 """The fault-tolerant control scheme under test: estimator, detector, belief,
 controllers and their selection.  A threshold sweep varies only ``detection``."""
@@ -208,11 +208,11 @@ LaneState = namedtuple("LaneState", [
     "JC",       # (12, 9, L) d h / d x of the outputs
     "JHW",      # (12, 3, L) d h / d wind
 ])
-"""Everything a trial carries from one step to the next (core/trial.py)."""
+"""Everything a trial carries from one step to the next (core/longitudinal/trial.py)."""
 
 TruthPlant = namedtuple("TruthPlant", [
     "kind",   # 0: the linear plant of eq. (1) (the filter's model); 1: the nonlinear
-              #    X8 of core/nonlinear.py integrated by RK4
+              #    X8 of core/longitudinal/nonlinear.py integrated by RK4
     "n_sub",  # RK4 sub-steps per control period (nonlinear plant)
     "dt",     # control period [s]
     "p",      # (25,) packed airframe parameters (model/dynamics.pack_parameters)

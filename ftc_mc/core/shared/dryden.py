@@ -15,7 +15,7 @@ done on local scalars, without allocation.
 
 from __future__ import annotations
 
-from .jit import kernel
+from ..jit import kernel
 
 N_GUST_STATE = 4
 N_GUST_NOISE = 4
