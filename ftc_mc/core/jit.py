@@ -26,11 +26,14 @@ CACHE = os.environ.get("FTC_MC_NUMBA_CACHE", "1") != "0"
 
 def source_digest(core: Path | None = None) -> str:
     """SHA-256 (16 hex digits) of the source of every module kernels compile from:
-    ``core/*.py`` and ``conventions.py`` beside it (``core``: this package's)."""
+    ``core/**/*.py`` (subpackages such as ``core/sixdof/`` included, each file by
+    its path relative to ``core``) and ``conventions.py`` beside it (``core``:
+    this package's)."""
     core = Path(__file__).resolve().parent if core is None else Path(core)
     h = hashlib.sha256()
-    for path in sorted(core.glob("*.py")) + [core.parent / "conventions.py"]:
-        h.update(path.name.encode())
+    files = [(p.relative_to(core).as_posix(), p) for p in sorted(core.rglob("*.py"))]
+    for name, path in files + [("conventions.py", core.parent / "conventions.py")]:
+        h.update(name.encode())
         h.update(path.read_bytes())
     return h.hexdigest()[:16]
 
