@@ -328,3 +328,68 @@ def test_longitudinal_path_does_not_import_the_sixdof_kernels():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          check=True)
     assert out.stdout.strip() == "[]", out.stdout + out.stderr
+
+
+# ------------------------------------------------------------ lateral gusts
+
+def test_lateral_dryden_variances_are_the_spectra_integrals():
+    import scipy.integrate
+
+    from ftc_mc.model.turbulence import (dryden_lateral_model, dryden_model, psd_p,
+                                         psd_r, psd_v)
+
+    m = dryden_lateral_model("moderate", V=20.0, altitude_m=100.0, dt=0.1, span=2.1)
+    lon = dryden_model("moderate", V=20.0, altitude_m=100.0, dt=0.1, span=2.1)
+    # MIL-F-8785C at low altitude: sigma_v = sigma_u, L_v = L_u
+    assert m.sigma_v == lon.sigma_u and m.L_v == lon.L_u
+    var = np.diag(m.Cc @ m.P0 @ m.Cc.T)
+    for i, psd in enumerate((psd_v, psd_p, psd_r)):
+        integral = scipy.integrate.quad(lambda w: psd(w, m), 0, np.inf, limit=500)[0]
+        assert var[i] == pytest.approx(integral, rel=1e-6), i
+    assert var[0] == pytest.approx(m.sigma_v ** 2, rel=1e-9)
+    assert not dryden_lateral_model("none").Bd.any()
+
+
+def test_lateral_gusts_run_through_the_dryden_kernel():
+    # the lateral model has the longitudinal one's shape, so gust_step runs it;
+    # a long record has the model's variances, and r_g lags dv_g/dt / V
+    from ftc_mc.core.dryden import gust_record
+    from ftc_mc.model.turbulence import dryden_lateral_model
+
+    m = dryden_lateral_model("moderate", dt=0.1)
+    rng = np.random.default_rng(7)
+    n = 200_000
+    state = m.P0_chol @ rng.standard_normal(4)
+    rec = np.empty((n, 3))
+    gust_record(state, rng.standard_normal((n, 4)), m.Ad, m.Bd, m.Cd, rec)
+    np.testing.assert_allclose(rec.var(axis=0), [m.sigma_v ** 2, m.sigma_p ** 2,
+                                                 m.sigma_r ** 2], rtol=0.06)
+    dv = np.diff(rec[:, 0]) / m.dt / m.V
+    assert np.corrcoef(dv, rec[1:, 2])[0, 1] > 0.5  # r_g = +dv_g/dx, lagged
+
+
+def test_sixdof_wind_places_components_by_name():
+    from ftc_mc.model.sixdof import sixdof_wind
+
+    w = sixdof_wind(np.array([[1.0, 2.0, 3.0]]), np.array([[4.0, 5.0, 6.0]]))
+    named = dict(zip(LAYOUT.wind, w[0]))
+    assert named == {"u_g": 1.0, "w_g": 2.0, "q_g": 3.0, "v_g": 4.0, "p_g": 5.0,
+                     "r_g": 6.0}
+
+
+def test_linear_and_nonlinear_agree_for_small_gusts(plant):
+    # the discrete gust matrices Bw, Dw against the nonlinear plant in a small,
+    # constant gust of every component over 1 s
+    tp = plant.trim
+    wind = 1e-3 * np.array([1.0, 1.0, 1.0, 0.1, 0.1, 0.1])
+    x = tp.x0.copy()
+    work = np.zeros((kernels.N_WORK, N_STATE))
+    dxl = np.zeros(N_STATE)
+    for _ in range(10):
+        kernels.propagate(x, tp.u0, tp.params, wind, 0.1, 10, work)
+        dxl = plant.A @ dxl + plant.Bw @ wind
+    # (the rest is second order in the gust: 1e-4 of the response here)
+    np.testing.assert_allclose(x - tp.x0, dxl, atol=1e-3 * np.max(np.abs(dxl)))
+    y = outputs(tp.x0, tp.params, wind)
+    np.testing.assert_allclose(y - tp.y0, plant.Dw @ wind, atol=1e-7)
+    assert plant.Bw.shape == (N_STATE, N_WIND) and plant.Dw.shape == (N_OUTPUT, N_WIND)

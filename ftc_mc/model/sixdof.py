@@ -19,7 +19,10 @@ trim balances with a small aileron, sideslip and bank (``docs/airframes.md``).
 Linearisation (:func:`build_sixdof_plant`): scipy's adaptive finite differences
 of the kernels at the trim (``ftc_mc.model.linear.jacobian``), then the
 zero-order hold of ``ftc_mc.model.linear.zoh``: 12 rigid-body states plus the
-throttle and each elevon (15), 3 commands, 19 outputs.
+throttle and each elevon (15), 3 commands, 19 outputs, and the gust input
+matrices of the six wind components (:func:`gust_jacobians`).  The wind of
+either plant comes from the longitudinal and lateral Dryden models
+(``ftc_mc.model.turbulence``), placed by :func:`sixdof_wind`.
 """
 
 from __future__ import annotations
@@ -270,6 +273,10 @@ class SixDofPlant:
     u_lower, u_upper : ndarray, shape (3,)
         Absolute command limits.
     airframe : Airframe
+    Bw, Dw : ndarray, shapes (15, 6) and (19, 6)
+        Gust input matrices: the wind ``[u_g, v_g, w_g, p_g, q_g, r_g]`` held
+        over ``dt`` (zero-order hold of the continuous Jacobian) and its
+        feed-through into the outputs (:func:`gust_jacobians`).
     """
 
     A: np.ndarray
@@ -283,6 +290,8 @@ class SixDofPlant:
     u_lower: np.ndarray
     u_upper: np.ndarray
     airframe: Airframe
+    Bw: np.ndarray | None = None
+    Dw: np.ndarray | None = None
 
     @property
     def u0(self) -> np.ndarray:
@@ -301,6 +310,44 @@ def linearise6(tp: SixDofTrim):
     Cc = jacobian(lambda x: outputs(x, p), tp.x0)
     Cc[:N_RIGID] = np.eye(N_OUTPUT, N_STATE)[:N_RIGID]
     return Ac, Bc, Cc
+
+
+def gust_jacobians(tp: SixDofTrim):
+    """Continuous gust Jacobians at a trim: ``Bwc = df/dwind`` (15, 6) and
+    ``Dw = dh/dwind`` (19, 6), the wind ``[u_g, v_g, w_g, p_g, q_g, r_g]``
+    (body axes) entering air-relative (:mod:`ftc_mc.core.sixdof.plant`)."""
+    p = tp.params
+    w0 = np.zeros(N_WIND)
+    Bwc = jacobian(lambda w: derivatives(tp.x0, tp.u0, p, w), w0)
+    Dw = jacobian(lambda w: outputs(tp.x0, p, w), w0)
+    return Bwc, Dw
+
+
+def sixdof_wind(longitudinal, lateral) -> np.ndarray:
+    """The 6-DOF wind from the two Dryden records, placed by name.
+
+    Parameters
+    ----------
+    longitudinal : ndarray, shape (n, 3)
+        ``u_g, w_g, q_g`` (:func:`ftc_mc.model.turbulence.dryden_model` run by
+        :func:`ftc_mc.core.dryden.gust_record`).
+    lateral : ndarray, shape (n, 3)
+        ``v_g, p_g, r_g`` (:func:`ftc_mc.model.turbulence.dryden_lateral_model`,
+        the same kernel).
+
+    Returns
+    -------
+    ndarray, shape (n, 6)
+        In the order of ``layout.LAYOUT.wind``.
+    """
+    lon = np.asarray(longitudinal, dtype=float)
+    lat = np.asarray(lateral, dtype=float)
+    out = np.zeros((lon.shape[0], N_WIND))
+    for j, name in enumerate(("u_g", "w_g", "q_g")):
+        out[:, LAYOUT.wind.index(name)] = lon[:, j]
+    for j, name in enumerate(("v_g", "p_g", "r_g")):
+        out[:, LAYOUT.wind.index(name)] = lat[:, j]
+    return out
 
 
 def build_sixdof_plant(airframe: Airframe, V0: float = 20.0, gamma0_deg: float = -3.0,
@@ -334,11 +381,13 @@ def build_sixdof_plant(airframe: Airframe, V0: float = 20.0, gamma0_deg: float =
     tp = trim6(airframe, V0, gamma0_deg, where)
     Ac, Bc, Cc = linearise6(tp)
     A, B = zoh(Ac, Bc, dt)
+    Bwc, Dw = gust_jacobians(tp)
+    _, Bw = zoh(Ac, Bwc, dt)
     return SixDofPlant(A=np.array(A), B=np.array(B), C=Cc.copy(), Ac=Ac, Bc=Bc, Cc=Cc,
                        dt=float(dt), trim=tp,
                        u_lower=np.array(airframe.command_lower, dtype=float),
                        u_upper=np.array(airframe.command_upper, dtype=float),
-                       airframe=airframe)
+                       airframe=airframe, Bw=np.array(Bw), Dw=Dw)
 
 
 MODE_NAMES = ("short_period", "phugoid", "roll", "dutch_roll", "spiral")
@@ -506,6 +555,9 @@ SIXDOF_MODEL_VARIABLES: dict[str, tuple[tuple[int, ...], str]] = {
     "alpha": ((), "trim angle of attack [rad]"),
     "beta": ((), "trim sideslip [rad]"),
     "phi": ((), "trim bank angle [rad]"),
+    "Bw": ((N_STATE, N_WIND), "discrete gust input matrix; gust [u_g, v_g, w_g "
+                              "[m/s], p_g, q_g, r_g [rad/s]] held over dt"),
+    "Dw": ((N_OUTPUT, N_WIND), "gust feed-through into the 19 outputs"),
     "state_names": ((N_STATE,), "names of the states (text)"),
     "command_names": ((N_COMMAND,), "names of the commands (text)"),
     "output_names": ((N_OUTPUT,), "names of the outputs (text)"),
@@ -533,7 +585,8 @@ def save_sixdof_npz(plant: SixDofPlant, f, source: str = "") -> None:
         Where the airframe's numbers come from (a preset's source or a path).
     """
     tp = plant.trim
-    data = dict(dof=np.int64(6), A=plant.A, B=plant.B, C=plant.C, x0=tp.x0, u0=tp.u0,
+    data = dict(dof=np.int64(6), A=plant.A, B=plant.B, C=plant.C, Bw=plant.Bw,
+                Dw=plant.Dw, x0=tp.x0, u0=tp.u0,
                 y0=tp.y0, u_lower=plant.u_lower, u_upper=plant.u_upper,
                 dt=np.float64(plant.dt), V0=np.float64(tp.V0),
                 gamma0=np.float64(tp.gamma0), alpha=np.float64(tp.alpha),
@@ -613,11 +666,14 @@ def load_sixdof_model(path) -> tuple:
                         C=np.array(raw["C"], dtype=float), Ac=None, Bc=None, Cc=None,
                         dt=float(raw["dt"]), trim=tp,
                         u_lower=np.array(raw["u_lower"], dtype=float),
-                        u_upper=np.array(raw["u_upper"], dtype=float), airframe=airframe)
+                        u_upper=np.array(raw["u_upper"], dtype=float), airframe=airframe,
+                        Bw=np.array(raw["Bw"], dtype=float),
+                        Dw=np.array(raw["Dw"], dtype=float))
     return plant, str(raw["source"])
 
 
 __all__ = ["require_lateral", "pack_parameters", "derivatives", "outputs", "elevons",
            "SixDofTrim", "trim6", "SixDofPlant", "linearise6", "build_sixdof_plant",
            "MODE_NAMES", "named_modes", "sixdof_summary", "format_sixdof_summary",
-           "PARAM", "SIXDOF_MODEL_VARIABLES", "save_sixdof_npz", "load_sixdof_model"]
+           "PARAM", "SIXDOF_MODEL_VARIABLES", "save_sixdof_npz", "load_sixdof_model",
+           "gust_jacobians", "sixdof_wind"]
