@@ -76,8 +76,8 @@ class Preset:
     note : str
         One line: what distinguishes this preset.
     unused : str
-        Entries present in the source file but not used by the longitudinal
-        model without stall.
+        Entries present in the source file but used by neither the
+        longitudinal nor the 6-DOF model.
     """
 
     name: str

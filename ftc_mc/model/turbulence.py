@@ -1,7 +1,9 @@
-"""MIL-F-8785C longitudinal Dryden turbulence, discretised exactly.
+"""MIL-F-8785C Dryden turbulence, discretised exactly.
 
-Builds the matrices of the discrete gust model run by
-:func:`ftc_mc.core.dryden.gust_step`.
+Builds the matrices of the discrete gust models run by
+:func:`ftc_mc.core.dryden.gust_step`: the longitudinal ``u_g, w_g, q_g``
+(:func:`dryden_model`, below) and, for the 6-DOF plant, the lateral
+``v_g, p_g, r_g`` (:func:`dryden_lateral_model`, at the end of the module).
 
 Spectra (MIL-F-8785C section 3.7.2; one-sided in angular frequency ``omega``
 [rad/s], i.e. ``int_0^inf Phi d omega = sigma^2``; ``V`` airspeed)::
