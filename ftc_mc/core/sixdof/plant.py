@@ -128,10 +128,16 @@ def air_forces(x, p, wind):
     L = qS * CL
     D = qS * CD
     Y = qS * CY
-    ca = math.cos(alpha)
-    sa = math.sin(alpha)
-    cb = math.cos(beta)
-    sb = math.sin(beta)
+    # cos and sin of alpha and beta from the velocity (no trigonometric calls)
+    uw = math.sqrt(ur * ur + wr * wr)
+    if uw > 0.0:
+        ca = ur / uw
+        sa = wr / uw
+    else:  # atan2(0, 0) = 0
+        ca = 1.0
+        sa = 0.0
+    cb = uw / Va
+    sb = vr / Va
     # Rzyx(0, alpha, beta)^T [-D, Y, -L]  (forces.m)
     Vd = Va + x[X_THR] * (p[P_KMOTOR] - Va)
     thrust = 0.5 * p[P_RHO] * p[P_SPROP] * p[P_CPROP] * Vd * (Vd - Va)
