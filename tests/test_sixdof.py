@@ -423,3 +423,20 @@ def test_single_elevon_step_matches_the_independent_implementation():
                 (side, name, got[side][name])
     for name in ("p", "phi", "beta"):
         assert abs(got["left"][name] + got["right"][name]) <= 4e-4, name
+
+
+@pytest.mark.parametrize("name", PRESET_NAMES)
+def test_a_locked_elevon_away_from_trim_has_no_straight_glide(name):
+    # no rudder: with one elevon locked, roll and yaw balance need the aileron
+    # at its trim value (the design notes, section 11); a lock at the trim
+    # position trims to the free trim, a lock 0.1 or 5 deg away is refused
+    af = PRESETS[name].airframe
+    tp = trim6(af)
+    for side in ("left", "right"):
+        at = trim6(af, locked=(side, tp.u0[COMMAND[side]]))
+        np.testing.assert_allclose(at.u0, tp.u0, atol=1e-12)
+        for deg in (0.1, 5.0, -5.0):
+            pos = tp.u0[COMMAND[side]] + math.radians(deg)
+            with pytest.raises(UserError, match=f"no straight glide with the {side} "
+                                                "elevon locked"):
+                trim6(af, locked=(side, pos))

@@ -185,7 +185,7 @@ def _trim_state(v, V0):
 
 
 def trim6(airframe: Airframe, V0: float = 20.0, gamma0_deg: float = -3.0,
-          where: str = "airframe") -> SixDofTrim:
+          where: str = "airframe", locked: tuple | None = None) -> SixDofTrim:
     """Trim the 6-DOF airframe in a steady straight glide (module docstring).
 
     Parameters
@@ -198,6 +198,13 @@ def trim6(airframe: Airframe, V0: float = 20.0, gamma0_deg: float = -3.0,
         Air-path angle [deg], within (-30, 30).
     where : str
         The airframe's name, for error lines.
+    locked : (str, float), optional
+        ``("left" | "right", position [rad])``: that elevon held at an absolute
+        position, the other one free.  Eight conditions then meet seven
+        unknowns, solved in the least-squares sense (``scipy.optimize.
+        least_squares``); with no rudder a straight glide exists only where
+        the locked elevon leaves no aileron to balance (the project's design
+        notes, section 11: locks away from trim are not trimmable).
 
     Returns
     -------
@@ -207,7 +214,8 @@ def trim6(airframe: Airframe, V0: float = 20.0, gamma0_deg: float = -3.0,
     ------
     UserError
         Missing lateral data (:func:`require_lateral`), a bad condition, no
-        equilibrium, or a trim throttle or elevon outside its range.
+        equilibrium (with ``locked``: no straight glide with that lock), or a
+        trim throttle or elevon outside its range.
     """
     require_lateral(airframe, where)
     if not (isinstance(V0, (int, float)) and math.isfinite(V0) and V0 > 0):
@@ -229,15 +237,35 @@ def trim6(airframe: Airframe, V0: float = 20.0, gamma0_deg: float = -3.0,
         return np.concatenate((dx[rows], [y[i_gamma] - gamma0, dx[i_east]]))
 
     guess = np.array([0.02, 0.0, 0.0, 0.02 + gamma0, 0.0, 0.1, 0.05, 0.0])
-    sol = scipy.optimize.root(residual, guess, tol=1e-14)
-    res = np.max(np.abs(residual(sol.x))) if np.all(np.isfinite(sol.x)) else math.inf
     where_c = (f"model.airspeed_mps={V0:g}, model.gamma_deg={gamma0_deg:g}: "
                "the airframe cannot fly this condition (6-DOF):")
+    if locked is None:
+        sol = scipy.optimize.root(residual, guess, tol=1e-14)
+        v = sol.x
+        how = f"solver: {' '.join(sol.message.split())}"
+    else:
+        side, pos = locked
+        if side not in ("left", "right") or not math.isfinite(pos):
+            raise ValueError(f"trim parameter 'locked' must be ('left' or 'right', a "
+                             f"finite position [rad]), got {locked!r}")
+        sign = 1.0 if side == "left" else -1.0
+
+        def full(w):
+            # w: alpha, beta, phi, theta, psi, throttle, the free elevon
+            de = 0.5 * (pos + w[6])
+            da = 0.5 * sign * (pos - w[6])
+            return np.concatenate((w[:6], [de, da]))
+
+        sol = scipy.optimize.least_squares(lambda w: residual(full(w)),
+                                           np.concatenate((guess[:6], [pos])),
+                                           xtol=1e-15, ftol=1e-15, gtol=1e-15)
+        v = full(sol.x)
+        how = f"no straight glide with the {side} elevon locked at {pos:.4g} rad"
+    res = np.max(np.abs(residual(v))) if np.all(np.isfinite(v)) else math.inf
     if not (math.isfinite(res) and res <= 1e-9):
-        raise UserError(f"{where_c} no equilibrium found (residual {res:.2g}; "
-                        f"solver: {' '.join(sol.message.split())})")
-    alpha, beta, phi, theta, psi, thr, de, da = sol.x
-    x0, u0 = _trim_state(sol.x, V0)
+        raise UserError(f"{where_c} no equilibrium found (residual {res:.2g}; {how})")
+    alpha, beta, phi, theta, psi, thr, de, da = v
+    x0, u0 = _trim_state(v, V0)
     problems = []
     lo_t, hi_t = airframe.throttle_limits
     if not lo_t <= thr <= hi_t:
