@@ -58,8 +58,13 @@ def cli():
               help="Trim flight-path angle [deg].")
 @click.option("--dt", default=0.1, show_default=True, type=float,
               help="Sampling period [s].")
+@click.option("--dof", type=click.Choice(["3", "6"]), default="3", show_default=True,
+              help="Degrees of freedom: 3 the longitudinal model (surge, heave, "
+              "pitch), 6 the full rigid body with lateral-directional dynamics "
+              "(trim and the named modes: short period, phugoid, roll, Dutch roll, "
+              "spiral; needs an airframe with lateral data).")
 @user_errors
-def model(as_json, airframe, save, export, airspeed, gamma_deg, dt):
+def model(as_json, airframe, save, export, airspeed, gamma_deg, dt, dof):
     """Trim point, named eigenvalues and redundancy check of the linear model."""
     from .io.atomic import atomic_path
     from .model.airframe_files import export_airframe
@@ -75,6 +80,8 @@ def model(as_json, airframe, save, export, airspeed, gamma_deg, dt):
     if export is not None and is_linear_model(spec):
         raise UserError(f"--export: {spec} is a linear model, it has no airframe "
                         "parameters to export")
+    if dof == "6":
+        return _model_sixdof(spec, as_json, save, export, airspeed, gamma_deg, dt)
     plant = load_plant(spec, airspeed, gamma_deg, dt)
     summary = model_summary(plant) if plant.airframe is not None else None
     if save is not None:
@@ -91,6 +98,36 @@ def model(as_json, airframe, save, export, airspeed, gamma_deg, dt):
     else:
         click.echo(json.dumps(summary, indent=2) if as_json else format_summary(summary))
     for what, path in (("linear model", save), ("airframe", export)):
+        if path is not None and not as_json:
+            click.echo(f"wrote the {what} to {path}")
+
+
+def _model_sixdof(spec, as_json, save, export, airspeed, gamma_deg, dt):
+    """``ftc-mc model --dof 6``: the 6-DOF trim and named modes (its own import
+    path, so a longitudinal ``model`` never loads the 6-DOF kernels)."""
+    from .io.atomic import atomic_path
+    from .model.airframe_files import export_airframe
+    from .model.presets import PRESETS, resolve_airframe
+    from .model.sixdof import (build_sixdof_plant, format_sixdof_summary,
+                               save_sixdof_npz, sixdof_summary)
+    from .model.source import is_linear_model
+
+    if is_linear_model(spec):
+        raise UserError(f"--dof 6: {spec} is a linear model; the 6-DOF model needs an "
+                        "airframe (a preset or an airframe .yaml with lateral data)")
+    af = resolve_airframe(spec)
+    plant = build_sixdof_plant(af, airspeed, gamma_deg, dt, where=f"airframe {spec}")
+    summary = sixdof_summary(plant)
+    source = str(PRESETS[spec].source) if spec in PRESETS else str(spec)
+    if save is not None:
+        with atomic_path(save) as tmp, open(tmp, "wb") as f:
+            save_sixdof_npz(plant, f, source)
+    if export is not None:
+        with atomic_path(export) as tmp:
+            export_airframe(af, tmp, name=spec, source=source)
+    click.echo(json.dumps(summary, indent=2) if as_json
+               else format_sixdof_summary(summary, spec))
+    for what, path in (("6-DOF linear model", save), ("airframe", export)):
         if path is not None and not as_json:
             click.echo(f"wrote the {what} to {path}")
 

@@ -15,7 +15,7 @@ import pytest
 import scipy.io
 
 from ftc_mc.errors import UserError
-from ftc_mc.model.airframe import X8, Airframe
+from ftc_mc.model.airframe import LATERAL_FIELDS, X8, Airframe
 from ftc_mc.model.airframe_files import (AIRFRAME_FIELDS, LINEAR_MODEL_VARIABLES,
                                          export_airframe, load_airframe_yaml,
                                          load_linear_model)
@@ -34,6 +34,15 @@ KRISGRY_X8 = {
     "C_D_delta_e": 0.06334739678180232, "C_m_0": 0.02275, "C_m_alpha": -0.4629,
     "C_m_q": -1.3012370370370372, "C_m_delta_e": -0.2292,
     "S_prop": 0.10178760197630929, "k_motor": 40, "C_prop": 1,
+    "b": 2.1, "Jx": 1.229, "Jz": 0.8808, "Jxz": 0.9343,
+    "C_D_beta1": -0.005842980345415388, "C_D_beta2": 0.14781193079241584,
+    "C_Y_0": 0, "C_Y_beta": -0.22387215700254048, "C_Y_p": -0.13735505263157893,
+    "C_Y_r": 0.08386876842105263, "C_Y_delta_a": 0.043276402502774876,
+    "C_l_0": 0, "C_l_beta": -0.08489628639662417, "C_l_p": -0.40419799999999995,
+    "C_l_r": 0.055520599999999996, "C_l_delta_a": 0.12018814125782745,
+    "C_n_0": 0, "C_n_beta": 0.0283, "C_n_p": 0.004365511578947368,
+    "C_n_r": -0.07200000000000001, "C_n_delta_a": -0.00339,
+    "k_T_P": 0, "k_Omega": 0,
 }
 
 # github.com/eivindeb/pyfly, pyfly/x8_param.mat,
@@ -46,6 +55,15 @@ PYFLY_X8 = {
     "C_D_delta_e": 0.06334739678180232, "C_m_0": 0.018, "C_m_alpha": -0.2524,
     "C_m_q": -1.3012370370370372, "C_m_delta_e": -0.2292,
     "S_prop": 0.10178760197630929, "k_motor": 37.42, "C_prop": 0.248,
+    "b": 2.1, "Jx": 1.229, "Jz": 0.8808, "Jxz": 0.9343,
+    "C_D_beta1": -0.005842980345415388, "C_D_beta2": 0.14781193079241584,
+    "C_Y_0": 0, "C_Y_beta": -0.22387215700254048, "C_Y_p": -0.13735505263157893,
+    "C_Y_r": 0.08386876842105263, "C_Y_delta_a": 0.043276402502774876,
+    "C_l_0": 0, "C_l_beta": -0.08489628639662417, "C_l_p": -0.40419799999999995,
+    "C_l_r": 0.055520599999999996, "C_l_delta_a": 0.12018814125782745,
+    "C_n_0": 0, "C_n_beta": 0.0283, "C_n_p": 0.004365511578947368,
+    "C_n_r": -0.07200000000000001, "C_n_delta_a": -0.00339,
+    "k_T_P": 1.1871e-06, "k_Omega": 797.1268,
 }
 
 # Airframe field <- variable of the parameter files.
@@ -55,6 +73,7 @@ FILE_NAME = {
     "CDa": "C_D_alpha1", "CDa2": "C_D_alpha2", "CDde2": "C_D_delta_e",
     "Cm0": "C_m_0", "Cma": "C_m_alpha", "Cmq": "C_m_q", "Cmde": "C_m_delta_e",
     "S_prop": "S_prop", "k_motor": "k_motor", "C_prop": "C_prop",
+    **{name: name for name in LATERAL_FIELDS},  # the files' own names
 }
 
 # Ours, not the files' (the same as today's X8).
@@ -62,13 +81,27 @@ OURS = {"rho": 1.225, "g": 9.81, "tau_thrust": 0.3, "tau_elevon": 0.05,
         "throttle_limits": (0.0, 1.0),
         "elevon_limits": (-math.radians(30.0), math.radians(30.0))}
 
+def _pyfly_mat() -> str:
+    """The x8_param.mat shipped in the pyfly-fixed-wing wheel (the `test` extra),
+    or a path that does not exist when the package is not installed."""
+    try:
+        import importlib.resources
+        return str(importlib.resources.files("pyfly") / "x8_param.mat")
+    except ImportError:
+        return "/nonexistent/pyfly/x8_param.mat"
+
+
+# krisgry/x8 has no licence file, so its x8_param.mat is not in this repository;
+# its SHA-256 (of the file at the commit below) pins the copy the values came
+# from.  Put a copy at KRISGRY_MAT to run the comparison.
+KRISGRY_SHA256 = "b0472b8f95bb308d89bdbe3a3212c6f2df2150bd3176c58fcc647f2de679e090"
+KRISGRY_MAT = os.environ.get("FTC_MC_KRISGRY_MAT", "/tmp/mats/krisgry_x8_param.mat")
+
 SOURCES = {
     "x8-gryte2018": (KRISGRY_X8, "krisgry/x8", "x8_param.mat",
-                     "8bfb2d945dbff9abdfda6431b8f1d962c9d45b30",
-                     "/tmp/mats/krisgry_x8_param.mat"),
+                     "8bfb2d945dbff9abdfda6431b8f1d962c9d45b30", KRISGRY_MAT),
     "x8-pyfly": (PYFLY_X8, "eivindeb/pyfly", "pyfly/x8_param.mat",
-                 "8451687b8df4a7bc6f78f3a1cdcfd503b76bf596",
-                 "/tmp/mats/pyfly_x8_param.mat"),
+                 "8451687b8df4a7bc6f78f3a1cdcfd503b76bf596", _pyfly_mat()),
 }
 
 
@@ -96,13 +129,25 @@ def test_preset_equals_its_source_file(name):
 
 
 @pytest.mark.parametrize("name", list(SOURCES))
-@pytest.mark.skipif(not all(os.path.exists(s[4]) for s in SOURCES.values()),
-                    reason="the cited .mat files are not on this machine")
 def test_hand_copied_values_equal_the_files(name):
+    # x8-pyfly: the x8_param.mat of the pyfly-fixed-wing package (test extra);
+    # x8-gryte2018: a local copy of krisgry/x8's file, checked by its SHA-256
     values, *_, mat = SOURCES[name]
+    if not os.path.exists(mat):
+        pytest.skip(f"{mat} is not on this machine")
+    if name == "x8-gryte2018":
+        import hashlib
+        with open(mat, "rb") as f:
+            assert hashlib.sha256(f.read()).hexdigest() == KRISGRY_SHA256
     data = scipy.io.loadmat(mat, squeeze_me=True)
     for var, value in values.items():
         assert float(data[var]) == value, var
+
+
+def test_pyfly_package_ships_its_parameter_file():
+    # the x8-pyfly comparison above must not skip where the test extra is installed
+    pytest.importorskip("pyfly")
+    assert os.path.exists(SOURCES["x8-pyfly"][4])
 
 
 def test_todays_x8_is_unchanged_and_is_not_the_preset():
@@ -172,10 +217,42 @@ def test_export_comments_every_field_with_its_unit():
     text = s.getvalue()
     assert "# name: x8" in text and "# source: src" in text
     lines = {ln.split(":")[0]: ln for ln in text.splitlines() if not ln.startswith("#")}
+    # today's X8 has no lateral-directional data: a longitudinal-only file
+    assert list(lines) == [f for f in AIRFRAME_FIELDS if f not in LATERAL_FIELDS]
+    for name, line in lines.items():
+        _, unit, meaning = AIRFRAME_FIELDS[name]
+        assert f"# {unit} {meaning}" in line
+    assert "[kg]" in lines["mass"] and "[rad]" in lines["elevon_limits"]
+    s = io.StringIO()
+    export_airframe(PRESETS["x8-pyfly"].airframe, s)
+    lines = {ln.split(":")[0]: ln for ln in s.getvalue().splitlines()
+             if not ln.startswith("#")}
     assert list(lines) == list(AIRFRAME_FIELDS)
     for name, (_, unit, meaning) in AIRFRAME_FIELDS.items():
         assert f"# {unit} {meaning}" in lines[name]
-    assert "[kg]" in lines["mass"] and "[rad]" in lines["elevon_limits"]
+    assert "[kg m^2]" in lines["Jxz"] and "[m]" in lines["b"]
+
+
+def test_longitudinal_only_file_loads_without_lateral_data(tmp_path):
+    path = tmp_path / "lon.yaml"
+    export_airframe(X8, path)
+    back = load_airframe_yaml(path)
+    assert back == X8 and not back.has_lateral
+    assert back.missing_lateral == LATERAL_FIELDS
+    path = tmp_path / "full.yaml"
+    export_airframe(PRESETS["x8-gryte2018"].airframe, path)
+    full = load_airframe_yaml(path)
+    assert full.has_lateral and full.missing_lateral == ()
+    # a file with part of the lateral data loads; the 6-DOF model names the rest
+    text = "\n".join(ln for ln in path.read_text().splitlines()
+                     if not ln.startswith(("Jxz:", "C_n_r:")))
+    path.write_text(text + "\n")
+    assert load_airframe_yaml(path).missing_lateral == ("Jxz", "C_n_r")
+
+
+def test_inertia_must_be_positive_definite():
+    with pytest.raises(UserError, match="positive definite"):
+        dataclasses.replace(PRESETS["x8-pyfly"].airframe, Jxz=2.0)
 
 
 def _yaml_with(tmp_path, **changes):
@@ -213,7 +290,11 @@ BAD_FIELDS = [
     ({"elevon_limits": "[-0.5, 0.4]"}, "airframe.elevon_limits: must be symmetric"),
     ({"elevon_limits": "0.5"}, "airframe.elevon_limits: must be a list of two"),
     ({"mas": "3.0"}, "airframe.mas: unknown field (did you mean 'mass'?)"),
-    ({"Cmq": None}, "airframe: missing field Cmq (every field is required)"),
+    ({"Cmq": None}, "airframe: missing field Cmq (every longitudinal field is "
+                    "required)"),
+    ({"Jx": "-1.0"}, "airframe.Jx: must be > 0, got -1.0 ("),
+    ({"C_l_p": ".nan"}, "airframe.C_l_p: must be finite, got nan ("),
+    ({"k_T_P": "-1e-6"}, "airframe.k_T_P: must be >= 0, got -1e-06 ("),
     ({"Cmq": None, "g": None}, "airframe: missing fields g, Cmq"),
 ]
 
@@ -269,7 +350,7 @@ def test_truncated_export_is_refused(tmp_path):
     export_airframe(X8, s)
     path = tmp_path / "cut.yaml"
     path.write_text(s.getvalue()[: len(s.getvalue()) // 2])
-    with pytest.raises(UserError, match=r"^airframe: missing fields .*\(every field"):
+    with pytest.raises(UserError, match=r"^airframe: missing fields .*\(every longitudinal field"):
         load_airframe_yaml(path)
 
 

@@ -1,7 +1,8 @@
-"""Longitudinal airframe parameters, and today's rounded Skywalker X8 (``X8``).
+"""Airframe parameters, and today's rounded Skywalker X8 (``X8``).
 
 :class:`Airframe` holds the coefficient set of the longitudinal model of
-``ftc_mc/model/dynamics.py``.  The cited, full-precision copies of the two public
+``ftc_mc/model/dynamics.py`` and, optionally (:data:`LATERAL_FIELDS`), the
+lateral-directional data of the 6-DOF model (``ftc_mc/model/sixdof.py``).  The cited, full-precision copies of the two public
 X8 parameter files are the presets of ``ftc_mc/model/presets.py``
 (``x8-gryte2018``, ``x8-pyfly``; ``docs/airframes.md`` compares them); a user's
 own aircraft comes from a YAML file (``ftc_mc/model/airframe_files.py``).
@@ -37,9 +38,10 @@ G0 = 9.81
 
 @dataclasses.dataclass(frozen=True)
 class Airframe:
-    """Longitudinal airframe parameters (SI units, angles in rad).
+    """Airframe parameters (SI units, angles in rad).
 
-    The defaults are today's rounded X8 (:data:`X8`, module docstring).
+    The defaults are today's rounded X8 (:data:`X8`, module docstring), which
+    has no lateral-directional data (longitudinal runs only).
 
     Parameters
     ----------
@@ -76,6 +78,24 @@ class Airframe:
         Absolute throttle command range [-].
     elevon_limits : tuple of float
         Absolute range of each elevon command [rad].
+    b : float or None
+        Wing span [m] (6-DOF only; so are the fields below, ``None``: not
+        given, see :data:`LATERAL_FIELDS`).
+    Jx, Jz, Jxz : float or None
+        Roll and yaw moments of inertia and the product of inertia [kg m^2];
+        the inertia matrix is ``[[Jx, 0, -Jxz], [0, Jy, 0], [-Jxz, 0, Jz]]``.
+    C_D_beta1, C_D_beta2 : float or None
+        Sideslip drag: ``+ C_D_beta1 beta + C_D_beta2 beta^2`` in ``CD``.
+    C_Y_0, C_Y_beta, C_Y_p, C_Y_r, C_Y_delta_a : float or None
+        Side force: ``CY = C_Y_0 + C_Y_beta beta + (C_Y_p p + C_Y_r r) b/(2 Va)
+        + C_Y_delta_a da`` with aileron ``da = (left - right)/2``.
+    C_l_0, C_l_beta, C_l_p, C_l_r, C_l_delta_a : float or None
+        Roll moment, the same form (times ``qbar S b``).
+    C_n_0, C_n_beta, C_n_p, C_n_r, C_n_delta_a : float or None
+        Yaw moment, the same form (times ``qbar S b``).
+    k_T_P, k_Omega : float or None
+        Propeller roll torque ``-k_T_P (k_Omega throttle)^2`` [N m]: ``k_T_P``
+        [N m s^2/rad^2], ``k_Omega`` [rad/s].
 
     Raises
     ------
@@ -108,6 +128,29 @@ class Airframe:
     tau_elevon: float = 0.05
     throttle_limits: tuple = (0.0, 1.0)
     elevon_limits: tuple = (-math.radians(30.0), math.radians(30.0))
+    b: float | None = None
+    Jx: float | None = None
+    Jz: float | None = None
+    Jxz: float | None = None
+    C_D_beta1: float | None = None
+    C_D_beta2: float | None = None
+    C_Y_0: float | None = None
+    C_Y_beta: float | None = None
+    C_Y_p: float | None = None
+    C_Y_r: float | None = None
+    C_Y_delta_a: float | None = None
+    C_l_0: float | None = None
+    C_l_beta: float | None = None
+    C_l_p: float | None = None
+    C_l_r: float | None = None
+    C_l_delta_a: float | None = None
+    C_n_0: float | None = None
+    C_n_beta: float | None = None
+    C_n_p: float | None = None
+    C_n_r: float | None = None
+    C_n_delta_a: float | None = None
+    k_T_P: float | None = None
+    k_Omega: float | None = None
 
     def __post_init__(self):
         positive = ("mass", "Jy", "S", "c", "rho", "g", "S_prop", "k_motor",
@@ -132,6 +175,34 @@ class Airframe:
         if self.elevon_limits[0] != -self.elevon_limits[1]:
             raise UserError("airframe parameter 'elevon_limits' must be "
                             f"symmetric, got {self.elevon_limits!r}")
+        for name in LATERAL_FIELDS:
+            value = getattr(self, name)
+            if value is None:
+                continue
+            if not (isinstance(value, (int, float)) and math.isfinite(value)):
+                raise UserError(f"airframe parameter {name!r} must be finite, "
+                                f"got {value!r}")
+            if name in ("b", "Jx", "Jz") and not value > 0:
+                raise UserError(f"airframe parameter {name!r} must be > 0, "
+                                f"got {value!r}")
+            if name in ("k_T_P", "k_Omega") and value < 0:
+                raise UserError(f"airframe parameter {name!r} must be >= 0, "
+                                f"got {value!r}")
+        if None not in (self.Jx, self.Jz, self.Jxz) and \
+                not self.Jx * self.Jz - self.Jxz ** 2 > 0:
+            raise UserError("airframe parameters 'Jx', 'Jz', 'Jxz': the inertia "
+                            "matrix must be positive definite (Jx Jz > Jxz^2), got "
+                            f"{self.Jx!r}, {self.Jz!r}, {self.Jxz!r}")
+
+    @property
+    def missing_lateral(self) -> tuple:
+        """The lateral-directional fields (:data:`LATERAL_FIELDS`) not given."""
+        return tuple(n for n in LATERAL_FIELDS if getattr(self, n) is None)
+
+    @property
+    def has_lateral(self) -> bool:
+        """True when every lateral-directional field is given (6-DOF capable)."""
+        return not self.missing_lateral
 
     @property
     def command_lower(self):
@@ -143,6 +214,17 @@ class Airframe:
         """Absolute upper command limits (throttle, left, right elevon)."""
         return (self.throttle_limits[1], self.elevon_limits[1], self.elevon_limits[1])
 
+
+LATERAL_FIELDS = ("b", "Jx", "Jz", "Jxz", "C_D_beta1", "C_D_beta2",
+                  "C_Y_0", "C_Y_beta", "C_Y_p", "C_Y_r", "C_Y_delta_a",
+                  "C_l_0", "C_l_beta", "C_l_p", "C_l_r", "C_l_delta_a",
+                  "C_n_0", "C_n_beta", "C_n_p", "C_n_r", "C_n_delta_a",
+                  "k_T_P", "k_Omega")
+"""The fields only the 6-DOF plant uses (optional: ``None`` when not given).
+
+A longitudinal run ignores them; the 6-DOF model (``ftc_mc.model.sixdof``)
+needs every one and names the missing ones.  The parameter files' rudder terms
+(``C_*_delta_r``) and ``C_D_q`` are zero and not fields (the X8 has no rudder)."""
 
 X8 = Airframe()
 """Today's Skywalker X8: the ``x8-gryte2018`` values rounded to about 4 digits.

@@ -1,9 +1,10 @@
 """A user's own aircraft from files: airframe YAML and linear models (.npz, .mat).
 
 Airframe YAML (``docs/airframes.md``): a flat mapping with every field of
-:class:`~ftc_mc.model.airframe.Airframe`, SI units, angles in rad.  Every field
-is required and unknown fields are refused, so a typo cannot silently fall back
-to a default; :func:`export_airframe` writes a complete, commented file to start
+:class:`~ftc_mc.model.airframe.Airframe`, SI units, angles in rad.  Every
+longitudinal field is required and unknown fields are refused, so a typo cannot
+silently fall back to a default; the lateral-directional fields are optional
+(only the 6-DOF model needs them, and it names the missing ones); :func:`export_airframe` writes a complete, commented file to start
 from.  YAML is read with ``yaml.safe_load`` only.
 
 Linear model (``.npz`` as written by :func:`ftc_mc.model.summary.save_npz`, or
@@ -31,7 +32,7 @@ import yaml
 
 from ..errors import UserError
 from ..io.yamlfile import read_yaml
-from .airframe import Airframe
+from .airframe import LATERAL_FIELDS, Airframe
 from .linear import LinearPlant, TrimPoint
 
 _REPR = reprlib.Repr()
@@ -69,11 +70,48 @@ AIRFRAME_FIELDS: dict[str, tuple[str, str, str]] = {
                         "absolute throttle command range [lo, hi], 0 <= lo < hi <= 1"),
     "elevon_limits": ("elevon", "[rad]",
                       "absolute range of each elevon [-max, max], 0 < max <= pi/2"),
+    # lateral-directional: optional, needed by the 6-DOF model only
+    "b": ("positive", "[m]", "wing span (6-DOF)"),
+    "Jx": ("positive", "[kg m^2]", "roll moment of inertia (6-DOF)"),
+    "Jz": ("positive", "[kg m^2]", "yaw moment of inertia (6-DOF)"),
+    "Jxz": ("finite", "[kg m^2]", "product of inertia, I = [[Jx,0,-Jxz],[0,Jy,0],"
+                                   "[-Jxz,0,Jz]] (6-DOF)"),
+    "C_D_beta1": ("finite", "[1/rad]", "drag, linear term in sideslip (6-DOF)"),
+    "C_D_beta2": ("finite", "[1/rad^2]", "drag, quadratic term in sideslip (6-DOF)"),
+    "C_Y_0": ("finite", "[-]", "side force at zero sideslip (6-DOF)"),
+    "C_Y_beta": ("finite", "[1/rad]", "side force due to sideslip (6-DOF)"),
+    "C_Y_p": ("finite", "[1/rad]", "side force due to roll rate, per b p / (2 Va) "
+                                   "(6-DOF)"),
+    "C_Y_r": ("finite", "[1/rad]", "side force due to yaw rate, per b r / (2 Va) "
+                                   "(6-DOF)"),
+    "C_Y_delta_a": ("finite", "[1/rad]", "side force due to aileron (left - "
+                                         "right)/2 (6-DOF)"),
+    "C_l_0": ("finite", "[-]", "roll moment at zero sideslip (6-DOF)"),
+    "C_l_beta": ("finite", "[1/rad]", "roll moment due to sideslip (6-DOF)"),
+    "C_l_p": ("finite", "[1/rad]", "roll damping, per b p / (2 Va) (6-DOF)"),
+    "C_l_r": ("finite", "[1/rad]", "roll moment due to yaw rate, per b r / (2 Va) "
+                                   "(6-DOF)"),
+    "C_l_delta_a": ("finite", "[1/rad]", "roll moment due to aileron (left - "
+                                         "right)/2 (6-DOF)"),
+    "C_n_0": ("finite", "[-]", "yaw moment at zero sideslip (6-DOF)"),
+    "C_n_beta": ("finite", "[1/rad]", "yaw moment due to sideslip (6-DOF)"),
+    "C_n_p": ("finite", "[1/rad]", "yaw moment due to roll rate, per b p / (2 Va) "
+                                   "(6-DOF)"),
+    "C_n_r": ("finite", "[1/rad]", "yaw damping, per b r / (2 Va) (6-DOF)"),
+    "C_n_delta_a": ("finite", "[1/rad]", "yaw moment due to aileron (left - "
+                                         "right)/2 (6-DOF)"),
+    "k_T_P": ("nonnegative", "[N m s^2/rad^2]", "propeller roll torque "
+                                                 "-k_T_P (k_Omega throttle)^2 (6-DOF)"),
+    "k_Omega": ("nonnegative", "[rad/s]", "propeller speed at full throttle, for "
+                                          "k_T_P (6-DOF)"),
 }
 """Airframe field -> (check, unit, meaning); the order of :class:`Airframe`.
 
-Checks: ``positive`` finite > 0; ``finite`` any finite number; ``throttle`` and
-``elevon`` the two-number ranges described in the meaning."""
+Checks: ``positive`` finite > 0; ``nonnegative`` finite >= 0; ``finite`` any
+finite number; ``throttle`` and ``elevon`` the two-number ranges described in
+the meaning.  The lateral-directional fields
+(:data:`~ftc_mc.model.airframe.LATERAL_FIELDS`) are optional: a file without
+them flies longitudinal runs; the 6-DOF model names the missing ones."""
 
 _NUMBER_TEXT = re.compile(r"^[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)$")
 """Scientific notation without a dot (``1e-5``), which YAML 1.1 reads as text."""
@@ -112,6 +150,8 @@ def export_airframe(airframe: Airframe, path_or_stream, name: str = "",
     rows = []
     for field in dataclasses.fields(Airframe):
         value = getattr(airframe, field.name)
+        if value is None:  # a lateral-directional field not given
+            continue
         if isinstance(value, tuple):
             text = "[" + ", ".join(_yaml_number(v) for v in value) + "]"
         else:
@@ -161,6 +201,8 @@ def _field_value(name: str, raw, source: str):
         value = _number(raw, where)
         if check == "positive" and not value > 0:
             raise UserError(f"{where}: must be > 0, got {value!r}")
+        if check == "nonnegative" and not value >= 0:
+            raise UserError(f"{where}: must be >= 0, got {value!r}")
         return value
     except UserError as exc:
         raise UserError(f"{exc}{tail}") from None
@@ -202,11 +244,13 @@ def parse_airframe(data, source: str = "airframe") -> Airframe:
         more = f" [and {len(unknown) - 1} more]" if len(unknown) > 1 else ""
         raise UserError(f"airframe.{str(key)[:40]}: unknown field "
                         f"({hint}){more}{tail}")
-    missing = [k for k in AIRFRAME_FIELDS if k not in data]
+    missing = [k for k in AIRFRAME_FIELDS if k not in data and k not in LATERAL_FIELDS]
     if missing:
         raise UserError(f"airframe: missing field{'s' if len(missing) > 1 else ''} "
-                        f"{', '.join(missing)} (every field is required){tail}")
-    values = {name: _field_value(name, data[name], source) for name in AIRFRAME_FIELDS}
+                        f"{', '.join(missing)} (every longitudinal field is "
+                        f"required){tail}")
+    values = {name: _field_value(name, data[name], source)
+              for name in AIRFRAME_FIELDS if name in data}
     try:
         return Airframe(**values)
     except ValueError as exc:  # the dataclass's own checks; ours are stricter

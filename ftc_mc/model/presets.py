@@ -16,7 +16,10 @@ g = 9.81 m/s^2, actuator time constants (engine 0.3 s, elevons 0.05 s) and the
 command limits (throttle [0, 1], each elevon +-30 deg).
 
 The longitudinal model without stall (``ftc_mc/model/dynamics.py``) uses 19 of
-a file's entries; the others are listed in each preset's ``unused`` text.
+a file's entries; the 6-DOF model (``ftc_mc/model/sixdof.py``) 23 more, the
+lateral-directional ones (:data:`ftc_mc.model.airframe.LATERAL_FIELDS`, the
+propeller torque included); the others are listed in each preset's ``unused``
+text.
 """
 
 from __future__ import annotations
@@ -73,8 +76,8 @@ class Preset:
     note : str
         One line: what distinguishes this preset.
     unused : str
-        Entries present in the source file but not used by the longitudinal
-        model without stall.
+        Entries present in the source file but used by neither the
+        longitudinal nor the 6-DOF model.
     """
 
     name: str
@@ -117,6 +120,30 @@ X8_GRYTE2018 = Airframe(
     S_prop=0.10178760197630929,      # S_prop
     k_motor=40.0,                    # k_motor (stored as the integer 40)
     C_prop=1.0,                      # C_prop (stored as the integer 1)
+    # lateral-directional (6-DOF only; identical in both files):
+    b=2.1,                           # b
+    Jx=1.229,                        # Jx
+    Jz=0.8808,                       # Jz
+    Jxz=0.9343,                      # Jxz
+    C_D_beta1=-0.005842980345415388,  # C_D_beta1
+    C_D_beta2=0.14781193079241584,   # C_D_beta2
+    C_Y_0=0.0,                       # C_Y_0 (stored as the integer 0)
+    C_Y_beta=-0.22387215700254048,   # C_Y_beta
+    C_Y_p=-0.13735505263157893,      # C_Y_p
+    C_Y_r=0.08386876842105263,       # C_Y_r
+    C_Y_delta_a=0.043276402502774876,  # C_Y_delta_a
+    C_l_0=0.0,                       # C_l_0 (stored as the integer 0)
+    C_l_beta=-0.08489628639662417,   # C_l_beta
+    C_l_p=-0.40419799999999995,      # C_l_p
+    C_l_r=0.055520599999999996,      # C_l_r
+    C_l_delta_a=0.12018814125782745,  # C_l_delta_a
+    C_n_0=0.0,                       # C_n_0 (stored as the integer 0)
+    C_n_beta=0.0283,                 # C_n_beta
+    C_n_p=0.004365511578947368,      # C_n_p
+    C_n_r=-0.07200000000000001,      # C_n_r (XFLR's value times 6, README)
+    C_n_delta_a=-0.00339,            # C_n_delta_a
+    k_T_P=0.0,                       # k_T_P (stored as the integer 0)
+    k_Omega=0.0,                     # k_Omega (stored as the integer 0)
     # ours, not the file's (module docstring):
     rho=1.225, g=9.81, tau_thrust=0.3, tau_elevon=0.05,
     throttle_limits=(0.0, 1.0),
@@ -145,6 +172,30 @@ X8_PYFLY = Airframe(
     S_prop=0.10178760197630929,      # S_prop
     k_motor=37.42,                   # k_motor
     C_prop=0.248,                    # C_prop
+    # lateral-directional (6-DOF only; identical in both files):
+    b=2.1,                           # b
+    Jx=1.229,                        # Jx
+    Jz=0.8808,                       # Jz
+    Jxz=0.9343,                      # Jxz
+    C_D_beta1=-0.005842980345415388,  # C_D_beta1
+    C_D_beta2=0.14781193079241584,   # C_D_beta2
+    C_Y_0=0.0,                       # C_Y_0 (stored as the integer 0)
+    C_Y_beta=-0.22387215700254048,   # C_Y_beta
+    C_Y_p=-0.13735505263157893,      # C_Y_p
+    C_Y_r=0.08386876842105263,       # C_Y_r
+    C_Y_delta_a=0.043276402502774876,  # C_Y_delta_a
+    C_l_0=0.0,                       # C_l_0 (stored as the integer 0)
+    C_l_beta=-0.08489628639662417,   # C_l_beta
+    C_l_p=-0.40419799999999995,      # C_l_p
+    C_l_r=0.055520599999999996,      # C_l_r
+    C_l_delta_a=0.12018814125782745,  # C_l_delta_a
+    C_n_0=0.0,                       # C_n_0 (stored as the integer 0)
+    C_n_beta=0.0283,                 # C_n_beta
+    C_n_p=0.004365511578947368,      # C_n_p
+    C_n_r=-0.07200000000000001,      # C_n_r (XFLR's value times 6, README)
+    C_n_delta_a=-0.00339,            # C_n_delta_a
+    k_T_P=1.1871e-06,                # k_T_P
+    k_Omega=797.1268,                # k_Omega
     # ours, not the file's (module docstring):
     rho=1.225, g=9.81, tau_thrust=0.3, tau_elevon=0.05,
     throttle_limits=(0.0, 1.0),
@@ -152,22 +203,21 @@ X8_PYFLY = Airframe(
 )
 
 _UNUSED_COMMON = (
-    "lateral-directional: b 2.1, Jx 1.229, Jz 0.8808, Jxz 0.9343, C_Y_*, C_l_*, "
-    "C_n_*; sideslip drag C_D_beta1, C_D_beta2; C_D_q 0; r_cg [0, 0, 0]")
+    "rudder terms C_Y_delta_r, C_l_delta_r, C_n_delta_r 0 (no rudder); C_D_q 0; "
+    "r_cg [0, 0, 0]")
 
 PRESETS: dict[str, Preset] = {
     "x8-gryte2018": Preset(
         name="x8-gryte2018", airframe=X8_GRYTE2018, source=_GRYTE2018,
         note=("the authors' simulator: C_m fitted to flight tests; strong engine "
               "(C_prop 1, k_motor 40 m/s)"),
-        unused=f"{_UNUSED_COMMON}; propeller torque k_T_P 0, k_Omega 0"),
+        unused=_UNUSED_COMMON),
     "x8-pyfly": Preset(
         name="x8-pyfly", airframe=X8_PYFLY, source=_PYFLY,
         note=("PyFly's file: C_m 0.018 - 0.2524 a; weaker engine (C_prop 0.248, "
               "k_motor 37.42 m/s)"),
-        unused=(f"{_UNUSED_COMMON}; propeller torque k_T_P 1.1871e-06, k_Omega "
-                "797.1268; PyFly's stall model M 50, a_0 0.267, C_m_fp -0.2168 and "
-                "its drag polar C_D_p 0.0102 with Oswald e 0.9935")),
+        unused=(f"{_UNUSED_COMMON}; PyFly's stall model M 50, a_0 0.267, C_m_fp "
+                "-0.2168 and its drag polar C_D_p 0.0102 with Oswald e 0.9935")),
 }
 """The registry: preset name -> :class:`Preset`."""
 

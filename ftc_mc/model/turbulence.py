@@ -1,7 +1,9 @@
-"""MIL-F-8785C longitudinal Dryden turbulence, discretised exactly.
+"""MIL-F-8785C Dryden turbulence, discretised exactly.
 
-Builds the matrices of the discrete gust model run by
-:func:`ftc_mc.core.shared.dryden.gust_step`.
+Builds the matrices of the discrete gust models run by
+:func:`ftc_mc.core.shared.dryden.gust_step`: the longitudinal ``u_g, w_g, q_g``
+(:func:`dryden_model`, below) and, for the 6-DOF plant, the lateral
+``v_g, p_g, r_g`` (:func:`dryden_lateral_model`, at the end of the module).
 
 Spectra (MIL-F-8785C section 3.7.2; one-sided in angular frequency ``omega``
 [rad/s], i.e. ``int_0^inf Phi d omega = sigma^2``; ``V`` airspeed)::
@@ -206,3 +208,138 @@ def psd_w(omega, m: DrydenModel):
 def psd_q(omega, m: DrydenModel):
     """Analytic one-sided Phi_q(omega) [(rad/s)^2 / (rad/s)]."""
     return (omega / m.V) ** 2 / (1.0 + (m.T_q * omega) ** 2) * psd_w(omega, m)
+
+
+# ----------------------------------------------------------------------------
+# lateral components (6-DOF plant, issue 24)
+
+DrydenLateralModel = collections.namedtuple(
+    "DrydenLateralModel",
+    ["Ad", "Bd", "Cd", "P0", "P0_chol", "Ac", "Bc", "Cc", "sigma_v", "sigma_p",
+     "sigma_r", "L_v", "L_w", "T_p", "T_r", "V", "dt", "level", "altitude_m", "span"])
+DrydenLateralModel.__doc__ = """Discrete lateral Dryden gust model (see
+:func:`dryden_lateral_model`).
+
+Ad, Bd (4, 4), Cd (3, 4): the same recursion as the longitudinal model
+(:func:`ftc_mc.core.dryden.gust_step` runs both), outputs ``v_g`` [m/s],
+``p_g``, ``r_g`` [rad/s]; states ``[s_v1, s_v2, s_r, s_p]``.
+P0, P0_chol: stationary state covariance and its Cholesky factor.
+Ac, Bc (4, 2), Cc: continuous shaping filters (noise inputs eta_v, eta_p).
+sigma_v [m/s], sigma_p, sigma_r [rad/s]: standard deviations of the gusts.
+L_v, L_w [m]: scale lengths; T_p, T_r [s]: the roll-gust filter's and the
+yaw-gust lag's time constants; V [m/s], dt [s], level, altitude_m [m], span [m]:
+the arguments."""
+
+
+def dryden_lateral_model(level: str = "moderate", V: float = 20.0,
+                         altitude_m: float = 100.0, dt: float = 0.1,
+                         span: float = X8_SPAN) -> DrydenLateralModel:
+    """Exact discrete Dryden model for the lateral gusts ``v_g, p_g, r_g``.
+
+    Spectra (MIL-F-8785C section 3.7.2, one-sided in ``omega`` as the module
+    docstring; at low altitude ``L_v = L_u``, ``sigma_v = sigma_u``)::
+
+        Phi_v(w) = sigma_v^2 (L_v / (pi V)) (1 + 3 (L_v w / V)^2) / (1 + (L_v w / V)^2)^2
+        Phi_p(w) = sigma_w^2 / (L_w V) 0.8 (pi L_w / (4 b))^(1/3) / (1 + (4 b w / (pi V))^2)
+        Phi_r(w) = (w / V)^2 / (1 + (3 b w / (pi V))^2) Phi_v(w)
+
+    Shaping filters (unit-intensity white noise, ``|H|^2 = pi Phi``)::
+
+        H_v(s) = sigma_v sqrt(L_v / V) (1 + sqrt(3) (L_v/V) s) / (1 + (L_v/V) s)^2
+        H_p(s) = sigma_w sqrt(0.8 pi (pi L_w / (4 b))^(1/3) / (L_w V)) / (1 + T_p s),
+                 T_p = 4 b / (pi V)
+        r_g    = +(s / V) / (1 + T_r s) v_g,     T_r = 3 b / (pi V)
+
+    The yaw gust is the rotation of the air ``r_g = +dv_g/dx`` (frozen field)
+    with the span's lag: a lateral gust growing toward the nose is seen by the
+    aerodynamics as the aircraft yawing left, so they see ``r - r_g`` (as
+    ``q - q_g``; the opposite sign convention of ``q_g = -dw_g/dx`` follows from
+    the axes).  The roll gust is an independent process (``p_g = dw_g/dy``,
+    the spanwise gradient of the vertical gust, uncorrelated with ``w_g`` at
+    the centre of gravity in the Dryden model).  Discretised exactly as
+    :func:`dryden_model` (Van Loan).
+
+    Parameters
+    ----------
+    level : {"none", "light", "moderate", "severe"}
+    V : float
+        Airspeed [m/s].
+    altitude_m : float
+        Altitude [m] for the scale lengths.
+    dt : float
+        Sampling period [s].
+    span : float
+        Wing span [m].
+
+    Returns
+    -------
+    DrydenLateralModel
+    """
+    for name, val in (("V", V), ("dt", dt), ("span", span)):
+        if not (isinstance(val, (int, float)) and math.isfinite(val) and val > 0):
+            raise ValueError(f"turbulence parameter {name!r} must be a finite "
+                             f"number > 0, got {val!r}")
+    sigma_u, sigma_w, L_u, L_w = dryden_scales(level, altitude_m)
+    sigma_v, L_v = sigma_u, L_u
+    tv = L_v / V
+    T_r = 3.0 * span / (math.pi * V)
+    T_p = 4.0 * span / (math.pi * V)
+    Kv = sigma_v * math.sqrt(L_v / V)
+    Kp = sigma_w * math.sqrt(0.8 * math.pi * (math.pi * L_w / (4.0 * span)) ** (1.0 / 3.0)
+                             / (L_w * V))
+    # states [s_v1, s_v2, s_r, s_p]; v_g = Cv s_v (controllable canonical form)
+    Cv = np.array([1.0 / tv ** 2, math.sqrt(3.0) / tv])
+    Ac = np.zeros((4, 4))
+    Bc = np.zeros((4, 2))
+    Cc = np.zeros((3, 4))
+    Ac[0, 1] = 1.0
+    Ac[1, 0] = -1.0 / tv ** 2
+    Ac[1, 1] = -2.0 / tv
+    Bc[1, 0] = Kv
+    Ac[2, 0:2] = Cv / T_r
+    Ac[2, 2] = -1.0 / T_r
+    Ac[3, 3] = -1.0 / T_p
+    Bc[3, 1] = Kp / T_p
+    Cc[0, 0:2] = Cv                      # v_g
+    Cc[1, 3] = 1.0                       # p_g
+    Cc[2, 0:2] = Cv / (V * T_r)          # r_g = (v_g - s_r) / (V T_r)
+    Cc[2, 2] = -1.0 / (V * T_r)
+    n = 4
+    M = np.zeros((2 * n, 2 * n))
+    M[:n, :n] = -Ac
+    M[:n, n:] = Bc @ Bc.T
+    M[n:, n:] = Ac.T
+    F = scipy.linalg.expm(M * dt)
+    Ad = F[n:, n:].T
+    Qd = Ad @ F[:n, n:]
+    Qd = 0.5 * (Qd + Qd.T)
+    Bd = _psd_sqrt(Qd)
+    P0 = scipy.linalg.solve_continuous_lyapunov(Ac, -Bc @ Bc.T)
+    P0 = 0.5 * (P0 + P0.T)
+    var = np.diag(Cc @ P0 @ Cc.T)
+    return DrydenLateralModel(
+        Ad=Ad, Bd=Bd, Cd=Cc.copy(), P0=P0, P0_chol=_psd_sqrt(P0), Ac=Ac, Bc=Bc, Cc=Cc,
+        sigma_v=sigma_v, sigma_p=math.sqrt(max(float(var[1]), 0.0)),
+        sigma_r=math.sqrt(max(float(var[2]), 0.0)), L_v=L_v, L_w=L_w, T_p=T_p,
+        T_r=T_r, V=float(V), dt=float(dt), level=level, altitude_m=float(altitude_m),
+        span=float(span))
+
+
+def psd_v(omega, m: DrydenLateralModel):
+    """Analytic one-sided Phi_v(omega) [(m/s)^2 / (rad/s)]."""
+    a = m.L_v / m.V
+    x2 = (a * omega) ** 2
+    return m.sigma_v ** 2 * a / math.pi * (1.0 + 3.0 * x2) / (1.0 + x2) ** 2
+
+
+def psd_p(omega, m: DrydenLateralModel):
+    """Analytic one-sided Phi_p(omega) [(rad/s)^2 / (rad/s)]."""
+    _, sigma_w, _, L_w = dryden_scales(m.level, m.altitude_m)
+    return (sigma_w ** 2 / (L_w * m.V) * 0.8
+            * (math.pi * L_w / (4.0 * m.span)) ** (1.0 / 3.0)
+            / (1.0 + (m.T_p * omega) ** 2))
+
+
+def psd_r(omega, m: DrydenLateralModel):
+    """Analytic one-sided Phi_r(omega) [(rad/s)^2 / (rad/s)]."""
+    return (omega / m.V) ** 2 / (1.0 + (m.T_r * omega) ** 2) * psd_v(omega, m)

@@ -1,0 +1,157 @@
+"""Plain-NumPy twins of the 6-DOF kernels (:mod:`ftc_mc.core.sixdof.plant`).
+
+Written in the matrix form of the authors' simulator (krisgry/x8 ``dynamics.m``
+and ``forces.m``), not by transcribing the kernels' scalar code: Fossen's
+rigid-body mass matrix ``M_rb`` and Coriolis matrix ``C_rb`` (his eq. 3.56,
+``r_cg = 0``) solved with ``np.linalg.solve``, the rotation matrices ``Rzyx`` and
+the Euler-rate matrix ``T`` as the authors' ``Rzyx.m`` and
+``TransformationMatrix.m``, the aerodynamic forces rotated by
+``Rzyx(0, alpha, beta)^T``.  States, commands, outputs and parameters are
+unpacked by their names in :data:`ftc_mc.core.sixdof.layout.LAYOUT`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ftc_mc.core.sixdof.layout import LAYOUT
+
+
+def _named(values, names):
+    return dict(zip(names, np.asarray(values, dtype=float)))
+
+
+def rzyx(phi, theta, psi):
+    """Body -> NED rotation, zyx Euler angles (the authors' ``Rzyx.m``)."""
+    cphi, sphi = np.cos(phi), np.sin(phi)
+    cth, sth = np.cos(theta), np.sin(theta)
+    cpsi, spsi = np.cos(psi), np.sin(psi)
+    return np.array([
+        [cpsi * cth, -spsi * cphi + cpsi * sth * sphi, spsi * sphi + cpsi * cphi * sth],
+        [spsi * cth, cpsi * cphi + sphi * sth * spsi, -cpsi * sphi + sth * spsi * cphi],
+        [-sth, cth * sphi, cth * cphi]])
+
+
+def euler_rates_matrix(phi, theta):
+    """``T(Theta)`` of ``TransformationMatrix.m``: Euler rates = T (p, q, r)."""
+    return np.array([
+        [1.0, np.sin(phi) * np.tan(theta), np.cos(phi) * np.tan(theta)],
+        [0.0, np.cos(phi), -np.sin(phi)],
+        [0.0, np.sin(phi) / np.cos(theta), np.cos(phi) / np.cos(theta)]])
+
+
+def smtrx(v):
+    """Skew-symmetric matrix: ``smtrx(a) @ b = a x b`` (``Smtrx.m``)."""
+    return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
+
+
+def inertia(a):
+    """``I_cg`` of ``simX8.m``."""
+    return np.array([[a["Jx"], 0.0, -a["Jxz"]], [0.0, a["Jy"], 0.0],
+                     [-a["Jxz"], 0.0, a["Jz"]]])
+
+
+def forces_ref(x, p, wind):
+    """Body forces (aerodynamic + thrust, no gravity), moments, alpha, beta, Va.
+
+    ``forces.m`` with the wind rates subtracted (``ftc_mc.core.sixdof.plant``).
+    """
+    s = _named(x, LAYOUT.states)
+    a = _named(p, LAYOUT.params)
+    wd = _named(wind, LAYOUT.wind)
+    vel_r = np.array([s["u"] - wd["u_g"], s["v"] - wd["v_g"], s["w"] - wd["w_g"]])
+    pr, qr, rr = s["p"] - wd["p_g"], s["q"] - wd["q_g"], s["r"] - wd["r_g"]
+    Va = np.linalg.norm(vel_r)
+    alpha = np.arctan2(vel_r[2], vel_r[0])
+    beta = np.arcsin(vel_r[1] / Va)
+    elevator = (s["left"] + s["right"]) / 2
+    aileron = (s["left"] - s["right"]) / 2
+    qbar = 0.5 * a["rho"] * Va ** 2
+    S, b, c = a["S"], a["b"], a["c"]
+    lift = qbar * S * (a["CL0"] + a["CLa"] * alpha + a["CLq"] * c / (2 * Va) * qr
+                       + a["CLde"] * elevator)
+    drag = qbar * S * (a["CD0"] + a["CDa"] * alpha + a["CDa2"] * alpha ** 2
+                       + a["C_D_beta1"] * beta + a["C_D_beta2"] * beta ** 2
+                       + a["CDde2"] * elevator ** 2)
+    pitch = qbar * S * c * (a["Cm0"] + a["Cma"] * alpha + a["Cmq"] * c / (2 * Va) * qr
+                            + a["Cmde"] * elevator)
+
+    def lateral(k):
+        return (a[f"C_{k}_0"] + a[f"C_{k}_beta"] * beta
+                + a[f"C_{k}_p"] * b / (2 * Va) * pr + a[f"C_{k}_r"] * b / (2 * Va) * rr
+                + a[f"C_{k}_delta_a"] * aileron)
+
+    side = qbar * S * lateral("Y")
+    roll = qbar * S * b * lateral("l")
+    yaw = qbar * S * b * lateral("n")
+    F_aero = rzyx(0.0, alpha, beta).T @ np.array([-drag, side, -lift])
+    Vd = Va + s["throttle"] * (a["k_motor"] - Va)
+    F_prop = np.array([0.5 * a["rho"] * a["S_prop"] * a["C_prop"] * Vd * (Vd - Va), 0, 0])
+    T_prop = np.array([-a["k_T_P"] * (a["k_Omega"] * s["throttle"]) ** 2, 0.0, 0.0])
+    return F_aero + F_prop, np.array([roll, pitch, yaw]) + T_prop, alpha, beta, Va
+
+
+def derivatives_ref(x, cmd, p, wind):
+    """``dx/dt`` (15): ``dynamics.m`` (``M_rb nu' = tau - C_rb nu``) plus the
+    reference point's velocity and three first-order actuators."""
+    s = _named(x, LAYOUT.states)
+    a = _named(p, LAYOUT.params)
+    u = _named(cmd, LAYOUT.commands)
+    F, M, _, _, _ = forces_ref(x, p, wind)
+    Theta = np.array([s["phi"], s["theta"], s["psi"]])
+    vel = np.array([s["u"], s["v"], s["w"]])
+    Omega = np.array([s["p"], s["q"], s["r"]])
+    R = rzyx(*Theta)
+    gravity = R.T @ np.array([0.0, 0.0, a["mass"] * a["g"]])
+    I = inertia(a)
+    M_rb = np.block([[a["mass"] * np.eye(3), np.zeros((3, 3))],
+                     [np.zeros((3, 3)), I]])
+    C_rb = np.block([[np.zeros((3, 3)), -a["mass"] * smtrx(vel)],
+                     [-a["mass"] * smtrx(vel), -smtrx(I @ Omega)]])
+    tau = np.concatenate([F + gravity, M])
+    nu_dot = np.linalg.solve(M_rb, tau - C_rb @ np.concatenate([vel, Omega]))
+    ref = a["V0"] * np.array([np.cos(a["gamma0"]), 0.0, -np.sin(a["gamma0"])])
+    pos_dot = R @ vel - ref
+    Theta_dot = euler_rates_matrix(s["phi"], s["theta"]) @ Omega
+    tau_act = {"throttle": a["tau_thrust"], "left": a["tau_elevon"],
+               "right": a["tau_elevon"]}
+    act = [(u[n] - s[n]) / tau_act[n] for n in LAYOUT.actuators]
+    named = dict(zip(("x", "y", "z"), pos_dot))
+    named.update(zip(("phi", "theta", "psi"), Theta_dot))
+    named.update(zip(("u", "v", "w", "p", "q", "r"), nu_dot))
+    named.update(zip(LAYOUT.actuators, act))
+    return np.array([named[n] for n in LAYOUT.states])
+
+
+def outputs_ref(x, p, wind):
+    """The 19 outputs: rigid-body states, specific forces over g (n_z up),
+    alpha, beta, the air-path angle (from the air-relative velocity rotated
+    to NED) and Va."""
+    s = _named(x, LAYOUT.states)
+    a = _named(p, LAYOUT.params)
+    F, _, alpha, beta, Va = forces_ref(x, p, wind)
+    mg = a["mass"] * a["g"]
+    # air-relative velocity in NED, from alpha and beta
+    v_air = Va * np.array([np.cos(alpha) * np.cos(beta), np.sin(beta),
+                           np.sin(alpha) * np.cos(beta)])
+    v_ned = rzyx(s["phi"], s["theta"], s["psi"]) @ v_air
+    named = {n: s[n] for n in LAYOUT.rigid}
+    named.update(n_x=F[0] / mg, n_y=F[1] / mg, n_z=-F[2] / mg, alpha=alpha, beta=beta,
+                 gamma=np.arcsin(-v_ned[2] / Va), Va=Va)
+    return np.array([named[n] for n in LAYOUT.outputs])
+
+
+def rk4_ref(x, cmd, p, wind, dt, n_sub):
+    """``n_sub`` classical RK4 steps over ``dt`` with commands and wind held."""
+    def f(s):
+        return derivatives_ref(s, cmd, p, wind)
+
+    h = dt / n_sub
+    x = np.array(x, dtype=float)
+    for _ in range(n_sub):
+        k1 = f(x)
+        k2 = f(x + h / 2 * k1)
+        k3 = f(x + h / 2 * k2)
+        k4 = f(x + h * k3)
+        x = x + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+    return x
