@@ -221,7 +221,7 @@ DrydenLateralModel.__doc__ = """Discrete lateral Dryden gust model (see
 :func:`dryden_lateral_model`).
 
 Ad, Bd (4, 4), Cd (3, 4): the same recursion as the longitudinal model
-(:func:`ftc_mc.core.dryden.gust_step` runs both), outputs ``v_g`` [m/s],
+(:func:`ftc_mc.core.shared.dryden.gust_step` runs both), outputs ``v_g`` [m/s],
 ``p_g``, ``r_g`` [rad/s]; states ``[s_v1, s_v2, s_r, s_p]``.
 P0, P0_chol: stationary state covariance and its Cholesky factor.
 Ac, Bc (4, 2), Cc: continuous shaping filters (noise inputs eta_v, eta_p).
