@@ -7,7 +7,7 @@ with Q- and R-sized noise (so resets are as rare as in a nominal flight).
 One *filter step* is predict, residuals, Table 1, reset and re-prediction when
 it fires, update and projection.  Measured:
 
-a. ``ftc_mc.core.longitudinal.step.filter_step`` called from a ``@njit`` loop;
+a. ``tests/single_trajectory.py::filter_step`` called from a ``@njit`` loop;
 b. the plain-NumPy twin ``tests/naive.py::filter_step_ref`` (textbook: explicit
    ``A_aug`` and ``C_aug``, ``S = C P C^T + R``, ``K = P C^T S^-1``, Joseph form);
 c. filterpy's ``KalmanFilter`` (``kf.F = A_aug(u)`` every step, ``predict`` /
@@ -46,10 +46,10 @@ sys.path.insert(0, str(ROOT / "tests"))
 import naive  # noqa: E402
 from filterpy.kalman import KalmanFilter  # noqa: E402
 
-from ftc_mc.batch_workspace import lane_zeros, new_lane_workspace  # noqa: E402
+from lane_workspace import lane_zeros, new_lane_workspace  # noqa: E402
 from ftc_mc.core.longitudinal.batch import filter_step_lanes  # noqa: E402
-from ftc_mc.core.longitudinal.step import filter_step  # noqa: E402
-from ftc_mc.sim.estimator import (EstimatorSettings, Workspace, detection,  # noqa: E402
+from single_trajectory import Workspace, filter_step  # noqa: E402
+from ftc_mc.sim.estimator import (EstimatorSettings, detection,  # noqa: E402
                                   filter_model, initial_covariance)
 from ftc_mc.model.faults import augmented  # noqa: E402
 from ftc_mc.model.linear import build_plant  # noqa: E402

@@ -392,7 +392,7 @@ def glr_ref(newest_first, m_min=1):
 
 
 def filter_step_ref(X, P, u, z, model, stat=None, gate=None):
-    """One estimator step in ``ftc_mc.core.longitudinal.step.filter_step``'s order:
+    """One estimator step in ``tests/single_trajectory.py::filter_step``'s order:
     predict, residuals, Table 1; on a reset, reset the block of ``P_{k|k}`` and
     predict again; update, projection.  ``stat``: a function of the signed
     innovations giving the decision statistics (the GLR test); ``None`` for

@@ -14,12 +14,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from ftc_mc.batch_workspace import LaneWorkspace, new_lane_workspace
+from lane_workspace import LaneWorkspace, new_lane_workspace
 from ftc_mc.core.longitudinal import batch as kb
-from ftc_mc.core.longitudinal import kalman as kk
+import single_trajectory as kk
 from ftc_mc.core.longitudinal import signature as ks
-from ftc_mc.core.longitudinal.step import filter_step
-from ftc_mc.sim.estimator import (EstimatorSettings, Workspace, detection, filter_model,
+from single_trajectory import Workspace, filter_step
+from ftc_mc.sim.estimator import (EstimatorSettings, detection, filter_model,
                                   initial_covariance, unit_rows)
 from ftc_mc.model.linear import build_plant
 
@@ -200,7 +200,7 @@ def test_reset_lanes(plant):
     kb.reset_lanes(P, blocks, det.reset_var)
     for l, b in enumerate(blocks):
         P1 = Ps[l].copy()
-        ks.reset_covariance(P1, int(b), det.reset_var)
+        kk.reset_covariance(P1, int(b), det.reset_var)
         assert np.array_equal(P[:, :, l], P1)
 
 

@@ -19,10 +19,10 @@ from hypothesis import strategies as st
 import naive
 from ftc_mc.core.shared import belief as kb
 from ftc_mc.core.shared import excitation as ke
-from ftc_mc.core.longitudinal import kalman as kk
+import single_trajectory as kk
 from ftc_mc.core.longitudinal import signature as ks
-from ftc_mc.core.longitudinal.step import filter_step
-from ftc_mc.sim.estimator import (PAPER_R_DIAG, EstimatorSettings, Workspace, belief_settings,
+from single_trajectory import Workspace, filter_step
+from ftc_mc.sim.estimator import (PAPER_R_DIAG, EstimatorSettings, belief_settings,
                                   detection, filter_model, initial_covariance, unit_rows)
 from ftc_mc.model.faults import bias_matrix
 from ftc_mc.model.linear import build_plant
@@ -306,7 +306,7 @@ def test_reset_covariance(plant, seed, block, t_q, t_nx):
     assert_close(det.reset_var, ref_var, what="reset variances")
     P = random_spd(np.random.default_rng(seed))
     Pk = P.copy()
-    ks.reset_covariance(Pk, block, det.reset_var)
+    kk.reset_covariance(Pk, block, det.reset_var)
     assert_close(Pk, naive.reset_ref(P, block, ref_var), what=f"reset block {block}")
     assert np.array_equal(Pk, Pk.T)
 

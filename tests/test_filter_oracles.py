@@ -20,10 +20,10 @@ from filterpy.kalman import KalmanFilter
 import naive
 from ftc_mc.core.shared.belief import belief_update
 from ftc_mc.core.shared.excitation import saturate, signal_3211
-from ftc_mc.core.longitudinal.kalman import predict, update
+from single_trajectory import predict, update
 from ftc_mc.core.longitudinal.signature import NO_RESET, RESET_ELEVONS, RESET_THRUST
-from ftc_mc.core.longitudinal.step import filter_step
-from ftc_mc.sim.estimator import (EstimatorSettings, Workspace, belief_settings, detection,
+from single_trajectory import Workspace, filter_step
+from ftc_mc.sim.estimator import (EstimatorSettings, belief_settings, detection,
                                   filter_model, initial_covariance)
 from ftc_mc.model.faults import augmented, effect
 from ftc_mc.model.linear import build_plant

@@ -5,7 +5,7 @@ import pytest
 from numba import njit
 
 from ftc_mc.core.shared.belief import belief_update
-from ftc_mc.core.longitudinal.step import filter_step
+from single_trajectory import filter_step
 from ftc_mc.sim.estimator import (EstimatorSettings, belief_settings, detection, filter_model)
 
 

@@ -32,6 +32,7 @@ import numpy as np
 import pytest
 
 import naive
+import single_trajectory
 from ftc_mc.sim.setup import build_setup
 from ftc_mc.conventions import (C_ELEVON, C_ENGINE, C_NOMINAL, I_B0_ELEVONS, I_B0_THRUST,
                                 I_B1_LEFT, I_B1_RIGHT, I_B1_THRUST, N_AUG, N_CONTROLLERS, N_X,
@@ -42,8 +43,7 @@ from ftc_mc.core.longitudinal import plant as kplant
 from ftc_mc.core.longitudinal import stages
 from ftc_mc.core.longitudinal import trial
 from ftc_mc.core.longitudinal.settings import LaneState, TrialInputs, TrialRecord
-from ftc_mc.core.longitudinal.workspace import (new_lane_selection_work, new_selection_work,
-                                                new_trial_work)
+from ftc_mc.core.longitudinal.workspace import new_lane_selection_work, new_trial_work
 from ftc_mc.config import Config
 from ftc_mc.sim.paths import path_of
 
@@ -274,7 +274,7 @@ def test_horizon_cost(linear, c):
     covariance after H zero-innovation updates to the update tolerance."""
     rng = np.random.default_rng(20 + c)
     scheme = scheme_of(linear)
-    work = new_selection_work(N_AUG)
+    work = single_trajectory.new_selection_work(N_AUG)
     assert scheme.reconfig.horizon >= 5
     saturated = 0
     for _ in range(8):
@@ -282,7 +282,7 @@ def test_horizon_cost(linear, c):
         if _ == 0:
             X[:N_X] *= 40.0  # far from trim: the commands saturate
         xs, Ps = X.copy(), P.copy()
-        cost = control.horizon_cost(c, xs, Ps, scheme, work)
+        cost = single_trajectory.horizon_cost(c, xs, Ps, scheme, work)
         cost_n, Xn, Pn = naive.horizon_cost_ref(c, X, P, scheme)
         assert abs(cost - cost_n) <= 1e-12 * abs(cost_n), (cost, cost_n)
         assert rel(xs, Xn) <= 1e-12
@@ -296,7 +296,7 @@ def test_select_controller(linear):
     current controllers that make each controller win somewhere."""
     rng = np.random.default_rng(30)
     scheme = scheme_of(linear)
-    work = new_selection_work(N_AUG)
+    work = single_trajectory.new_selection_work(N_AUG)
     chosen = set()
     for i in range(12):
         X, P = selection_case(linear, rng)
@@ -304,7 +304,7 @@ def test_select_controller(linear):
         belief[i % 4] = 1.0
         belief /= belief.sum()
         current = (i // 4) % N_CONTROLLERS
-        got = control.select_controller(current, X, P, belief, scheme, work)
+        got = single_trajectory.select_controller(current, X, P, belief, scheme, work)
         want, obj = naive.select_controller_ref(current, X, P, belief, scheme)
         assert np.all(np.isfinite(obj))
         assert np.all(np.abs(work.obj - obj) <= 1e-12 * np.abs(obj)), (work.obj, obj)
@@ -317,14 +317,14 @@ def test_select_controller(linear):
 @pytest.mark.parametrize("n_lanes", [L, 24])
 def test_select_controllers_lanes_is_the_single_lane_kernel(linear, n_lanes):
     """The lane-interleaved selection (used by the reconfigure stage) gives every
-    lane's objectives and choice bit for bit as :func:`control.select_controller`
+    lane's objectives and choice bit for bit as :func:`single_trajectory.select_controller`
     on that lane alone: same operations in the same order, zero-innovation
     updates included.  Lanes far from trim (saturating), in every mode's box,
     with every controller in use, and one non-finite (stopped) lane that must
     not disturb the others."""
     rng = np.random.default_rng(31)
     scheme = scheme_of(linear)
-    work = new_selection_work(N_AUG)
+    work = single_trajectory.new_selection_work(N_AUG)
     lw = new_lane_selection_work(n_lanes, N_AUG)
     chosen = set()
     for rep in range(3):
@@ -342,7 +342,7 @@ def test_select_controllers_lanes_is_the_single_lane_kernel(linear, n_lanes):
         want_cur = cur.copy()
         want_obj = np.zeros((N_CONTROLLERS, n_lanes))
         for l in range(n_lanes):
-            want_cur[l] = control.select_controller(int(cur[l]), xa[:, l].copy(),
+            want_cur[l] = single_trajectory.select_controller(int(cur[l]), xa[:, l].copy(),
                                                     P[:, :, l].copy(), belief[:, l].copy(),
                                                     scheme, work)
             want_obj[:, l] = work.obj

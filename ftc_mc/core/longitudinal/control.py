@@ -7,7 +7,7 @@ Controllers (command deviations before the saturation and excitation of eq. 15):
   4.1's gain and affine term interpolated in the offline tables (eq. 44);
 * ``c2`` redundant-elevon fault: thrust ``-K_1 x_hat``, elevons by the
   minimum-norm allocation of eqs. 20-25 (eq. 25 corrected, see
-  :func:`ftc_mc.design.theorem41.elevon_allocation`).
+  :func:`elevon_allocation`).
 
 Selection (eqs. 45-47), every reconfiguration period: for each controller ``a``
 the estimate and covariance are predicted ``H`` steps ahead with ``a`` in the
@@ -21,7 +21,7 @@ The trial loop selects for all its lanes at once
 (:func:`select_controllers_lanes`): each controller's horizon is predicted for
 every lane with the lane-interleaved filter kernels of :mod:`ftc_mc.core.longitudinal.batch`,
 then belief and objective follow per lane.  Per lane this is
-:func:`select_controller` bit for bit (``tests/test_stages.py``); measured on a
+``tests/single_trajectory.py::select_controller`` bit for bit (``tests/test_stages.py``); measured on a
 chunk of 128 lanes of ``configs/paper_tables.yaml``, one core: 2.9 ms per
 selection against 9.3 ms one lane at a time (of which the measurement updates
 take about 60 %, the predictions 35 %).
@@ -42,7 +42,6 @@ from ..shared.excitation import saturate
 from ..shared.interp import engine_controller
 from ..jit import kernel
 from .batch import predict_lanes, project_lanes, update_lanes
-from .kalman import predict, project, update
 
 from ...conventions import (C_ELEVON, C_ENGINE, C_NOMINAL, I_B0_ELEVONS,  # noqa: F401
                            I_B0_THRUST, I_B1_LEFT, I_B1_RIGHT, I_B1_THRUST, INPUT_NAMES,
@@ -56,7 +55,25 @@ U_RIGHT = INPUT_NAMES.index("elevon_right")
 
 @kernel
 def elevon_allocation(K2x, b0e, b1L, b1R, u0L, u0R):
-    """Minimum-norm elevon commands with ``Phi = 0`` (eqs. 20-25, eq. 25 corrected).
+    """Minimum-norm elevon commands under a redundant-elevon fault (eqs. 20-25).
+
+    Solves (24): ``min 1/2 (U2^2 + U3^2)`` s.t. ``Phi = 0`` (eq. 22) with
+
+        Phi = 2 K2 x + b0e + (1 - b1L) U2 - b1L u0L + (1 - b1R) U3 - b1R u0R,
+
+    i.e. the summed elevon effect equals the nominal ``-2 K2 x`` (eq. 20).  With
+    ``a = (1 - b1L, 1 - b1R)`` and ``c = 2 K2 x + b0e - b1L u0L - b1R u0R`` the
+    Lagrange conditions give ``U = -lambda a``, ``lambda = c / |a|^2``:
+    ``U2 = -lambda (1 - b1L)``, ``U3 = -lambda (1 - b1R)``.
+
+    **Correction of eq. 25**: the paper prints ``U3 = -lambda (1 - b1^2)``, which
+    violates ``Phi = 0`` whenever ``b1^2 != b1^3`` (e.g. a locked left elevon,
+    ``b1^2 = 1``, would give ``U3 = 0``).  The ``lambda`` printed below eq. 25 is
+    right.  When both elevons are fully ineffective (``|a| = 0``) the constraint
+    cannot be met; the minimum-norm least-squares answer ``U2 = U3 = 0`` is
+    returned.  The estimator carries a single elevon bias, the **sum**
+    ``b0e = b0_L + b0_R`` (:mod:`ftc_mc.model.faults`); eq. 22 only needs that
+    sum (the paper's ``b0^2``).
 
     Parameters
     ----------
@@ -81,6 +98,30 @@ def elevon_allocation(K2x, b0e, b1L, b1R, u0L, u0R):
         return 0.0, 0.0
     lam = (2.0 * K2x + b0e - b1L * u0L - b1R * u0R) / den
     return -lam * aL, -lam * aR
+
+
+@kernel(inline="always")
+def feedback_lanes(K, x, U):
+    """The nominal feedback ``U = -K x`` (eq. 19) of every lane: the one loop of
+    c0 and of c2's nominal part, in the trial loop and in the selection.
+
+    Parameters
+    ----------
+    K : ndarray, shape (3, 9)
+        Nominal gain.
+    x : ndarray, shape (n, L)
+        Estimates (their first 9 states are read).
+    U : ndarray, shape (3, L)
+        Written with the command deviations.
+    """
+    L = x.shape[1]
+    for i in range(N_U):
+        for l in range(L):
+            U[i, l] = 0.0
+        for j in range(N_X):
+            kij = K[i, j]
+            for l in range(L):
+                U[i, l] -= kij * x[j, l]
 
 
 @kernel
@@ -117,155 +158,6 @@ def controller_command(c, xa, K, eng, u0, U):
 
 
 @kernel
-def horizon_cost(c, xs, Ps, scheme, work):
-    """Predict ``H`` steps with controller ``c``; return the discounted cost (eq. 45).
-
-    ``I(c) = sum_{k'=1..H} alpha^k' (x_k'^T Q_lqr x_k' + u_k'^T R_lqr u_k')`` on
-    the predicted state and the saturated commands (eq. 16); ``xs`` and ``Ps``
-    are advanced in place to ``X_{k+H|k}`` and ``P_{k+H|k+H}`` (zero
-    innovations: each step is a prediction, a measurement update with the
-    predicted measurement, and the projection of eqs. 6-8).
-
-    Parameters
-    ----------
-    c : int
-        Controller (``C_NOMINAL``, ``C_ENGINE``, ``C_ELEVON``).
-    xs : ndarray, shape (n,)
-        Augmented estimate, advanced in place.
-    Ps : ndarray, shape (n, n)
-        Its covariance, advanced in place.
-    scheme : Scheme
-        Reads ``filter``, ``controller`` (gain and limits), ``reconfig``
-        (``horizon``, ``alpha``, ``q_lqr``, ``r_lqr``) and ``engine``.
-    work : SelectionWork
-        Scratch (``U``, ``z``, ``h``, ``phi``, ``T``).
-
-    Returns
-    -------
-    float
-        The discounted short-horizon cost.
-    """
-    ctl = scheme.controller
-    return _predicted_cost(c, xs, Ps, scheme.filter, scheme.reconfig, scheme.engine, ctl.K,
-                           ctl.lo_dev, ctl.hi_dev, work.U, work.z, work.h, work.phi, work.T)
-
-
-@kernel
-def _predicted_cost(c, xs, Ps, fm, rc, eng, K, lo, hi, U, z, h, phi, T):
-    """The loop of :func:`horizon_cost` on unpacked settings and scratch.
-
-    The settings are unpacked once, outside the loop: reading them from the
-    whole ``Scheme`` inside it made the reconfiguring trial about 8 % slower
-    (128 lanes of ``configs/paper_tables.yaml``, one core).
-    """
-    cost = 0.0
-    disc = 1.0
-    for _ in range(rc.horizon):
-        controller_command(c, xs, K, eng, fm.u0, U)
-        for i in range(N_U):
-            U[i] = saturate(U[i], 0.0, 0.0, lo[i], hi[i])
-        predict(xs, Ps, U, fm, phi, T)
-        for r in range(z.shape[0]):
-            s = fm.c_ident[r]
-            if s >= 0:
-                z[r] = xs[s]
-            else:
-                acc = 0.0
-                for j in range(N_X):
-                    acc += fm.C[r, j] * xs[j]
-                z[r] = acc
-        update(xs, Ps, z, fm, h)
-        project(xs, fm)
-        disc *= rc.alpha
-        stage = 0.0
-        for j in range(N_X):
-            stage += rc.q_lqr[j] * xs[j] * xs[j]
-        for i in range(N_U):
-            stage += rc.r_lqr[i] * U[i] * U[i]
-        cost += disc * stage
-    return cost
-
-
-@kernel
-def controller_objectives(current, xa, P, belief, scheme, work):
-    """The objective of eq. (47) for every controller, into ``work.obj``.
-
-    ``obj(a) = I(a) + sum_m b_{k+H|k+H}(m) (J^N(m, a) + P(c, a))``: the
-    short-horizon cost (eq. 45, :func:`horizon_cost`), the belief updated with
-    the predicted fault parameters and their variances (eqs. 12-14), the
-    terminal cost and the switching penalty (eq. 46).
-
-    Parameters
-    ----------
-    current : int
-        Controller in use ``c`` (for the switching penalty ``P(c, a)``).
-    xa : ndarray, shape (n,)
-        Augmented estimate.
-    P : ndarray, shape (n, n)
-        Its covariance.
-    belief : ndarray, shape (4,)
-        Current mode probabilities.
-    scheme : Scheme
-        Reads ``filter``, ``belief``, ``controller``, ``reconfig`` and ``engine``.
-    work : SelectionWork
-        Scratch; ``work.obj`` (3,) is written.
-    """
-    n = xa.shape[0]
-    rc = scheme.reconfig
-    xs = work.xs
-    Ps = work.Ps
-    bl = work.belief
-    bv = work.bvar
-    for a in range(N_CONTROLLERS):
-        for i in range(n):
-            xs[i] = xa[i]
-            for j in range(n):
-                Ps[i, j] = P[i, j]
-        obj = horizon_cost(a, xs, Ps, scheme, work)
-        for m in range(N_MODES):
-            bl[m] = belief[m]
-        for j in range(N_FAULT):
-            bv[j] = Ps[N_X + j, N_X + j]
-        belief_update(bl, scheme.belief, xs[N_X:N_X + N_FAULT], bv, work.bwork)
-        for m in range(N_MODES):
-            obj += bl[m] * (rc.JN[m, a] + rc.penalty[current, a])
-        work.obj[a] = obj
-
-
-@kernel
-def select_controller(current, xa, P, belief, scheme, work):
-    """Rolling-horizon choice of the controller (eqs. 45-47) for one trajectory.
-
-    The controller with the smallest objective of :func:`controller_objectives`
-    (the first of equal ones); the current one when no objective is finite.
-
-    Parameters
-    ----------
-    current : int
-        Controller in use (for the switching penalty ``P(c, a)``).
-    xa : ndarray, shape (n,)
-    P : ndarray, shape (n, n)
-    belief : ndarray, shape (4,)
-        Current mode probabilities.
-    scheme : Scheme
-    work : SelectionWork
-
-    Returns
-    -------
-    int
-        The selected controller.
-    """
-    controller_objectives(current, xa, P, belief, scheme, work)
-    best = current
-    best_obj = math.inf
-    for a in range(N_CONTROLLERS):
-        if work.obj[a] < best_obj:
-            best_obj = work.obj[a]
-            best = a
-    return best
-
-
-@kernel
 def _lane_commands(c, xs, K, eng, u0, lo, hi, U, xl, Ul):
     """Saturated command of controller ``c`` for every lane of ``xs`` (eq. 16).
 
@@ -275,13 +167,7 @@ def _lane_commands(c, xs, K, eng, u0, lo, hi, U, xl, Ul):
     """
     L = xs.shape[1]
     if c != C_ENGINE:
-        for i in range(N_U):
-            for l in range(L):
-                U[i, l] = 0.0
-            for j in range(N_X):
-                kij = K[i, j]
-                for l in range(L):
-                    U[i, l] -= kij * xs[j, l]
+        feedback_lanes(K, xs, U)
         if c == C_ELEVON:
             for l in range(L):
                 U[U_LEFT, l], U[U_RIGHT, l] = elevon_allocation(
@@ -309,8 +195,8 @@ def _predicted_cost_lanes(c, xs, Ps, fm, rc, eng, K, lo, hi, sw):
     Lane ``l`` goes through the same floating-point operations, in the same
     order, as :func:`_predicted_cost` on ``xs[:, l]``, ``Ps[:, :, l]``: the
     lane kernels of :mod:`ftc_mc.core.longitudinal.batch` are bit-identical per lane to
-    :func:`~ftc_mc.core.longitudinal.kalman.predict`, :func:`~ftc_mc.core.longitudinal.kalman.update` and
-    :func:`~ftc_mc.core.longitudinal.kalman.project`.  The discounted cost of each lane is
+    ``tests/single_trajectory.py::predict``, ``tests/single_trajectory.py::update`` and
+    ``tests/single_trajectory.py::project``.  The discounted cost of each lane is
     written to ``sw.cost``.
     """
     L = xs.shape[1]
@@ -402,7 +288,7 @@ def controller_objectives_lanes(cur, xa, P, belief, scheme, sw):
 
 @kernel(inline="always")
 def select_controllers_lanes(cur, xa, P, belief, scheme, sw):
-    """:func:`select_controller` for every lane; ``cur`` is updated in place.
+    """``tests/single_trajectory.py::select_controller`` for every lane; ``cur`` is updated in place.
 
     Parameters are those of :func:`controller_objectives_lanes`.
     """

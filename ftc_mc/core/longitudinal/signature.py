@@ -12,8 +12,8 @@ rule sends to the thrust block; see ``docs/paper-map.md``).
 
 from __future__ import annotations
 
-from ...conventions import (ELEVON_BLOCK, N_FAULT, N_X, NO_RESET,  # noqa: F401
-                           RESET_ELEVONS, RESET_THRUST, THRUST_BLOCK)
+from ...conventions import (ELEVON_BLOCK, NO_RESET, RESET_ELEVONS,  # noqa: F401
+                           RESET_THRUST, THRUST_BLOCK)
 from ..jit import kernel
 
 
@@ -67,31 +67,3 @@ def signature(r_q, r_nx, r_nz, t_q, t_nx, swapped):
     return NO_RESET
 
 
-@kernel
-def reset_covariance(P, block, reset_var):
-    """Reset one fault block of a covariance (section 3.2.2; the filter step
-    applies it to ``P_{k|k}``, see :mod:`ftc_mc.core.longitudinal.step`).
-
-    The rows and columns of the block's fault parameters are zeroed and their
-    variances set to ``reset_var``: thrust ``((u_max - u_min)/t_nx)^2`` for b0 and
-    ``1/t_nx^2`` for b1; elevons the same with ``t_q``.
-
-    Parameters
-    ----------
-    P : ndarray, shape (n, n)
-        Updated in place; the fault parameters are entries ``N_X .. N_X + 4``.
-    block : int
-        ``RESET_THRUST`` or ``RESET_ELEVONS`` (``NO_RESET`` does nothing).
-    reset_var : ndarray, shape (5,)
-        Variance of each fault parameter after its block is reset.
-    """
-    if block != RESET_THRUST and block != RESET_ELEVONS:
-        return
-    n = P.shape[0]
-    for j in range(N_FAULT):
-        if in_block(j, block):
-            i = N_X + j
-            for k in range(n):
-                P[i, k] = 0.0
-                P[k, i] = 0.0
-            P[i, i] = reset_var[j]

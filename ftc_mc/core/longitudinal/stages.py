@@ -42,7 +42,8 @@ from .batch import (filter_correct_lanes, filter_predict_lanes, innovations_lane
 from ..shared.glr import glr_lanes, glr_restart
 from .gustfilter import gust_correct_lanes, gust_predict_lanes
 from ..shared.belief import belief_update
-from .control import (U_LEFT, U_RIGHT, U_THRUST, controller_command, select_controllers_lanes)
+from .control import (U_LEFT, U_RIGHT, U_THRUST, controller_command, feedback_lanes,
+                      select_controllers_lanes)
 from ..shared.excitation import (doublet, doublet_length, running, saturate, signal_3211,
                                  signal_3211_length)
 from ..jit import kernel
@@ -58,18 +59,8 @@ R_Q, R_NX = 0, 1
 @kernel(inline="always")
 def nominal_output(scheme, st, work):
     """The nominal controller's output ``U = -K x_hat`` (c0, eq. 19) of every
-    lane into ``work.u``."""
-    K = scheme.controller.K
-    xa = st.xa
-    u = work.u
-    L = xa.shape[1]
-    for i in range(N_U):
-        for l in range(L):
-            u[i, l] = 0.0
-        for j in range(N_X):
-            kij = K[i, j]
-            for l in range(L):
-                u[i, l] -= kij * xa[j, l]
+    lane into ``work.u`` (:func:`ftc_mc.core.longitudinal.control.feedback_lanes`)."""
+    feedback_lanes(scheme.controller.K, st.xa, work.u)
 
 
 @kernel(inline="always")
@@ -527,7 +518,7 @@ def reconfigure(path, scheme, timing, inp, st, kn, period, work, rec):
     path the controller selection (eqs. 45-47, :func:`select`) on the
     estimate's first 14 states (a design's gust states are left out), for every
     lane at once (:func:`ftc_mc.core.longitudinal.control.select_controllers_lanes`, per
-    lane bit-identical to :func:`~ftc_mc.core.longitudinal.control.select_controller`; the
+    lane bit-identical to ``tests/single_trajectory.py::select_controller``; the
     horizon predictions run lane-interleaved, about 4x faster than one lane at
     a time); and the detection time: the
     first period end after the switch ``k_fault`` where the final mode is the

@@ -6,7 +6,7 @@ state of a trial (:class:`~ftc_mc.core.longitudinal.settings.LaneState`) and its
 lane arrays (lane index last, see :mod:`ftc_mc.core.longitudinal.batch`) that one stage
 writes and the next reads, and small one-lane buffers for the kernels that run
 a lane at a time (nonlinear plant, belief, controller selection).
-:class:`SelectionWork` is the scratch of :func:`ftc_mc.core.longitudinal.control.select_controller`.
+:class:`LaneSelectionWork` is the scratch of :func:`ftc_mc.core.longitudinal.control.select_controllers_lanes`.
 
 Every size comes from :mod:`ftc_mc.conventions` or from the augmented dimension
 ``n`` passed in (taken from the state's arrays), never from a literal.  The
@@ -33,20 +33,6 @@ value on the engine, the 3211 value on the left elevon (minus on the right),
 then 1.0 on the step where each signal started."""
 N_EXC = 4
 
-SelectionWork = namedtuple("SelectionWork", [
-    "xs",      # (n,) estimate predicted over the horizon
-    "Ps",      # (n, n) its covariance
-    "belief",  # (N_MODES,) belief updated with the prediction (eq. 47)
-    "U",       # (N_U,) command of the controller under test
-    "z",       # (N_Z,) predicted measurement (zero innovation)
-    "h",       # (n,) gain of one scalar update (kalman.update)
-    "bvar",    # (N_FAULT,) predicted variances of the fault parameters
-    "bwork",   # (2 N_MODES,) work of belief.belief_update
-    "phi",     # (N_X, N_FAULT) Phi(u) (kalman.predict)
-    "T",       # (N_X, n) [A Phi] P (kalman.predict)
-    "obj",     # (N_CONTROLLERS,) objective of each controller (eq. 47)
-])
-"""Scratch of the rolling-horizon controller selection (paper eqs. 45-47)."""
 
 LaneSelectionWork = namedtuple("LaneSelectionWork", [
     # lane arrays (lane index last)
@@ -94,7 +80,6 @@ TrialWork = namedtuple("TrialWork", [
     "jc",         # (n, L) a row of its C_aug per lane, [JC_r, 0, JHW_r C_d]
     # one lane at a time
     "xl",         # (n,) a lane's estimate
-    "Pl",         # (n, n) a lane's covariance
     "Ul",         # (N_U,) a lane's command
     "chol",       # (n, n) Cholesky factor of the positive-definiteness test
     "crow",       # (n,) a row of the gust-aware filter's C_aug
@@ -109,20 +94,9 @@ TrialWork = namedtuple("TrialWork", [
     "bhat",       # (N_FAULT,) a lane's fault-parameter estimate
     "bvar",       # (N_FAULT,) its marginal variances
     "bwork",      # (2 N_MODES,) work of belief.belief_update
-    "sel",        # SelectionWork
     "lsel",       # LaneSelectionWork
 ])
 """Scratch of one :func:`ftc_mc.core.longitudinal.trial.advance` call (see module docstring)."""
-
-
-@kernel
-def new_selection_work(n):
-    """Zeroed :class:`SelectionWork` for an augmented dimension ``n``."""
-    return SelectionWork(xs=np.zeros(n), Ps=np.zeros((n, n)), belief=np.zeros(N_MODES),
-                         U=np.zeros(N_U), z=np.zeros(N_Z), h=np.zeros(n),
-                         bvar=np.zeros(N_FAULT), bwork=np.zeros(2 * N_MODES),
-                         phi=np.zeros((N_X, N_FAULT)), T=np.zeros((N_X, n)),
-                         obj=np.zeros(N_CONTROLLERS))
 
 
 @kernel
@@ -152,10 +126,10 @@ def new_trial_work(L, n):
         xsel=np.zeros((N_AUG, L)), Psel=np.zeros((N_AUG, N_AUG, L)),
         finite=np.zeros(L, dtype=np.bool_),
         jg=np.zeros((N_X, max(n - N_AUG, 0), L)), jc=np.zeros((n, L)),
-        xl=np.zeros(n), Pl=np.zeros((n, n)), Ul=np.zeros(N_U), chol=np.zeros((n, n)),
+        xl=np.zeros(n), Ul=np.zeros(N_U), chol=np.zeros((n, n)),
         crow=np.zeros(n),
         gust=np.zeros(N_GUST_STATE), eta=np.zeros(N_GUST_NOISE), wl=np.zeros(N_GUST_OUT),
         xabs=np.zeros(N_X), cmd=np.zeros(N_U), y=np.zeros(N_Z),
         rk4=np.zeros((N_WORK, N_X)), bl=np.zeros(N_MODES), bhat=np.zeros(N_FAULT),
-        bvar=np.zeros(N_FAULT), bwork=np.zeros(2 * N_MODES), sel=new_selection_work(N_AUG),
+        bvar=np.zeros(N_FAULT), bwork=np.zeros(2 * N_MODES),
         lsel=new_lane_selection_work(L, N_AUG))

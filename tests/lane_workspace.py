@@ -1,6 +1,7 @@
 """Work arrays of the lane-interleaved filter kernels (:mod:`ftc_mc.core.longitudinal.batch`).
 
-Lives outside ``core/`` because ``core/`` holds only kernels.
+The benchmark (``scripts/bench_core.py``) and the tests of the lane filter
+use them; the trial loop has its own (``core/longitudinal/workspace.py``).
 
 Alignment matters: the kernels load and store 64-byte vectors along the lane
 axis, and a lane row that does not start on a 64-byte boundary splits every
@@ -17,8 +18,8 @@ from collections import namedtuple
 
 import numpy as np
 
-from .conventions import N_AUG, N_FAULT, N_X, RESIDUAL_NAMES
-from .core.longitudinal.batch import step_rows
+from ftc_mc.conventions import N_AUG, N_FAULT, N_X, RESIDUAL_NAMES
+from ftc_mc.core.longitudinal.batch import step_rows
 
 ALIGN = 64
 """Byte alignment of the arrays made here (one cache line, one AVX-512 vector)."""
