@@ -1,8 +1,8 @@
 """One compile of each path of the trial kernel at a time per kernel cache.
 
 A cold compile of a path of :func:`ftc_mc.core.longitudinal.trial.advance`
-(``core/shared/paths.py``) takes from a quarter of a minute to a minute
-(``scripts/bench_campaign.py``).  Processes that start together on an empty
+(``core/shared/paths.py``) takes tens of seconds (``scripts/bench_campaign.py``,
+``docs/performance.md`` lesson 11).  Processes that start together on an empty
 cache (two runs launched at once, Dask or test workers on one machine) would
 each compile it, on cores they then share.  :func:`compiled_once` makes the
 first one compile while the others wait for it and then load the result from
@@ -29,8 +29,9 @@ WAIT_NOTICE = ("ftc-mc: another process is compiling the simulation kernels; wai
 """Printed to stderr when the compile lock is busy."""
 
 WAIT_LIMIT_S = 900.0
-"""Longest wait for another process's compile [s] (a cold compile takes about
-1.5 minutes); a holder stopped for longer is no longer waited for."""
+"""Longest wait for another process's compile [s] (a path's cold compile takes
+minutes at most, ``docs/performance.md`` lesson 11); a holder stopped for longer
+is no longer waited for."""
 
 GAVE_UP_NOTICE = ("ftc-mc: the other process has not finished compiling after {:.0f} s; "
                   "compiling here")

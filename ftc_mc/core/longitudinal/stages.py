@@ -24,11 +24,10 @@ Each stage has a plain-NumPy twin in ``tests/naive.py`` (same name with
 ``_ref``), compared in ``tests/test_stages.py``.
 
 The stages are compiled inline into ``advance`` (``inline="always"``, Numba IR
-inlining), so the loop runs as one function: measured on 128 lanes of
-``configs/paper_tables.yaml``, the nominal linear trial was 3 % slower with the
-stages as separate calls, and the cold compile of the campaign kernels took
-57 s against 62 s for the former single-function loop.  They remain callable
-on their own (the tests do).
+inlining), so the loop runs as one function (as separate calls the trial was
+slower, ``docs/performance.md`` lesson 6).  Where the compile paths part
+(``core/shared/paths.py``) a dispatcher compiles the one kernel its path
+reaches.  The stages remain callable on their own (the tests do).
 """
 
 from __future__ import annotations
