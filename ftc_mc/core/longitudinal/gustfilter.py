@@ -224,27 +224,27 @@ def _nl_outputs(xa, fm, hpred, xp, tw):
 
 
 # ------------------------------------------------------------------ path dispatch
-# The airframe's equations run only on the extended filter's path (core/shared/paths.py):
-# on the dense path these calls compile to nothing, and the airframe is never
-# compiled.
+# The airframe's equations run only on the extended filter's path
+# (core/shared/paths.py): the general filter's kernels take the filter's marker
+# (``fkind``), and on the dense filter's these calls compile to nothing.
 
 @on_path("filter", {EXTENDED_FILTER: _nl_state})
-def nl_state(path, xa, u, fm, xn, tw):
+def nl_state(fkind, xa, u, fm, xn, tw):
     """:func:`_nl_state` on the extended filter's path."""
 
 
 @on_path("filter", {EXTENDED_FILTER: _nl_outputs})
-def nl_outputs(path, xa, fm, hpred, xp, tw):
+def nl_outputs(fkind, xa, fm, hpred, xp, tw):
     """:func:`_nl_outputs` on the extended filter's path."""
 
 
 @on_path("filter", {EXTENDED_FILTER: relinearise_lanes})
-def relinearise(path, xa, u, fm, st, tw):
+def relinearise(fkind, xa, u, fm, st, tw):
     """:func:`relinearise_lanes` on the extended filter's path."""
 
 
 @kernel
-def _gpredict(path, xa, P, Pn, u, fm, phi, T, xn, tw, st):
+def _gpredict(fkind, xa, P, Pn, u, fm, phi, T, xn, tw, st):
     """Time update of every lane: ``X <- F X + B_aug u``, ``Pn <- F P F^T + Q``.
 
     ``F = [[A, Phi(u), G], [0, I, 0], [0, 0, A_d]]`` and ``Q`` block-diagonal
@@ -304,7 +304,7 @@ def _gpredict(path, xa, P, Pn, u, fm, phi, T, xn, tw, st):
                 acc += fm.Ad[a, g] * xa[N_AUG + g, l]
             xn[N_AUG + a, l] = acc
     if fm.nl != 0:
-        nl_state(path, xa, u, fm, xn, tw)
+        nl_state(fkind, xa, u, fm, xn, tw)
     for i in range(N_X):
         for l in range(L):
             xa[i, l] = xn[i, l]
@@ -527,12 +527,15 @@ def _gupdate(xa, P, z, fm, crow, h, v, gs, hpred, xp, st, cl):
 
 
 @kernel(inline="always")
-def gust_predict_lanes(path, xa, P, fm, tw, st, k):
+def gust_predict_lanes(fkind, xa, P, fm, tw, st, k):
     """First half of a general filter step: predict into ``tw.fwork[:n]`` and the
     residuals; ``X_{k|k}`` is kept in ``tw.fwork`` for a re-prediction.
 
     Parameters
     ----------
+    fkind : DenseFilter or ExtendedFilter
+        The filter's marker (``core/shared/paths.py``): the airframe's
+        equations predict on the extended filter's path only.
     xa : ndarray, shape (n, L)
         ``X_{k|k}``, replaced by ``X_{k+1|k}``.
     P : ndarray, shape (n, n, L)
@@ -560,10 +563,10 @@ def gust_predict_lanes(path, xa, P, fm, tw, st, k):
         for l in range(xa.shape[1]):
             x_prev[i, l] = xa[i, l]
     if fm.relin > 0 and k % fm.relin == 0:
-        relinearise(path, xa, tw.u, fm, st, tw)
-    _gpredict(path, xa, P, work[0:n], tw.u, fm, tw.phi, tw.T, work[n + 3], tw, st)
+        relinearise(fkind, xa, tw.u, fm, st, tw)
+    _gpredict(fkind, xa, P, work[0:n], tw.u, fm, tw.phi, tw.T, work[n + 3], tw, st)
     if fm.nl != 0:
-        nl_outputs(path, xa, fm, work[n + 4], work[n + 5], tw)
+        nl_outputs(fkind, xa, fm, work[n + 4], work[n + 5], tw)
     gust_residuals_lanes(xa, work[0:n], tw.z, fm, tw.crow, work[n + 4], tw.res, tw.innov,
                          st, tw.jc)
 
@@ -603,7 +606,7 @@ def reset_extra_lanes(P, block, reset_g):
 
 
 @kernel(inline="always")
-def gust_correct_lanes(path, xa, P, fm, det, tw, st):
+def gust_correct_lanes(fkind, xa, P, fm, det, tw, st):
     """Second half, once ``tw.block`` is decided: reset the block of ``P_{k|k}``
     (section 3.2.2, with the extra states that go with it,
     :func:`reset_extra_lanes`) of every lane that resets and predict all lanes again from
@@ -626,9 +629,9 @@ def gust_correct_lanes(path, xa, P, fm, det, tw, st):
         for i in range(n):
             for l in range(L):
                 xa[i, l] = x_prev[i, l]
-        _gpredict(path, xa, P, Pn, tw.u, fm, tw.phi, tw.T, work[n + 3], tw, st)
+        _gpredict(fkind, xa, P, Pn, tw.u, fm, tw.phi, tw.T, work[n + 3], tw, st)
         if fm.nl != 0:
-            nl_outputs(path, xa, fm, work[n + 4], work[n + 5], tw)
+            nl_outputs(fkind, xa, fm, work[n + 4], work[n + 5], tw)
     _gupdate(xa, Pn, tw.z, fm, tw.crow, work[n], work[n + 1], work[n + 2], work[n + 4],
              work[n + 5], st, tw.jc)
     for i in range(n):

@@ -280,13 +280,21 @@ def sensor_fault(inp, k, dt, v, zhold, z):
             z[o, l] += (size - 1.0) * v[o, l]
 
 
-@kernel(inline="always")
+@kernel
+def linear_truth(model, flight, w, v, x, work):
+    """:func:`linear_step` as a kernel of its own (one compile for every path
+    that flies the linear plant)."""
+    linear_step(model, flight, w, v, x, work)
+
+
+@kernel
 def nonlinear_truth(model, flight, w, v, x, work):
-    """:func:`nonlinear_step` with :func:`linear_step`'s parameters."""
+    """:func:`nonlinear_step` with :func:`linear_step`'s parameters, as a kernel
+    of its own."""
     nonlinear_step(model.u0, flight.plant, w, v, x, work)
 
 
-@on_path("plant", {LINEAR_PLANT: linear_step, NONLINEAR_PLANT: nonlinear_truth})
+@on_path("plant", {LINEAR_PLANT: linear_truth, NONLINEAR_PLANT: nonlinear_truth})
 def plant_step(path, model, flight, w, v, x, work):
     """The path's truth plant over one step: :func:`linear_step` or the
     nonlinear X8 (:func:`nonlinear_step`)."""

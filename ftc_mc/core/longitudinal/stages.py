@@ -62,7 +62,7 @@ def nominal_output(scheme, st, work):
     feedback_lanes(scheme.controller.K, st.xa, work.u)
 
 
-@kernel(inline="always")
+@kernel
 def reconfiguring_output(scheme, st, work):
     """The output of each lane's controller in use into ``work.u``
     (:func:`ftc_mc.core.longitudinal.control.controller_command`: c0, c1 of eq. 44 or c2 of
@@ -150,62 +150,73 @@ def commands(path, scheme, st, k, work):
 
 
 # ------------------------------------------------------------------ 3. filter
-@kernel(inline="always")
-def paper_predict(scheme, st, k, work):
+# The kernels the paths part into are kernels of their own, without the path:
+# compiled once, and loaded from the cache by every other path that reaches them
+# (core/shared/paths.py).  The filter's take the filter's marker (``fkind``), by
+# which the general filter picks its prediction.
+
+@kernel
+def paper_predict(fkind, scheme, st, k, work):
     """The paper filter's prediction and one-step residuals
     (:func:`ftc_mc.core.longitudinal.batch.filter_predict_lanes`)."""
     filter_predict_lanes(st.xa, st.P, work.u, work.z, scheme.filter, work.phi, work.T,
                          work.fwork, work.res)
 
 
-@kernel(inline="always")
-def paper_predict_glr(scheme, st, k, work):
-    """:func:`paper_predict` and the signed innovations the GLR test reads
-    (:func:`ftc_mc.core.longitudinal.batch.innovations_lanes`)."""
-    paper_predict(scheme, st, k, work)
-    innovations_lanes(st.xa, work.fwork[0:st.xa.shape[0]], work.z, scheme.filter, work.innov)
-
-
-@on_path("test", {ONE_STEP_TEST: paper_predict, GLR_TEST: paper_predict_glr})
-def paper_predict_on(path, scheme, st, k, work):
-    """The paper filter's prediction, with the innovations on the GLR test's path."""
-
-
-@kernel(inline="always")
-def general_predict(path, scheme, st, k, work):
-    """The general filter's prediction and residuals
+@kernel
+def general_predict(fkind, scheme, st, k, work):
+    """The general filter's prediction and residuals, with the airframe's
+    equations on the extended filter's path
     (:func:`ftc_mc.core.longitudinal.gustfilter.gust_predict_lanes`)."""
-    gust_predict_lanes(path, st.xa, st.P, scheme.filter, work, st, k)
+    gust_predict_lanes(fkind, st.xa, st.P, scheme.filter, work, st, k)
 
 
-@on_path("filter", {PAPER_FILTER: paper_predict_on, DENSE_FILTER: general_predict,
-                    EXTENDED_FILTER: general_predict}, with_path=True)
+@on_path("filter", {PAPER_FILTER: paper_predict, DENSE_FILTER: general_predict,
+                    EXTENDED_FILTER: general_predict}, passes="marker")
 def predict(path, scheme, st, k, work):
     """The first half of the path's filter step."""
 
 
-@kernel(inline="always")
-def paper_correct(path, scheme, st, work):
+@kernel
+def paper_innovations(scheme, st, work):
+    """The signed innovations the GLR test reads, of the paper's filter
+    (:func:`ftc_mc.core.longitudinal.batch.innovations_lanes`; the general
+    filter writes them as it predicts)."""
+    innovations_lanes(st.xa, work.fwork[0:st.xa.shape[0]], work.z, scheme.filter, work.innov)
+
+
+@on_path("filter", {PAPER_FILTER: paper_innovations})
+def paper_innovations_on(path, scheme, st, work):
+    """:func:`paper_innovations` on the paper filter's path."""
+
+
+@on_path("test", {GLR_TEST: paper_innovations_on}, passes="path")
+def innovations(path, scheme, st, work):
+    """The paper filter's innovations on the GLR test's path."""
+
+
+@kernel
+def paper_correct(fkind, scheme, st, work):
     """Reset, update and projection of the paper's filter
-    (:func:`ftc_mc.core.longitudinal.batch.filter_correct_lanes`; ``path`` unused)."""
+    (:func:`ftc_mc.core.longitudinal.batch.filter_correct_lanes`)."""
     filter_correct_lanes(st.xa, st.P, work.u, work.z, scheme.filter, scheme.detection,
                          work.phi, work.T, work.fwork, work.block)
 
 
-@kernel(inline="always")
-def general_correct(path, scheme, st, work):
+@kernel
+def general_correct(fkind, scheme, st, work):
     """Reset, re-prediction, update and projection of the general filter
     (:func:`ftc_mc.core.longitudinal.gustfilter.gust_correct_lanes`)."""
-    gust_correct_lanes(path, st.xa, st.P, scheme.filter, scheme.detection, work, st)
+    gust_correct_lanes(fkind, st.xa, st.P, scheme.filter, scheme.detection, work, st)
 
 
 @on_path("filter", {PAPER_FILTER: paper_correct, DENSE_FILTER: general_correct,
-                    EXTENDED_FILTER: general_correct}, with_path=True)
+                    EXTENDED_FILTER: general_correct}, passes="marker")
 def correct(path, scheme, st, work):
     """The second half of the path's filter step."""
 
 
-@kernel(inline="always")
+@kernel
 def glr_statistics(det, st, k, work):
     """The GLR statistics of the window (:func:`ftc_mc.core.shared.glr.glr_lanes`) in
     place of the one-step residuals ``work.res``."""
@@ -260,6 +271,7 @@ def filter_update(path, scheme, st, k, work):
     det = scheme.detection
     res = work.res
     predict(path, scheme, st, k, work)
+    innovations(path, scheme, st, work)
     decision_statistics(path, det, st, k, work)
     signature_lanes(res, det, work.block)
     if det.settle > 0:
@@ -481,7 +493,7 @@ def record_step(k, st, work, rec):
 
 
 # ------------------------------------------------------------------ 7. reconfigure
-@kernel(inline="always")
+@kernel
 def select_lanes(scheme, st, work):
     """The controller selection (eqs. 45-47) of every lane
     (:func:`ftc_mc.core.longitudinal.control.select_controllers_lanes`) on the estimate's

@@ -92,22 +92,25 @@ def describe(path: Path) -> str:
     return ", ".join(NAMES[type(m)] for m in path)
 
 
-def _marker_class(path_type, field: str):
-    if not (isinstance(path_type, types.BaseNamedTuple)
-            and path_type.instance_class is Path):
-        raise TypeError(f"expected a core.shared.paths.Path, got {path_type}")
-    t = path_type.types[Path._fields.index(field)]
-    return t.instance_class if isinstance(t, types.BaseNamedTuple) else None
+def _marker_class(arg_type, field: str):
+    """The marker class a dispatcher's first argument names for ``field``: read
+    from a :class:`Path`, or the argument is that marker itself."""
+    if isinstance(arg_type, types.BaseNamedTuple) and arg_type.instance_class is Path:
+        arg_type = arg_type.types[Path._fields.index(field)]
+    if not (isinstance(arg_type, types.BaseNamedTuple) and not arg_type.types
+            and arg_type.instance_class in NAMES):
+        raise TypeError(f"expected a core.shared.paths.Path or marker, got {arg_type}")
+    return arg_type.instance_class
 
 
 def takes(path_type, field: str, marker) -> bool:
-    """Whether the Numba type of a :class:`Path` holds ``marker``'s class in
-    ``field`` (read while a dispatcher's caller is typed).
+    """Whether the Numba type of a :class:`Path` (or of a marker) holds
+    ``marker``'s class in ``field`` (read while a dispatcher's caller is typed).
 
     Parameters
     ----------
     path_type : numba.types.NamedTuple
-        The type Numba gives a :class:`Path`.
+        The type Numba gives a :class:`Path` or a marker.
     field : str
         ``"plant"``, ``"filter"``, ``"test"`` or ``"control"``.
     marker : namedtuple instance
@@ -116,16 +119,27 @@ def takes(path_type, field: str, marker) -> bool:
     return _marker_class(path_type, field) is type(marker)
 
 
-def on_path(field: str, impls: dict, with_path: bool = False):
-    """Make a stub a dispatcher on ``path.<field>``.
+def on_path(field: str, impls: dict, passes: str | None = None):
+    """Make a stub a dispatcher on the ``field`` marker of its first argument.
 
-    The decorated function is a stub whose first parameter is the
-    :class:`Path`; a call ``stub(path, a, b)`` in a kernel compiles as
-    ``impls[marker](a, b)`` (``impls[marker](path, a, b)`` with ``with_path``)
-    for the marker ``path.<field>`` holds, or as nothing (``None``) when
-    ``impls`` has no entry for it.  The choice is made while
-    the caller is typed (a ``numba.extending.overload``, IR-inlined), so the
-    kernels of the other markers are never compiled.
+    The decorated function is a stub whose first parameter is a :class:`Path`
+    or a marker; a call ``stub(path, a, b)`` in a kernel compiles as
+    ``impls[marker](a, b)`` for the marker ``path.<field>`` (or ``path``)
+    holds, or as nothing (``None``) when ``impls`` has no entry for it.  With
+    ``passes="marker"`` the kernel gets that marker first
+    (``impls[marker](path.<field>, a, b)``: a kernel that dispatches further on
+    the same choice); with ``passes="path"``, the first argument as it is
+    (another dispatcher).
+
+    The choice is made while the caller is typed (a
+    ``numba.extending.overload``), so the kernels of the other markers are
+    never compiled.  The chosen kernels are ``@kernel`` functions of their own
+    (cached on disk) that take no :class:`Path`: compiled once, whatever the
+    path that calls them, and loaded from the cache by every later path.  The
+    call between is a small function of its own, not inlined into the
+    caller's IR: Numba's typed inlining of overloads gave wrong results inside
+    the trial loop (lanes read as out of the envelope at the first step;
+    ``docs/performance.md`` lesson 11).
 
     Parameters
     ----------
@@ -133,25 +147,34 @@ def on_path(field: str, impls: dict, with_path: bool = False):
         ``"plant"``, ``"filter"``, ``"test"`` or ``"control"``.
     impls : dict
         Marker (e.g. :data:`PAPER_FILTER`) -> kernel taking the stub's
-        parameters after ``path`` (or another dispatcher).
-    with_path : bool
-        Pass ``path`` on as the first argument (to kernels that dispatch
-        further).
+        parameters after the first.
+    passes : {None, "marker", "path"}
+        What the kernel gets first, if anything.
     """
+    assert passes in (None, "marker", "path"), passes
     table = {type(m): f for m, f in impls.items()}
 
     def decorate(stub):
         params = list(inspect.signature(stub).parameters)
+        first, rest = params[0], ", ".join(params[1:])
         arglist = ", ".join(params)
-        inner = ", ".join(params if with_path else params[1:])
+        lead = {None: "", "path": f"{first}, ",
+                "marker": f"{first}.{field}, "}[passes]
         # the overload must take the stub's own parameter names: written out
         src = (f"def overload_of({arglist}):\n"
-               f"    impl = table.get(_marker_class({params[0]}, field))\n"
+               f"    impl = table.get(_marker_class({first}, field))\n"
                f"    if impl is None:\n"
                f"        return lambda {arglist}: None\n"
-               f"    return lambda {arglist}: impl({inner})\n")
-        scope = {"table": table, "_marker_class": _marker_class, "field": field}
+               f"    if passes == 'marker' and not _is_path({first}):\n"
+               f"        return lambda {arglist}: impl({first}, {rest})\n"
+               f"    return lambda {arglist}: impl({lead}{rest})\n")
+        scope = {"table": table, "_marker_class": _marker_class, "field": field,
+                 "passes": passes, "_is_path": _is_path}
         exec(src, scope)  # noqa: S102 -- source built above from the stub's names
         overload(stub, jit_options=_JIT_OPTIONS)(scope["overload_of"])
         return stub
     return decorate
+
+
+def _is_path(arg_type) -> bool:
+    return isinstance(arg_type, types.BaseNamedTuple) and arg_type.instance_class is Path
