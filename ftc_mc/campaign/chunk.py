@@ -136,7 +136,10 @@ def classify(spec: ChunkSpec, tr_name: str, variant: str, trial_ids, values,
     * ``inappropriate``: the other block was reset in the window (whether or
       not the correct one was too);
     * ``no_reset``: nothing was reset in the window;
-    * ``false_resets``: resets at or before ``k_f``;
+    * ``false_resets``: resets at or before ``k_f`` while the truth is nominal,
+      i.e. in rows that start nominal (``mode_pre``); an unlock or recover row
+      starts faulted, so its resets before the switch are no false alarms and
+      count 0 (issue 25);
     * ``first_reset_s``: delay from the switch to the first reset in the window;
     * ``correct_reset_s``: delay from the switch to the first reset of the
       correct block in the window (NaN when it had none), whatever was reset
@@ -218,7 +221,8 @@ def classify(spec: ChunkSpec, tr_name: str, variant: str, trial_ids, values,
                                        for b, n in zip(first_block, n_win)], dtype=object),
         "correct_reset_s": correct_reset_s,
         "resets_in_window": n_win.astype(np.int64),
-        "false_resets": before.sum(axis=0).astype(np.int64),
+        "false_resets": np.where(inp.mode_pre == MODE_NOMINAL, before.sum(axis=0),
+                                 0).astype(np.int64),
         "resets_total": rec.n_resets.copy(),
         "detection_s": np.where(detected, (rec.detect_k - kf) * dt, np.nan),
         "mode_changed": changed,
