@@ -31,6 +31,9 @@ from .transitions import (TRANSITION_TABLE, FaultRanges, SensorTransition, fault
 
 FLIGHT = "fault_free"
 """Chunk name of the fault-free flights of a sweep (false resets per flight hour)."""
+ENDURANCE = "endurance"
+"""Chunk name of the fault-free flights of ``ftc-mc endurance``: the same flights
+as :data:`FLIGHT`, every reset kept with its time (``ftc_mc/campaign/endurance.py``)."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -406,6 +409,52 @@ def count_flights(rec: TrialRecord) -> dict:
             "resets": int(rec.n_resets[ok].sum())}
 
 
+def classify_flights(variant: str, flight_ids, rec: TrialRecord, dt: float):
+    """Per-flight and per-reset columns of fault-free flights (``ftc-mc endurance``).
+
+    Every reset of a fault-free flight is a false reset.  A flight is ``judged``
+    when it flew to its end (no numerical failure, no envelope exit); the
+    exposure of the false-reset rate is the judged flights' time.  Its resets are
+    counted whether or not stored; the first ``rec``-capacity of them keep
+    their time and residuals.
+
+    Returns
+    -------
+    flights : dict of str to ndarray
+        ``variant, flight_id, status, stop_s, judged, false_resets`` (all resets,
+        stored or not), ``first_false_reset_s`` (from the flight's start, NaN
+        without one).
+    resets : dict of str to ndarray
+        ``variant, flight_id, time_s`` (from the flight's start), ``block``,
+        ``r_q, r_nx, r_nz`` of every stored reset.
+    """
+    L = len(flight_ids)
+    R = rec.reset_k.shape[0]
+    stored = np.minimum(rec.n_resets, R)
+    valid = np.arange(R)[:, None] < stored[None, :]
+    lane, slot = np.nonzero(valid.T)
+    ids = np.asarray(flight_ids, dtype=np.int64)
+    flights = {
+        "variant": np.full(L, variant, dtype=object),
+        "flight_id": ids,
+        "status": np.array([STATUS_NAMES[s] for s in rec.status], dtype=object),
+        "stop_s": np.where(rec.stop_k >= 0, rec.stop_k * dt, np.nan),
+        "judged": rec.status == 0,
+        "false_resets": rec.n_resets.astype(np.int64),
+        "first_false_reset_s": np.where(rec.n_resets > 0, rec.reset_k[0] * dt, np.nan),
+    }
+    resets = {
+        "variant": np.full(len(lane), variant, dtype=object),
+        "flight_id": ids[lane],
+        "time_s": rec.reset_k[slot, lane] * dt,
+        "block": np.array([BLOCK_NAMES[b] for b in rec.reset_block[slot, lane]], dtype=object),
+        "r_q": rec.reset_res[slot, 0, lane],
+        "r_nx": rec.reset_res[slot, 1, lane],
+        "r_nz": rec.reset_res[slot, 2, lane],
+    }
+    return flights, resets
+
+
 def _runs(spec: ChunkSpec):
     """``(t_q, t_nx, variant, Detection)`` of every run of a chunk, point-major."""
     setup = spec.setup
@@ -426,7 +475,9 @@ def run_chunk(spec: ChunkSpec, name: str, trial_ids) -> dict:
     ----------
     spec : ChunkSpec
     name : str
-        A transition, or :data:`FLIGHT` for fault-free flights (sweeps only).
+        A transition, :data:`FLIGHT` for fault-free flights (sweeps only), or
+        :data:`ENDURANCE` for the fault-free flights of an endurance run
+        (:func:`classify_flights` tables ``trials`` and ``resets``).
     trial_ids : ndarray of int
 
     Returns
@@ -441,6 +492,13 @@ def run_chunk(spec: ChunkSpec, name: str, trial_ids) -> dict:
     setup = spec.setup
     runs = _runs(spec)
     L, n = len(trial_ids), setup.tim.n_steps
+    if name == ENDURANCE:  # every design alone on the same flights (no threshold points)
+        inp = flight_inputs(setup, trial_ids, spec.seed)
+        recs, _ = simulate(setup, inp, [r[2:] for r in runs], spec.max_resets)
+        parts = [classify_flights(v, trial_ids, rec, setup.plant.dt)
+                 for (_, _, v, _), rec in zip(runs, recs)]
+        return {"trials": pd.DataFrame(_columns([p[0] for p in parts])),
+                "resets": pd.DataFrame(_columns([p[1] for p in parts]))}
     if name == FLIGHT:
         assert spec.points is not None
         inp = flight_inputs(setup, trial_ids, spec.seed)
