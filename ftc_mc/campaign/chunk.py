@@ -409,19 +409,20 @@ def count_flights(rec: TrialRecord) -> dict:
             "resets": int(rec.n_resets[ok].sum())}
 
 
-def classify_flights(variant: str, flight_ids, rec: TrialRecord, dt: float):
+def classify_flights(variant: str, flight_ids, rec: TrialRecord, dt: float, n_s: float):
     """Per-flight and per-reset columns of fault-free flights (``ftc-mc endurance``).
 
     Every reset of a fault-free flight is a false reset.  A flight is ``judged``
-    when it flew to its end (no numerical failure, no envelope exit); the
-    exposure of the false-reset rate is the judged flights' time.  Its resets are
-    counted whether or not stored; the first ``rec``-capacity of them keep
-    their time and residuals.
+    when its numbers stayed finite and its covariance positive semi-definite;
+    it then counts with the time it flew (``flown_s``: to its end, or to its
+    exit from the validity envelope) and the resets it made meanwhile.  Its
+    resets are counted whether or not stored; the first ``rec``-capacity of
+    them keep their time and residuals.
 
     Returns
     -------
     flights : dict of str to ndarray
-        ``variant, flight_id, status, stop_s, judged, false_resets`` (all resets,
+        ``variant, flight_id, status, stop_s, judged, flown_s, false_resets`` (all resets,
         stored or not), ``first_false_reset_s`` (from the flight's start, NaN
         without one).
     resets : dict of str to ndarray
@@ -439,7 +440,8 @@ def classify_flights(variant: str, flight_ids, rec: TrialRecord, dt: float):
         "flight_id": ids,
         "status": np.array([STATUS_NAMES[s] for s in rec.status], dtype=object),
         "stop_s": np.where(rec.stop_k >= 0, rec.stop_k * dt, np.nan),
-        "judged": rec.status == 0,
+        "judged": (rec.status != STATUS_NONFINITE) & (rec.status != STATUS_NOT_PSD),
+        "flown_s": np.where(rec.stop_k >= 0, rec.stop_k * dt, n_s),
         "false_resets": rec.n_resets.astype(np.int64),
         "first_false_reset_s": np.where(rec.n_resets > 0, rec.reset_k[0] * dt, np.nan),
     }
@@ -495,7 +497,7 @@ def run_chunk(spec: ChunkSpec, name: str, trial_ids) -> dict:
     if name == ENDURANCE:  # every design alone on the same flights (no threshold points)
         inp = flight_inputs(setup, trial_ids, spec.seed)
         recs, _ = simulate(setup, inp, [r[2:] for r in runs], spec.max_resets)
-        parts = [classify_flights(v, trial_ids, rec, setup.plant.dt)
+        parts = [classify_flights(v, trial_ids, rec, setup.plant.dt, n * setup.plant.dt)
                  for (_, _, v, _), rec in zip(runs, recs)]
         return {"trials": pd.DataFrame(_columns([p[0] for p in parts])),
                 "resets": pd.DataFrame(_columns([p[1] for p in parts]))}

@@ -143,7 +143,8 @@ def summarize_endurance(flights: pd.DataFrame, resets: pd.DataFrame, cfg: Config
 
     Columns: the condition (``plant``, ``turbulence``, ``airframe``), ``variant``,
     its thresholds ``t_q``, ``t_nx``, ``flights``, ``judged`` (flown to the end),
-    ``stopped_<reason>``, ``flight_s``, ``flight_hours`` (judged flights [h]),
+    ``stopped_<reason>``, ``flight_s``, ``flight_hours`` (the time the judged flights
+    flew: to their end or to their exit from the validity envelope [h]),
     ``false_resets``, ``flights_with_false_reset``, ``false_resets_per_hour`` with
     the exact two-sided 95 % interval ``_ci_low`` / ``_ci_high`` [1/h],
     ``false_resets_per_hour_upper95`` (one-sided 95 % bound [1/h]),
@@ -160,7 +161,7 @@ def summarize_endurance(flights: pd.DataFrame, resets: pd.DataFrame, cfg: Config
         ok = f[f["judged"].astype(bool)]
         r = resets[(resets["variant"] == v) & resets["flight_id"].isin(ok["flight_id"])]
         k = int(ok["false_resets"].sum())
-        hours = len(ok) * flight_s / 3600.0
+        hours = float(ok["flown_s"].sum()) / 3600.0
         rate, lo, hi = poisson_rate(k, hours)
         up = poisson_upper(k, hours)
         row = {"plant": cfg.plant.kind, "turbulence": cfg.plant.turbulence,
