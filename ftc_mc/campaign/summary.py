@@ -16,6 +16,7 @@ import pandas as pd
 
 from ..core.trial import STATUS_NAMES
 from ..stats import median_p95, wilson
+from .scoring import real_flight_scores
 from .transitions import PAPER_TABLES, TRANSITION_TABLE, is_sensor, transition_of
 
 SENSOR_RATES = ("actuator_reset", "wrong_mode", "controller_switch", "misattributed",
@@ -58,7 +59,10 @@ def summarize(trials: pd.DataFrame) -> pd.DataFrame:
     correct block in the window [s] (``correct_reset_s``), over the trials with
     one, whatever was reset before it (the detection delay of the operating
     characteristic; NaN for trials tables without that column);
-    ``detection_median_s`` / ``detection_p95_s``: the belief's detection time [s].
+    ``detection_median_s`` / ``detection_p95_s``: the belief's detection time [s];
+    the real-flight metrics of :mod:`ftc_mc.campaign.scoring` (ALFA precision,
+    recall and delays; average detection delay ``add_s`` and correct diagnosis
+    rate ``cdr``).
 
     Only judged trials (``judged`` column: no numerical failure, inside the
     validity envelope through the judging window, all resets stored) enter the
@@ -110,6 +114,7 @@ def summarize(trials: pd.DataFrame) -> pd.DataFrame:
         row.update(_quantiles("detection", ok["detection_s"].to_numpy()))
         row.update({"paper_trials": paper[0], "paper_inappropriate": paper[1],
                     "paper_no_reset": paper[2]})
+        row.update(real_flight_scores(name, ok))  # ALFA and FDDBenchmark (scoring.py)
         rows.append(row)
     out = pd.DataFrame(rows)
     if len(out):
