@@ -52,12 +52,14 @@ MAX_FLIGHT_S = 600.0
 
 
 def startup_s(setup, variants) -> float:
-    """The filters' start-up [s]: the longest residual-test window of the designs
-    flown (a GLR window not yet full tests fewer samples) and the first belief
-    update (one reconfiguration period).  A flight must be longer."""
+    """The filters' start-up [s]: per design, its start-up hold (``startup_s``:
+    the test is not armed before it) plus its residual-test window (a GLR window
+    not yet full tests fewer samples), the longest over the designs flown, and
+    at least the first belief update (one reconfiguration period).  A flight
+    must be longer."""
     dt = setup.plant.dt
-    windows = [setup.designs[v].window for v in variants]
-    return max(max(windows) * dt, setup.tim.reconf_every * dt)
+    longest = max(setup.designs[v].det.startup + setup.designs[v].window for v in variants)
+    return max(longest * dt, setup.tim.reconf_every * dt)
 
 
 def endurance_config(cfg: Config, flight_s: float | None) -> Config:
@@ -192,8 +194,8 @@ def endurance_spec(cfg: Config):
     start = startup_s(spec.setup, spec.variants)
     if cfg.timing.duration_s <= start:
         raise UserError(f"--flight-s: a flight of {cfg.timing.duration_s:g} s is not longer "
-                        f"than the filters' start-up ({start:g} s: the longest residual "
-                        "window, and the first belief update)")
+                        f"than the filters' start-up ({start:g} s: the longest start-up hold "
+                        "plus residual window, and the first belief update)")
     return dataclasses.replace(spec, max_resets=min(RESETS_STORED, spec.max_resets))
 
 
