@@ -157,3 +157,23 @@ def test_bad_input_is_one_line_and_writes_nothing(tmp_path, args, needle):
     assert len(lines) == 1 and needle in lines[0], res.output
     assert not out.exists()
     assert sorted(p.name for p in tmp_path.iterdir()) == ["c.yaml"]
+
+
+def test_report_shows_the_endurance_run_and_uses_its_hours(tmp_path):
+    """An endurance directory gets its section; a sweep of the same condition and
+    designs takes the endurance hours at the matching point."""
+    end = tmp_path / "end"
+    sw = tmp_path / "sw"
+    ftc_mc.run_endurance(CFG, HOURS, out=end, progress=False)
+    ftc_mc.run_sweep(CFG, [4.0], flights=6, out=sw, progress=False)
+    out = ftc_mc.build_report([sw, end], tmp_path / "rep.md")
+    text = out.read_text(encoding="utf-8")
+    assert f"## Endurance `{end}`" in text
+    assert (tmp_path / "rep_figures" / "end_endurance.png").stat().st_size > 5_000
+    summary = pd.read_parquet(end / "endurance.parquet").set_index("variant")
+    op = text.split("### Operating characteristic", 1)[1]
+    for v in ("paper", "swapped"):
+        k, h = int(summary.loc[v, "false_resets"]), summary.loc[v, "flight_hours"]
+        assert f"| {k} / {h:.3g} (endurance)" in op
+    # not shown: 0.1 h cannot show 0.01 per hour
+    assert "**not shown**" in text
