@@ -269,15 +269,17 @@ def endurance_markdown(summary: pd.DataFrame) -> str:
     view = pd.DataFrame({
         "design": summary["variant"],
         "plant / turbulence": summary["plant"] + " / " + summary["turbulence"],
-        "flight hours": summary["flight_hours"].map("{:.1f}".format),
+        "flight hours": summary["flight_hours"].map("{:.4g}".format),
         "false resets": summary["false_resets"],
         "per h (95 % CI)": [f"{fmt(r)} ({fmt(lo)}-{fmt(hi)})" for r, lo, hi in zip(
             summary["false_resets_per_hour"], summary["false_resets_per_hour_ci_low"],
             summary["false_resets_per_hour_ci_high"])],
         "one-sided 95 % bound / h": summary["false_resets_per_hour_upper95"].map(fmt),
         "in the first 5 s": summary["early_false_resets"],
-        "target": [("shown" if s else f"not shown: {h:.0f} h needed") + f" (<= {t:g} / h)"
-                   for s, h, t in zip(summary["target_shown"], summary["hours_to_show"],
-                                      summary["target_per_h"])],
+        "target": [f"<= {t:g} / h: " + ("shown" if s else
+                                         f"not shown ({h:.4g} h would show it"
+                                         + (")" if k == 0 else " with no further one)"))
+                   for s, h, t, k in zip(summary["target_shown"], summary["hours_to_show"],
+                                         summary["target_per_h"], summary["false_resets"])],
     })
     return view.to_markdown(index=False)

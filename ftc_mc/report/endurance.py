@@ -64,7 +64,7 @@ def endurance_table(summary: pd.DataFrame) -> str:
         "t_q / t_nx": [f"{a:g} / {b:g}" for a, b in zip(summary["t_q"], summary["t_nx"])],
         "flights (judged)": [f"{a} ({b})" for a, b in zip(summary["flights"],
                                                          summary["judged"])],
-        "flight hours": summary["flight_hours"].map("{:.1f}".format),
+        "flight hours": summary["flight_hours"].map("{:.4g}".format),
         "false resets": summary["false_resets"],
         "per flight h (95 % CI)": [
             f"{_fmt(r)} ({_fmt(lo)}-{_fmt(hi)})" for r, lo, hi in
