@@ -6,6 +6,7 @@
     cfg = ftc_mc.load_config("configs/paper_tables.yaml")      # validated Config
     res = ftc_mc.run_campaign(cfg, trials=200, jobs=2)         # res.summary, res.trials
     sw = ftc_mc.run_sweep(cfg, "10,25,50", trials=100)         # sw.table
+    en = ftc_mc.run_endurance(cfg, hours=10, jobs=2)           # en.summary, en.resets
     sc = ftc_mc.run_scenario("configs/paper_scenario.yaml")    # sc.timeseries, sc.events
     ftc_mc.build_report(["results/paper_tables"], "report.md")
 
