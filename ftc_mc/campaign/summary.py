@@ -203,7 +203,7 @@ def sensor_markdown_table(summary: pd.DataFrame, intervals: bool = True) -> str:
 
 _COUNTS = ("inappropriate", "no_reset", "no_reset_explained", "correct", "correct_only",
            "false_alarm_trials", "mode_changes", "detected", "paper_trials",
-           "paper_inappropriate", "paper_no_reset")
+           "paper_inappropriate", "paper_no_reset", "alfa_tp", "alfa_fp", "alfa_fn")
 
 
 def actuator_rows(summary: pd.DataFrame) -> pd.DataFrame:
