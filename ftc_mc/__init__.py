@@ -9,6 +9,8 @@ function per command (see :mod:`ftc_mc.api`)::
     res.summary
 """
 
-from .api import build_report, load_config, run_campaign, run_scenario, run_sweep
+from .api import (build_report, load_config, run_campaign, run_endurance, run_scenario,
+                  run_sweep)
 
-__all__ = ["run_campaign", "run_sweep", "run_scenario", "build_report", "load_config"]
+__all__ = ["run_campaign", "run_sweep", "run_endurance", "run_scenario", "build_report",
+           "load_config"]

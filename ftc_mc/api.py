@@ -6,6 +6,7 @@
     cfg = ftc_mc.load_config("configs/paper_tables.yaml")      # validated Config
     res = ftc_mc.run_campaign(cfg, trials=200, jobs=2)         # res.summary, res.trials
     sw = ftc_mc.run_sweep(cfg, "10,25,50", trials=100)         # sw.table
+    en = ftc_mc.run_endurance(cfg, hours=10, jobs=2)           # en.summary, en.resets
     sc = ftc_mc.run_scenario("configs/paper_scenario.yaml")    # sc.timeseries, sc.events
     ftc_mc.build_report(["results/paper_tables"], "report.md")
 
@@ -32,6 +33,9 @@ RUN_OUTPUTS = ("summary.parquet", "trials.parquet", "resets.parquet", "summary.m
 """Files of a finished ``run`` directory (the first holds the metadata checked)."""
 SWEEP_OUTPUTS = ("sweep.parquet", "sweep.md")
 """Files of a finished ``sweep`` directory."""
+ENDURANCE_OUTPUTS = ("endurance.parquet", "flights.parquet", "false_resets.parquet",
+                     "endurance.md")
+"""Files of a finished ``endurance`` directory (the first holds the metadata checked)."""
 SCENARIO_OUTPUTS = ("timeseries.parquet", "events.parquet", "segments.parquet",
                     "summary.md")
 """Files of a ``scenario`` directory besides its figures."""
@@ -425,6 +429,76 @@ def run_sweep(config, thresholds=None, *, tq=None, tnx=None, transitions=None,
         meta["trial_steps"] = {"simulated": res.simulated_steps, "alone": res.alone_steps}
         write_parquet(res.table, out_dir / "sweep.parquet", meta)
         write_text(out_dir / "sweep.md", sweep_markdown(res))
+        store.remove()
+    return res
+
+
+def run_endurance(config, hours, *, flight_s: float | None = None, seed=None,
+                  signature=None, plant=None, turbulence=None, airframe=None, design=None,
+                  jobs: int = 1, progress: bool = True, backend: str = "threads",
+                  scheduler: str | None = None, out=None, overwrite: bool = False,
+                  resume: bool = False, command: str | None = None):
+    """Fault-free flight hours per design: false resets per hour (``ftc-mc endurance``).
+
+    Parameters
+    ----------
+    config : str, Path, dict or Config
+    hours : float
+        Flight hours to fly (finite, > 0); rounded up to whole flights.
+    flight_s : float, optional
+        Length of each flight [s] (default ``timing.duration_s``); it must be
+        longer than the filters' start-up
+        (:func:`ftc_mc.campaign.endurance.startup_s`).
+    seed, signature, plant, turbulence, airframe, design : optional
+        Overrides of the config (:func:`campaign_config`); every design flies
+        the same flights.
+    jobs, progress, backend, scheduler, out, overwrite, resume, command
+        As in :func:`run_campaign`; ``out`` receives ``endurance.parquet`` (one
+        row per design), ``flights.parquet``, ``false_resets.parquet`` and
+        ``endurance.md``.
+
+    Returns
+    -------
+    EnduranceResult or None
+        ``.summary``, ``.flights``, ``.resets``; None if ``resume`` found the
+        run already finished in ``out``.
+    """
+    from .campaign.endurance import (check_hours, endurance_config, endurance_spec,
+                                     run_endurance as endure)
+    from .io.atomic import write_text
+    from .io.lock import acquire
+    from .io.results import prepare_output_dir, provenance, write_parquet
+
+    cfg = campaign_config(config, seed=seed, signature=signature, plant=plant,
+                          turbulence=turbulence, airframe=airframe, design=design)
+    hours = check_hours(hours)
+    cfg = endurance_config(cfg, flight_s)
+    _check_jobs(jobs)
+    spec = endurance_spec(cfg)  # a flight shorter than the start-up: refused here
+    kw = dict(jobs=jobs, progress=progress, backend=backend, scheduler=scheduler, spec=spec)
+    out_dir = _check_out(out, resume)
+    if out_dir is None:
+        return endure(cfg, hours, **kw)
+    config_json = cfg.model_dump(mode="json")
+    identity = {"config": config_json, "hours": hours}
+    with acquire(out_dir, command=command or _who("run_endurance")):
+        if resume and not overwrite and _finished(out_dir, "endurance", ENDURANCE_OUTPUTS,
+                                                  identity):
+            return None
+        prepare_output_dir(out_dir, overwrite)
+        store = _open_chunks(out_dir, json.dumps(identity, sort_keys=True), overwrite,
+                             resume)
+        try:
+            res = endure(cfg, hours, chunks=store, **kw)
+        except Exception:
+            store.discard_if_empty()
+            raise
+        meta = provenance(config_json, cfg.campaign.seed, "endurance")
+        meta["hours"] = hours
+        write_parquet(res.flights, out_dir / "flights.parquet", meta)
+        write_parquet(res.resets, out_dir / "false_resets.parquet", meta)
+        write_parquet(res.summary, out_dir / "endurance.parquet", meta)
+        write_text(out_dir / "endurance.md", "# ftc-mc endurance\n\n" + res.markdown() + "\n")
         store.remove()
     return res
 

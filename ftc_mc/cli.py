@@ -401,6 +401,62 @@ def sweep(config, thresholds, tq, tnx, transitions, signature, design, trials, f
 
 
 @cli.command()
+@click.argument("config", type=click.Path(dir_okay=True))
+@click.option("--hours", required=True, metavar="H",
+              help="Fault-free flight hours to fly (finite, > 0; rounded up to whole flights).")
+@click.option("--flight-s", "flight_s", type=str, metavar="S",
+              help="Length of each flight [s] [default: timing.duration_s]; longer than "
+              "the filters' start-up.")
+@click.option("--seed", type=int, help="Root seed of the flights (overrides the config).")
+@click.option("--signature", type=click.Choice(["paper", "swapped", "both"]),
+              help="Table 1 variant(s) (overrides the config).")
+@click.option("--design", "design", multiple=True, metavar="NAME", help=DESIGN_HELP)
+@click.option("--jobs", type=int, default=-1, show_default=True,
+              help="Workers; -1: every core. Results do not depend on it.")
+@click.option("--out", type=click.Path(file_okay=False),
+              help="Output directory [default: results/<config name>-endurance, never reused].")
+@click.option("--overwrite", is_flag=True, help="Replace results already in --out.")
+@click.option("--resume", is_flag=True,
+              help="Continue an interrupted endurance run in --out, skipping its finished "
+              "chunks.")
+@plant_options
+@parallel_options
+@user_errors
+def endurance(config, hours, flight_s, seed, signature, design, jobs, out, overwrite, resume,
+              backend, scheduler, quiet, plant, turbulence, airframe):
+    """Fly every design fault-free for H flight hours: false resets per flight hour."""
+    from pathlib import Path
+
+    from . import api
+    from .campaign.endurance import check_hours, endurance_config
+
+    hours = check_hours(hours)
+    if flight_s is not None:
+        try:
+            flight_s = float(flight_s)
+        except ValueError:
+            raise UserError(f"--flight-s: expected seconds, got {flight_s!r}") from None
+    cfg = api.campaign_config(config, seed=seed, signature=signature, plant=plant,
+                              turbulence=turbulence, airframe=airframe,
+                              design=list(design) or None)
+    cfg = endurance_config(cfg, flight_s)
+    if resume and not out:
+        raise UserError("--resume: name the run's directory with --out")
+    stem = Path(config).with_name(Path(config).stem + "-endurance")
+    out_dir = Path(out) if out else _default_out(str(stem), cfg)
+    with _interruptible(out_dir):
+        res = api.run_endurance(cfg, hours, jobs=jobs, progress=not quiet, backend=backend,
+                                scheduler=scheduler, out=out_dir, overwrite=overwrite,
+                                resume=resume,
+                                command=shlex.join(["ftc-mc", "endurance", config]))
+    if res is None:
+        click.echo(f"{out_dir}: the endurance run is already complete; nothing to resume")
+        return
+    click.echo(res.markdown())
+    click.echo(f"wrote {out_dir}/: {', '.join(api.ENDURANCE_OUTPUTS)}")
+
+
+@cli.command()
 @click.argument("dirs", nargs=-1, required=True, metavar="DIR...", type=click.Path())
 @click.option("-o", "--output", default="report.md", show_default=True,
               type=click.Path(dir_okay=False),

@@ -7,6 +7,8 @@ come from the same formula:
 * :func:`wilson`: score interval of a binomial proportion (Tables 2-3 rates);
 * :func:`poisson_ci`, :func:`poisson_rate`: exact interval of a Poisson rate
   (false resets per flight hour);
+* :func:`poisson_upper`, :func:`hours_to_show`: one-sided upper bound of a
+  Poisson rate, and the exposure a rate target needs (endurance runs);
 * :func:`mcnemar_exact`: paired comparison of the two signature variants;
 * :func:`finite`, :func:`finite_median`, :func:`median_p95`: delay and
   detection-time quantiles over the trials that have one.
@@ -105,6 +107,61 @@ def poisson_rate(k: int, exposure: float):
         return np.nan, np.nan, np.nan
     lo, hi = poisson_ci(k, exposure)
     return k / exposure, lo, hi
+
+
+def poisson_upper(k: int, exposure: float, confidence: float = 0.95) -> float:
+    """One-sided exact upper confidence bound of a Poisson rate ``k / exposure``.
+
+    ``chi2(confidence; 2k + 2) / 2 / exposure`` (Garwood 1936): the rate whose
+    chance of giving at most ``k`` events in ``exposure`` is ``1 - confidence``.
+    For ``k = 0`` it is ``-ln(1 - confidence) / exposure`` (3.0 / exposure at
+    95 %, the "rule of three").  This is the bound a false-alarm target is
+    checked against ("shown at 95 % confidence"); the two-sided interval of
+    :func:`poisson_ci` has the larger 97.5 % upper end (3.69 / exposure at
+    ``k = 0``).
+
+    Parameters
+    ----------
+    k : int
+        Observed events (``k >= 0``).
+    exposure : float
+        Exposure (``> 0``), e.g. flight hours [h].
+    confidence : float
+        One-sided confidence level.
+
+    Returns
+    -------
+    float
+        Upper bound [events per unit of ``exposure``]; NaN when ``exposure`` is 0.
+    """
+    if not exposure:
+        return np.nan
+    return float(scipy.stats.chi2.ppf(confidence, 2 * int(k) + 2) / 2 / exposure)
+
+
+def hours_to_show(k: int, target: float, confidence: float = 0.95) -> float:
+    """Exposure at which ``k`` events give a one-sided upper bound of ``target``.
+
+    ``chi2(confidence; 2k + 2) / 2 / target``: with ``k = 0`` events,
+    ``-ln(1 - confidence) / target`` (3.0 / target at 95 %).  For ``k > 0`` it
+    is the exposure needed if no further event occurred (a lower bound on what
+    a longer run needs).
+
+    Parameters
+    ----------
+    k : int
+        Events seen so far.
+    target : float
+        Largest acceptable rate [events per unit of exposure], ``> 0``.
+    confidence : float
+        One-sided confidence level.
+
+    Returns
+    -------
+    float
+        Exposure [unit of ``1 / target``, e.g. h].
+    """
+    return float(scipy.stats.chi2.ppf(confidence, 2 * int(k) + 2) / 2 / target)
 
 
 def mcnemar_exact(only_a: int, only_b: int) -> float:

@@ -89,6 +89,7 @@ class RefModel:
     window: int = 1
     min_window: int = 1
     settle: int = 0
+    startup: int = 0
     nl: int = 0
     p: np.ndarray | None = None
     x0: np.ndarray | None = None
@@ -635,6 +636,7 @@ def ref_of(scheme):
                     Dg=fm.Dg if gust else None, Qg=fm.Qg if gust else None,
                     test=("one_step", "glr")[det.test], window=int(det.window),
                     min_window=int(det.min_window), settle=int(det.settle),
+                    startup=int(det.startup),
                     nl=int(fm.nl), p=fm.p, x0=fm.x0, y0=fm.y0,
                     Cg=fm.Cg if gust else None, n_sub=int(fm.n_sub), dt=float(fm.dt),
                     relin=int(fm.relin), Dz=fm.Dz if gust else None,
@@ -819,14 +821,16 @@ def filter_update_ref(scheme, st, u, z, k=0, relinearised_already=False):
                 ecount[l] = min(ecount[l] + 1, W)
                 return glr_ref(ebuf[(k - np.arange(ecount[l])) % W, :, l], model.min_window)
         gate = None
-        if model.settle > 0:
-            def gate(b, l=l):  # the other block, within `settle` steps of a reset
-                recent = k - last_k[l] < model.settle
+        if model.settle > 0 or k < model.startup:
+            def gate(b, l=l):  # the other block, within `settle` steps of a reset;
+                recent = k - last_k[l] < model.settle  # nothing before the start-up
+                if k < model.startup:
+                    return 0
                 return 0 if (b and last_block[l] and b != last_block[l] and recent) else b
         xa[:, l], P[:, :, l], block[l], res[:, l], _ = filter_step_ref(
             st.xa[:, l], st.P[:, :, l], u[:, l], z[:, l], relinearised(model, jac, l), stat,
             gate)
-        if model.test == "glr" and block[l]:
+        if model.test == "glr" and block[l] or k < model.startup:
             ecount[l] = 0
         if model.settle > 0 and block[l]:
             last_k[l], last_block[l] = k, block[l]

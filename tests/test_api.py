@@ -47,8 +47,8 @@ def test_import_is_cheap_and_exports_the_api():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          check=True, cwd=ROOT)
     assert out.stdout.strip() == "[]"
-    assert set(ftc_mc.__all__) == {"run_campaign", "run_sweep", "run_scenario",
-                                   "build_report", "load_config"}
+    assert set(ftc_mc.__all__) == {"run_campaign", "run_sweep", "run_endurance",
+                                   "run_scenario", "build_report", "load_config"}
     assert all(callable(getattr(ftc_mc, name)) for name in ftc_mc.__all__)
 
 

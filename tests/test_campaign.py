@@ -78,6 +78,26 @@ def test_classification_of_hand_made_resets(spec):
     assert r["r_q"][0] == 30.0
 
 
+@pytest.mark.parametrize("tr_name,false", [("elevon_unlock", [0, 0, 0]),
+                                          ("elevon_loss_recover", [0, 0, 0]),
+                                          ("elevon_loss", [1, 2, 0])])
+def test_false_resets_count_only_while_the_truth_is_nominal(tr_name, false):
+    """Resets before the switch are false alarms only in rows that start nominal:
+    an unlock or recover row flies faulted until the switch (issue 25)."""
+    sp = chunk_spec(small_config([tr_name]))
+    kf = sp.setup.tim.k_fault
+    lanes = [[(kf - 10, 1)], [(kf - 30, 2), (kf, 1)], [(kf + 3, 2)]]
+    ids = np.arange(len(lanes))
+    inp, values = trial_inputs(sp, tr_name, ids)
+    rec = _fake_record(sp.setup, lanes, [-1] * len(lanes))
+    t, r = classify(sp, tr_name, "paper", ids, values, inp, rec)
+    assert list(t["false_resets"]) == false
+    assert list(r["before_fault"]) == [True, True, True, False]  # the resets stay listed
+    s = summarize(pd.DataFrame(t))
+    assert s["false_resets"].iloc[0] == sum(false)
+    assert s["false_alarm_trials"].iloc[0] == sum(f > 0 for f in false)
+
+
 def test_summary_rates_and_wilson():
     # Reference: Wilson's score interval (Newcombe 1998, method 3) for 17/1000,
     # z = 1.959964, evaluated by hand: centre 0.018848, half-width 0.0082075.

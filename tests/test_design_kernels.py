@@ -193,12 +193,14 @@ def test_glr_against_direct_window():
 
 
 @pytest.mark.usefixtures("trial_kernel")
-def test_gust_glr_whole_loop(linear_gusts):
+@pytest.mark.parametrize("startup", [0, 8])
+def test_gust_glr_whole_loop(linear_gusts, startup):
     """25 steps of ``advance`` with the gust-aware filter, the GLR test and the
-    reconfiguring controller, against ``naive.advance_ref``."""
+    reconfiguring controller, against ``naive.advance_ref``; with a start-up of 8
+    steps no reset comes before the window has filled after it."""
     fm, P0, d = gust_filter(linear_gusts)
     scheme = gust_scheme(linear_gusts, fm, window=6, test=TEST_GLR, t_q=12.0, t_nx=12.0,
-                         min_window=2, settle=5)
+                         min_window=2, settle=5, startup=startup)
     flight = linear_gusts.flight._replace(timing=linear_gusts.tim._replace(n_steps=25))
     rng = np.random.default_rng(111)
     inp = random_inputs(linear_gusts, rng, 25)
@@ -207,6 +209,11 @@ def test_gust_glr_whole_loop(linear_gusts):
     inp = inp._replace(xa0=xa0, P0=P0, g0=d.P0_chol @ rng.standard_normal((4, L)))
     rec, _ = assert_loop_matches(scheme, flight, inp, 25, 1e-9)
     assert rec.n_resets.sum() > 0
+    first = rec.reset_k[0][rec.n_resets > 0]
+    if startup:  # armed at step 8, the GLR tests changes of >= 2 steps from step 9
+        assert first.min() >= startup + 1
+    else:
+        assert first.min() < 8 + 1  # the same lanes reset earlier without the start-up
 
 
 @pytest.mark.usefixtures("trial_kernel")

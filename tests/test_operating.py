@@ -26,6 +26,7 @@ from ftc_mc.campaign.transitions import TRANSITION_TABLE
 from ftc_mc.conventions import BLOCK_NAMES
 from ftc_mc.io.results import read_metadata, write_parquet
 from ftc_mc.report import build_report, operating_points, recommend_design
+from ftc_mc.report.operating import recommendation_lines
 from ftc_mc.stats import wilson
 
 from golden_cases import CAMPAIGNS, golden_path, read
@@ -108,9 +109,10 @@ def test_hours_between_false_resets():
 # --------------------------------------------------------------- recommendation
 
 
-def _table(spec) -> pd.DataFrame:
+def _table(spec, hours=2.0) -> pd.DataFrame:
     """A sweep table: ``spec`` maps (design, t) to (false resets per hour, cost per
-    transition of the two transitions, delay medians, correct_only counts of 10)."""
+    transition of the two transitions, delay medians, correct_only counts of 10),
+    over ``hours`` fault-free flight hours."""
     rows = []
     for (design, t), (rate, costs, delays, ks) in spec.items():
         for tr, c, d, k in zip(("elevon_lock", "engine_loss"), costs, delays, ks):
@@ -118,7 +120,7 @@ def _table(spec) -> pd.DataFrame:
                          "trials": 10, "inappropriate_rate": c / 2, "no_reset_rate": c,
                          "no_reset_explained_share": 0.5, "correct_only": k,
                          "correct_delay_median_s": d, "correct_delay_p95_s": 2 * d,
-                         "flight_hours": 2.0, "flight_false_resets": int(rate * 2),
+                         "flight_hours": hours, "flight_false_resets": int(rate * hours),
                          "false_resets_per_hour": rate,
                          "false_resets_per_hour_ci_high": rate + 1.8})
     return pd.DataFrame(rows)
@@ -152,13 +154,42 @@ def test_operating_points_average_the_transitions():
 
 
 def test_recommend_design_picks_the_best_point_meeting_the_target():
-    rec = recommend_design(_table(SPEC), target=0.01)
+    # 0 false resets in 300 h: one-sided 95 % bound 0.00999 per hour, shown
+    rec = recommend_design(_table(SPEC, hours=300.0), target=0.01)
     assert rec["met"] and (rec["best"]["design"], rec["best"]["t_q"]) == ("gust_glr", 20.0)
+    assert rec["best"]["false_resets_per_hour_upper95"] == pytest.approx(-np.log(0.05) / 300)
     assert rec["baseline_met"]
     assert (rec["baseline"]["design"], rec["baseline"]["t_q"]) == ("swapped", 20.0)
-    # a looser target admits gust_glr's best point
-    loose = recommend_design(_table(SPEC), target=1.0)
+    # a looser target admits gust_glr's best point (150 in 300 h: bound 0.57 / h)
+    loose = recommend_design(_table(SPEC, hours=300.0), target=1.0)
     assert (loose["best"]["design"], loose["best"]["t_q"]) == ("gust_glr", 5.0)
+
+
+def test_a_point_meets_the_target_only_when_its_upper_bound_does():
+    """0 false resets in 299 h (bound 0.01002 / h) do not show 0.01 per hour (issue 25:
+    the report recommended `robust` from 0 resets in 0.875 h)."""
+    for hours in (0.875, 299.0):
+        rec = recommend_design(_table(SPEC, hours=hours), target=0.01)
+        assert not rec["met"] and not rec["baseline_met"]
+        # the lowest bound: a point without false resets
+        assert rec["best"]["flight_false_resets"] == 0
+    lines = recommendation_lines(_table(SPEC, hours=0.875), "still air", 0.01)
+    assert "**not shown**" in lines[0] and "300 fault-free flight hours would show it" in lines[0]
+
+
+def test_endurance_hours_replace_the_sweeps_flights():
+    """An endurance run of gust_glr at t = 20 (0 in 400 h) makes that point meet the
+    target, where the sweep's 2 h do not; other points keep the sweep's hours."""
+    end = pd.DataFrame({"variant": ["gust_glr"], "t_q": [20.0], "t_nx": [20.0],
+                        "flight_hours": [400.0], "false_resets": [0],
+                        "false_resets_per_hour_ci_high": [3.69 / 400]})
+    p = operating_points(_table(SPEC), end).set_index(["design", "t_q"])
+    assert p.loc[("gust_glr", 20.0), "hours_source"] == "endurance"
+    assert p.loc[("gust_glr", 20.0), "flight_hours"] == 400.0
+    assert p.loc[("gust_glr", 40.0), "hours_source"] == "sweep"
+    rec = recommend_design(_table(SPEC), 0.01, end)
+    assert rec["met"] and (rec["best"]["design"], rec["best"]["t_q"]) == ("gust_glr", 20.0)
+    assert not rec["baseline_met"]
 
 
 def test_recommend_design_without_a_point_meeting_the_target():

@@ -122,7 +122,9 @@ def _expected(run: Path) -> pd.DataFrame:
     rows = []
     for (name, variant), g in t.groupby(["transition", "variant"]):
         ok = g[g["judged"]]
-        k, hours = int(ok["false_resets"].sum()), len(ok) * FAULT_TIME_S / 3600
+        # exposure: trials flying nominal before the switch (all of these rows)
+        k = int(ok["false_resets"].sum())
+        hours = int((ok["mode_pre"] == "nominal").sum()) * FAULT_TIME_S / 3600
         lo = scipy.stats.chi2.ppf(0.025, 2 * k) / 2 / hours if k else 0.0
         hi = scipy.stats.chi2.ppf(0.975, 2 * k + 2) / 2 / hours
         delay = ok["first_reset_s"].dropna()

@@ -33,6 +33,9 @@ from .transitions import (TRANSITION_TABLE, FaultRanges, SensorTransition, fault
 
 FLIGHT = "fault_free"
 """Chunk name of the fault-free flights of a sweep (false resets per flight hour)."""
+ENDURANCE = "endurance"
+"""Chunk name of the fault-free flights of ``ftc-mc endurance``: the same flights
+as :data:`FLIGHT`, every reset kept with its time (``ftc_mc/campaign/endurance.py``)."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -138,7 +141,10 @@ def classify(spec: ChunkSpec, tr_name: str, variant: str, trial_ids, values,
     * ``inappropriate``: the other block was reset in the window (whether or
       not the correct one was too);
     * ``no_reset``: nothing was reset in the window;
-    * ``false_resets``: resets at or before ``k_f``;
+    * ``false_resets``: resets at or before ``k_f`` while the truth is nominal,
+      i.e. in rows that start nominal (``mode_pre``); an unlock or recover row
+      starts faulted, so its resets before the switch are no false alarms and
+      count 0 (issue 25);
     * ``first_reset_s``: delay from the switch to the first reset in the window;
     * ``correct_reset_s``: delay from the switch to the first reset of the
       correct block in the window (NaN when it had none), whatever was reset
@@ -220,7 +226,8 @@ def classify(spec: ChunkSpec, tr_name: str, variant: str, trial_ids, values,
                                        for b, n in zip(first_block, n_win)], dtype=object),
         "correct_reset_s": correct_reset_s,
         "resets_in_window": n_win.astype(np.int64),
-        "false_resets": before.sum(axis=0).astype(np.int64),
+        "false_resets": np.where(inp.mode_pre == MODE_NOMINAL, before.sum(axis=0),
+                                 0).astype(np.int64),
         "resets_total": rec.n_resets.copy(),
         "detection_s": np.where(detected, (rec.detect_k - kf) * dt, np.nan),
         "mode_changed": changed,
@@ -404,6 +411,54 @@ def count_flights(rec: TrialRecord) -> dict:
             "resets": int(rec.n_resets[ok].sum())}
 
 
+def classify_flights(variant: str, flight_ids, rec: TrialRecord, dt: float, n_s: float):
+    """Per-flight and per-reset columns of fault-free flights (``ftc-mc endurance``).
+
+    Every reset of a fault-free flight is a false reset.  A flight is ``judged``
+    when its numbers stayed finite and its covariance positive semi-definite;
+    it then counts with the time it flew (``flown_s``: to its end, or to its
+    exit from the validity envelope) and the resets it made meanwhile.  Its
+    resets are counted whether or not stored; the first ``rec``-capacity of
+    them keep their time and residuals.
+
+    Returns
+    -------
+    flights : dict of str to ndarray
+        ``variant, flight_id, status, stop_s, judged, flown_s, false_resets`` (all resets,
+        stored or not), ``first_false_reset_s`` (from the flight's start, NaN
+        without one).
+    resets : dict of str to ndarray
+        ``variant, flight_id, time_s`` (from the flight's start), ``block``,
+        ``r_q, r_nx, r_nz`` of every stored reset.
+    """
+    L = len(flight_ids)
+    R = rec.reset_k.shape[0]
+    stored = np.minimum(rec.n_resets, R)
+    valid = np.arange(R)[:, None] < stored[None, :]
+    lane, slot = np.nonzero(valid.T)
+    ids = np.asarray(flight_ids, dtype=np.int64)
+    flights = {
+        "variant": np.full(L, variant, dtype=object),
+        "flight_id": ids,
+        "status": np.array([STATUS_NAMES[s] for s in rec.status], dtype=object),
+        "stop_s": np.where(rec.stop_k >= 0, rec.stop_k * dt, np.nan),
+        "judged": (rec.status != STATUS_NONFINITE) & (rec.status != STATUS_NOT_PSD),
+        "flown_s": np.where(rec.stop_k >= 0, rec.stop_k * dt, n_s),
+        "false_resets": rec.n_resets.astype(np.int64),
+        "first_false_reset_s": np.where(rec.n_resets > 0, rec.reset_k[0] * dt, np.nan),
+    }
+    resets = {
+        "variant": np.full(len(lane), variant, dtype=object),
+        "flight_id": ids[lane],
+        "time_s": rec.reset_k[slot, lane] * dt,
+        "block": np.array([BLOCK_NAMES[b] for b in rec.reset_block[slot, lane]], dtype=object),
+        "r_q": rec.reset_res[slot, 0, lane],
+        "r_nx": rec.reset_res[slot, 1, lane],
+        "r_nz": rec.reset_res[slot, 2, lane],
+    }
+    return flights, resets
+
+
 def _runs(spec: ChunkSpec):
     """``(t_q, t_nx, variant, Detection)`` of every run of a chunk, point-major."""
     setup = spec.setup
@@ -424,7 +479,9 @@ def run_chunk(spec: ChunkSpec, name: str, trial_ids) -> dict:
     ----------
     spec : ChunkSpec
     name : str
-        A transition, or :data:`FLIGHT` for fault-free flights (sweeps only).
+        A transition, :data:`FLIGHT` for fault-free flights (sweeps only), or
+        :data:`ENDURANCE` for the fault-free flights of an endurance run
+        (:func:`classify_flights` tables ``trials`` and ``resets``).
     trial_ids : ndarray of int
 
     Returns
@@ -439,6 +496,13 @@ def run_chunk(spec: ChunkSpec, name: str, trial_ids) -> dict:
     setup = spec.setup
     runs = _runs(spec)
     L, n = len(trial_ids), setup.tim.n_steps
+    if name == ENDURANCE:  # every design alone on the same flights (no threshold points)
+        inp = flight_inputs(setup, trial_ids, spec.seed)
+        recs, _ = simulate(setup, inp, [r[2:] for r in runs], spec.max_resets)
+        parts = [classify_flights(v, trial_ids, rec, setup.plant.dt, n * setup.plant.dt)
+                 for (_, _, v, _), rec in zip(runs, recs)]
+        return {"trials": pd.DataFrame(_columns([p[0] for p in parts])),
+                "resets": pd.DataFrame(_columns([p[1] for p in parts]))}
     if name == FLIGHT:
         assert spec.points is not None
         inp = flight_inputs(setup, trial_ids, spec.seed)

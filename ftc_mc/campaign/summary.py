@@ -16,6 +16,7 @@ import pandas as pd
 
 from ..core.longitudinal.trial import STATUS_NAMES
 from ..stats import median_p95, wilson
+from .scoring import real_flight_scores
 from .transitions import PAPER_TABLES, TRANSITION_TABLE, is_sensor, transition_of
 
 SENSOR_RATES = ("actuator_reset", "wrong_mode", "controller_switch", "misattributed",
@@ -58,7 +59,10 @@ def summarize(trials: pd.DataFrame) -> pd.DataFrame:
     correct block in the window [s] (``correct_reset_s``), over the trials with
     one, whatever was reset before it (the detection delay of the operating
     characteristic; NaN for trials tables without that column);
-    ``detection_median_s`` / ``detection_p95_s``: the belief's detection time [s].
+    ``detection_median_s`` / ``detection_p95_s``: the belief's detection time [s];
+    the real-flight metrics of :mod:`ftc_mc.campaign.scoring` (ALFA precision,
+    recall and delays; average detection delay ``add_s`` and correct diagnosis
+    rate ``cdr``).
 
     Only judged trials (``judged`` column: no numerical failure, inside the
     validity envelope through the judging window, all resets stored) enter the
@@ -110,6 +114,7 @@ def summarize(trials: pd.DataFrame) -> pd.DataFrame:
         row.update(_quantiles("detection", ok["detection_s"].to_numpy()))
         row.update({"paper_trials": paper[0], "paper_inappropriate": paper[1],
                     "paper_no_reset": paper[2]})
+        row.update(real_flight_scores(name, ok))  # ALFA and FDDBenchmark (scoring.py)
         rows.append(row)
     out = pd.DataFrame(rows)
     if len(out):
@@ -198,7 +203,7 @@ def sensor_markdown_table(summary: pd.DataFrame, intervals: bool = True) -> str:
 
 _COUNTS = ("inappropriate", "no_reset", "no_reset_explained", "correct", "correct_only",
            "false_alarm_trials", "mode_changes", "detected", "paper_trials",
-           "paper_inappropriate", "paper_no_reset")
+           "paper_inappropriate", "paper_no_reset", "alfa_tp", "alfa_fp", "alfa_fn")
 
 
 def actuator_rows(summary: pd.DataFrame) -> pd.DataFrame:

@@ -407,6 +407,8 @@ class DesignConfig(_Strict):
     """GLR window [s] (a multiple of model.dt_s; glr only)."""
     settle_s: NonNeg = 0.0
     """After a reset, the other block is not reset for this long [s] while the filter re-converges (a multiple of model.dt_s; 0: no wait)."""
+    startup_s: NonNeg = 0.0
+    """The test is armed this long after the flight's start [s] (a multiple of model.dt_s): before it no block is reset and the GLR window stays empty, so the filter's start-up transient (the truth meets its initial gust at trim) is not tested; 0: armed at once (issue 25)."""
     min_change_s: Pos | None = None
     """Shortest change the GLR tests [s] (a multiple of model.dt_s, at most window_s): a one-step outlier is not a persistent change; null: one step (glr only)."""
     signature: Literal["paper", "swapped"] = "swapped"
@@ -471,6 +473,8 @@ def _check_designs(cfg, listed, where: str, duration: tuple) -> None:
                                     if d.test == "glr" and d.min_change_s is not None])
     _check_periods(cfg.model.dt_s, [(f"designs.{n}.settle_s", d.settle_s)
                                     for n, d in cfg.designs.items() if d.settle_s > 0])
+    _check_periods(cfg.model.dt_s, [(f"designs.{n}.startup_s", d.startup_s)
+                                    for n, d in cfg.designs.items() if d.startup_s > 0])
     _check_periods(cfg.model.dt_s, [(f"designs.{n}.relinearise_s", d.relinearise_s)
                                     for n, d in cfg.designs.items()
                                     if d.relinearise_s is not None])

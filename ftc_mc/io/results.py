@@ -21,7 +21,7 @@ from .atomic import atomic_path, write_text
 
 META_KEY = b"ftc_mc"
 RUN_FILES = ("trials.parquet", "resets.parquet", "summary.parquet", "summary.md",
-             "timeseries.parquet", "events.parquet", "sweep.parquet")
+             "timeseries.parquet", "events.parquet", "sweep.parquet", "endurance.parquet")
 
 
 def package_version() -> str:

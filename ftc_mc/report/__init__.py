@@ -15,7 +15,11 @@ Markdown file with:
   recommended threshold (``sweep.py``); the operating characteristic of its
   designs (flight hours between false resets against detection delay and
   correct-block rate, the paper's design as the baseline) and the design
-  recommended for its truth plant and turbulence (``operating.py``);
+  recommended for its truth plant and turbulence (``operating.py``), with the
+  hours of a matching endurance run where one is given;
+* for each endurance run (``ftc-mc endurance``): false resets per fault-free
+  flight hour per design, the one-sided 95 % bound, whether the false-alarm
+  target is shown and the hours that would show it (``endurance.py``);
 * when at least two runs flew different truth plants or turbulence levels
   (config section ``plant``): their rates side by side per transition, with
   false resets per flight hour and the changes against the reference plant
@@ -48,6 +52,7 @@ from .provenance import (check_provenance, mixed_message, provenance_groups,
                          provenance_section)
 from .runs import (SIGNIFICANCE, exclusion_table, paired_counts, paper_tables,
                    run_section, variant_comparison)
+from .endurance import endurance_section, matching_endurance
 from .operating import (BASELINE_DESIGNS, operating_points, operating_section,
                         recommend_design)
 from .scenario import (scenario_section, switches_and_excitations,
@@ -129,7 +134,10 @@ def build_report(dirs: list, out: Path, allow_mixed: bool = False) -> Path:
         if r.kind == "run":
             lines += run_section(r, fig_dir, slug, out)
         elif r.kind == "sweep":
-            lines += sweep_section(r, fig_dir, slug, out)
+            lines += sweep_section(r, fig_dir, slug, out, matching_endurance(
+                [e for e in inputs if e.kind == "endurance"], r.meta.get("config", {})))
+        elif r.kind == "endurance":
+            lines += endurance_section(r, fig_dir, slug, out)
         else:
             lines += scenario_section(r, out)
     runs = [(r, slug) for r, slug in zip(inputs, names) if r.kind == "run"]

@@ -23,6 +23,8 @@ SCENARIO_TABLES = ("segments.parquet", "events.parquet")
 """Parquet files a scenario directory must hold (``timeseries.parquet`` optional)."""
 SWEEP_TABLES = ("sweep.parquet",)
 """Parquet file of a sweep directory."""
+ENDURANCE_TABLES = ("false_resets.parquet", "endurance.parquet")
+"""Parquet files of an endurance directory (``ftc-mc endurance``)."""
 
 
 @dataclasses.dataclass
@@ -34,7 +36,7 @@ class ResultDir:
     path : Path
         The directory as given.
     kind : str
-        ``"run"``, ``"scenario"`` or ``"sweep"``.
+        ``"run"``, ``"scenario"``, ``"sweep"`` or ``"endurance"``.
     meta : dict
         ``ftc_mc`` metadata of the main table (summary, events or sweep).
     file_meta : dict of str to dict
@@ -53,7 +55,7 @@ class ResultDir:
 def _kind_from_files(path: Path) -> str | None:
     """``"run"``, ``"scenario"``, ``"sweep"`` or None, from the Parquet files present."""
     found = [k for k, files in (("run", RUN_TABLES), ("scenario", SCENARIO_TABLES),
-                                ("sweep", SWEEP_TABLES))
+                                ("sweep", SWEEP_TABLES), ("endurance", ENDURANCE_TABLES[1:]))
              if any((path / f).is_file() for f in files)]
     if len(found) > 1:
         raise UserError(f"{path}: holds {' and '.join(found)} files; give one "
@@ -112,7 +114,8 @@ def load_result_dir(path) -> ResultDir:
         raise UserError(f"{path}: no ftc-mc results{unfinished} (expected trials.parquet "
                         "and summary.parquet of a run, or segments.parquet and "
                         "events.parquet of a scenario)")
-    needed = {"run": RUN_TABLES, "scenario": SCENARIO_TABLES, "sweep": SWEEP_TABLES}[kind]
+    needed = {"run": RUN_TABLES, "scenario": SCENARIO_TABLES, "sweep": SWEEP_TABLES,
+              "endurance": ENDURANCE_TABLES}[kind]
     missing = [f for f in needed if not (path / f).is_file()]
     if missing:
         raise UserError(f"{path}: incomplete {kind} results, missing {', '.join(missing)}")

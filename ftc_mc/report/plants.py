@@ -15,8 +15,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..conventions import (AIRFRAME_PRESETS, DEFAULT_AIRFRAME, PLANT_KINDS, TRANSITIONS,
-                           TURBULENCE_LEVELS)
+from ..conventions import (AIRFRAME_PRESETS, DEFAULT_AIRFRAME, MODE_NAMES, MODE_NOMINAL,
+                           PLANT_KINDS, TRANSITIONS, TURBULENCE_LEVELS)
 from ..config.schema import TimingConfig
 from ..stats import finite_median, poisson_rate
 from .markdown import (DEFAULT_PLANT, LABELS, airframe_of, label, num, plant_condition,
@@ -142,8 +142,10 @@ def condition_rates(trials: pd.DataFrame, fault_time_s: float) -> pd.DataFrame:
     trials : DataFrame
         ``trials.parquet`` of a run.
     fault_time_s : float
-        Fault-free flight before the switch in every trial [s]: the exposure
-        of ``false_resets``.
+        Flight before the switch in every trial [s]: the exposure of
+        ``false_resets``, counted only in trials whose truth is nominal before
+        the switch (``mode_pre``; unlock and recover rows start faulted and
+        have no false resets, issue 25).
 
     Returns
     -------
@@ -158,7 +160,8 @@ def condition_rates(trials: pd.DataFrame, fault_time_s: float) -> pd.DataFrame:
     for (name, variant), g in trials.groupby(["transition", "variant"], sort=False):
         ok = g[g["judged"].astype(bool)]
         n, k = len(ok), int(ok["false_resets"].sum())
-        hours = n * fault_time_s / 3600.0
+        nominal = (ok["mode_pre"] == MODE_NAMES[MODE_NOMINAL]) if "mode_pre" in ok else ok["judged"]
+        hours = int(nominal.sum()) * fault_time_s / 3600.0
         rate, lo, hi = poisson_rate(k, hours)
         rows.append({
             "transition": name, "variant": variant, "judged": n, "excluded": len(g) - n,

@@ -356,6 +356,7 @@ def run_section(r: ResultDir, fig_dir: Path, slug: str, report: Path) -> list:
     """
     from ..plots.campaign import delay_figure  # matplotlib only when drawing
 
+    from .realflight import real_flight_lines
     from .sensors import actuator_part, misattribution_table
 
     full_summary = r.tables["summary"]
@@ -370,4 +371,4 @@ def run_section(r: ResultDir, fig_dir: Path, slug: str, report: Path) -> list:
             + ["### Excluded trials", ""] + exclusion_table(summary, trials, cfg)
             + [_comparison_heading(trials), ""] + variant_comparison(trials)
             + ["### Delay distributions", "", f"![delays of {slug}]({rel_link(fig, report)})",
-               ""] + sensor)
+               ""] + real_flight_lines(trials) + sensor)

@@ -110,7 +110,7 @@ class Design:
             return self.det._replace(t_q=math.inf, t_nx=math.inf)
         det = detection(plant, dataclasses.replace(self.est, t_q=t_q, t_nx=t_nx))
         return _with_test(det, self.test, self.window, self.det.min_window)._replace(
-            settle=self.det.settle)
+            settle=self.det.settle, startup=self.det.startup)
 
 
 def builtin_design(name: str, est: EstimatorConfig) -> DesignConfig:
@@ -185,7 +185,7 @@ def build_design(name: str, dc: DesignConfig, plant: LinearPlant, est: Estimator
     min_window = (1 if test != TEST_GLR or dc.min_change_s is None
                   else int(round(dc.min_change_s / plant.dt)))
     det = _with_test(detection(plant, s), test, window, min_window)._replace(
-        settle=int(round(dc.settle_s / plant.dt)))
+        settle=int(round(dc.settle_s / plant.dt)), startup=int(round(dc.startup_s / plant.dt)))
     # every field but those Table 1 reads only when it decides (a shared start runs
     # with resets disabled)
     key = dc.model_dump_json(exclude={"signature", "t_q", "t_nx"})

@@ -149,7 +149,7 @@ def detection(plant: LinearPlant, s: EstimatorSettings) -> Detection:
                           1.0 / s.t_nx ** 2, 1.0 / s.t_q ** 2, 1.0 / s.t_q ** 2])
     return Detection(t_q=float(s.t_q), t_nx=float(s.t_nx),
                      swapped=1 if s.signature == "swapped" else 0, reset_var=reset_var,
-                     test=TEST_ONE_STEP, window=1, min_window=1, settle=0)
+                     test=TEST_ONE_STEP, window=1, min_window=1, settle=0, startup=0)
 
 
 def belief_settings(plant: LinearPlant, s: EstimatorSettings) -> Belief:

@@ -59,6 +59,8 @@ Detection = namedtuple("Detection", [
     "window",     # GLR window [steps] (1 with the one-step test)
     "min_window", # shortest change the GLR tests [steps] (1: any; <= window)
     "settle",     # steps after a reset during which the other block is not reset (0: none)
+    "startup",    # steps from the start before the test is armed: no reset, GLR window
+                  # kept empty (0: armed at once; DesignConfig.startup_s, issue 25)
 ])
 """Residual signature and covariance reset (paper section 3.2.2, Table 1)."""
 

@@ -245,7 +245,9 @@ def filter_update(path, scheme, st, k, work):
     statistics of :func:`ftc_mc.core.shared.glr.glr_lanes` replace the one-step
     residuals; Table 1
     on them, a decision for the other block withheld within
-    ``detection.settle`` steps of a reset (:func:`settle_lanes`); reset, update
+    ``detection.settle`` steps of a reset (:func:`settle_lanes`), and every
+    decision before step ``detection.startup`` (then the GLR window is kept
+    empty too: the test is armed after the start-up); reset, update
     and projection (the ``*_correct_lanes`` halves); a reset restarts the
     lane's GLR window.  Then
     the largest ``r_q`` and ``r_nx`` seen so far (threshold sweeps).
@@ -276,6 +278,10 @@ def filter_update(path, scheme, st, k, work):
     signature_lanes(res, det, work.block)
     if det.settle > 0:
         settle_lanes(work.block, st.last_k, st.last_block, k, det.settle)
+    if k < det.startup:  # not armed yet: no reset, and the GLR window stays empty
+        for l in range(st.xa.shape[1]):
+            work.block[l] = 0
+            st.ecount[l] = 0
     correct(path, scheme, st, work)
     restart_window(path, work.block, st.ecount)
     if det.settle > 0:
