@@ -110,7 +110,7 @@ def test_real_trial_kernel_cache(tmp_path, monkeypatch):
 def test_the_kernel_cache_follows_every_kernel_module(tmp_path, monkeypatch):
     # Numba checks a cached kernel only against its own file; the cache folder is
     # named after all of core/ and conventions.py, so an edit of a module that a
-    # kernel inlines (core/longitudinal/stages.py into core/longitudinal/trial.py) starts a new folder
+    # kernel inlines (longitudinal/stages.py into longitudinal/trial.py) starts a new folder
     # (tests/test_kernel_cache.py: subpackages, and a second copy of the sources)
     import shutil
 
@@ -120,7 +120,7 @@ def test_the_kernel_cache_follows_every_kernel_module(tmp_path, monkeypatch):
     shutil.copy(src.parent / "conventions.py", copy / "conventions.py")
     same = jit.source_digest(copy / "core")
     assert same == jit.source_digest()
-    stages = copy / "core" / "stages.py"
+    stages = copy / "core" / "longitudinal" / "stages.py"
     stages.write_text(stages.read_text() + "\n# an edit\n")
     assert jit.source_digest(copy / "core") != same
     conv = copy / "conventions.py"
