@@ -47,7 +47,14 @@ from numba.core import event as ev
 stack, rows = [], []
 class Recorder(ev.Listener):
     def on_start(self, e):
-        name = e.data["dispatcher"].py_func.__qualname__ if "dispatcher" in e.data else "?"
+        name = "?"
+        if "dispatcher" in e.data:
+            f = e.data["dispatcher"].py_func
+            name = f.__qualname__
+            # a dispatcher's call (core/shared/paths.on_path): name the kernel it calls
+            for cell in (f.__closure__ or ()) if name.endswith("<lambda>") else ():
+                if hasattr(cell.cell_contents, "py_func"):
+                    name = "-> " + cell.cell_contents.py_func.__name__
         stack.append((name, time.process_time()))
     def on_end(self, e):
         name, t0 = stack.pop()
