@@ -16,7 +16,8 @@ import dataclasses
 import numpy as np
 
 from ..config.schema import parse_sensor_transition
-from ..conventions import OUTPUT_NAMES, SENSOR_FAULT_KINDS, SENSOR_PREFIX
+from ..conventions import (LONGITUDINAL, OUTPUT_NAMES, RESET_ELEVONS, RESET_THRUST,
+                           SENSOR_FAULT_KINDS, SENSOR_PREFIX)
 from ..sim.inputs import Schedule
 
 ENGINE, LEFT, RIGHT = 0, 1, 2
@@ -47,13 +48,14 @@ class Transition:
 
     @property
     def correct_block(self) -> int:
-        """Covariance block that a reset should hit (1 thrust, 2 elevons)."""
-        return 1 if self.actuator == ENGINE else 2
+        """Covariance block that a reset should hit (Table 1's block code of the
+        faulty actuator)."""
+        return LONGITUDINAL.actuator_block[self.actuator]
 
     @property
     def other_block(self) -> int:
-        """The block whose reset is inappropriate."""
-        return 2 if self.actuator == ENGINE else 1
+        """The block whose reset is inappropriate (the other one)."""
+        return RESET_ELEVONS if self.correct_block == RESET_THRUST else RESET_THRUST
 
     def schedule(self, values: np.ndarray, k_fault: int) -> Schedule:
         """The two-entry schedule of trials with the fault values ``values``.

@@ -12,9 +12,12 @@ import math
 import numpy as np
 import scipy.linalg
 
+from ..conventions import LONGITUDINAL
 
-def paper_q_lqr(gamma0: float, n: int = 9) -> np.ndarray:
-    """``Q_lqr = diag(0, 0, 0, tan^2(gamma), 1, 0, 0, 0, 0)`` (section 5.1).
+
+def paper_q_lqr(gamma0: float, n: int = LONGITUDINAL.n_x) -> np.ndarray:
+    """``Q_lqr = diag(0, 0, 0, tan^2(gamma), 1, 0, 0, 0, 0)`` (section 5.1): the
+    weights on the along-track ``x`` and the vertical ``z`` deviations.
 
     Parameters
     ----------
@@ -24,8 +27,8 @@ def paper_q_lqr(gamma0: float, n: int = 9) -> np.ndarray:
         State dimension (9).
     """
     q = np.zeros(n)
-    q[3] = math.tan(gamma0) ** 2
-    q[4] = 1.0
+    q[LONGITUDINAL.state("x")] = math.tan(gamma0) ** 2
+    q[LONGITUDINAL.state("z")] = 1.0
     return np.diag(q)
 
 

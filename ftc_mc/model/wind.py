@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..conventions import LONGITUDINAL
 from ..conventions import N_X as N_STATE
 from ..conventions import N_Z as N_OUTPUT
 from ..core.longitudinal.nonlinear import derivatives_nb, outputs_nb
@@ -53,8 +54,8 @@ def wind_matrices(plant: LinearPlant):
     # structural zeros (the finite differences leave ~1e-12 there): the
     # kinematics, attitude and actuator rates and the first six outputs (the
     # states themselves) do not depend on the air's motion
-    Ewc[3:] = 0.0
-    Dw[:6] = 0.0
+    Ewc[LONGITUDINAL.state("x"):] = 0.0
+    Dw[:LONGITUDINAL.output("n_x")] = 0.0
     _, Bw = zoh(plant.Ac, Ewc, plant.dt)
     return np.ascontiguousarray(Bw), np.ascontiguousarray(Dw), Ewc
 

@@ -25,7 +25,11 @@ import math
 
 import numpy as np
 
+from ..conventions import LONGITUDINAL as LAY
+from ..conventions import N_MODES
+from ..core.longitudinal.gustfilter import N_WIND
 from ..core.longitudinal.settings import TrialInputs, TrialRecord
+from ..core.longitudinal.workspace import N_EXC
 from ..core.longitudinal.trial import advance, init_jacobians, init_state, new_state
 from .inputs import design_inputs
 from .paths import path_of
@@ -60,7 +64,7 @@ def run_trials(scheme, flight, inp: TrialInputs, rec: TrialRecord) -> None:
 
 
 def new_record(setup, L: int, max_resets: int, history: bool = False,
-               n_est: int = 14) -> TrialRecord:
+               n_est: int = LAY.n_aug) -> TrialRecord:
     """Preallocated outputs of :func:`run_trials`.
 
     ``history=True`` keeps every step's state, estimate, commands, residuals
@@ -70,20 +74,21 @@ def new_record(setup, L: int, max_resets: int, history: bool = False,
     """
     n_per = setup.tim.n_steps // setup.tim.reconf_every
     n_hist = setup.tim.n_steps if history else 0
+    n_res, n_par = len(LAY.residuals), len(LAY.params)
     return TrialRecord(
         reset_k=np.zeros((max_resets, L), dtype=np.int64),
         reset_block=np.zeros((max_resets, L), dtype=np.int64),
-        reset_res=np.zeros((max_resets, 3, L)),
+        reset_res=np.zeros((max_resets, n_res, L)),
         n_resets=np.zeros(L, dtype=np.int64),
-        belief=np.zeros((n_per, 4, L)), bhat=np.zeros((n_per, 5, L)),
+        belief=np.zeros((n_per, N_MODES, L)), bhat=np.zeros((n_per, n_par, L)),
         detect_k=np.zeros(L, dtype=np.int64), status=np.zeros(L, dtype=np.int64),
         stop_k=np.zeros(L, dtype=np.int64),
         controller=np.zeros((n_per, L), dtype=np.int64),
-        hist_x=np.zeros((n_hist, 9, L)), hist_xa=np.zeros((n_hist, 14, L)),
-        hist_pdiag=np.zeros((n_hist, 5, L)), hist_u=np.zeros((n_hist, 3, L)),
-        hist_res=np.zeros((n_hist, 3, L)), hist_exc=np.zeros((n_hist, 4, L)),
+        hist_x=np.zeros((n_hist, LAY.n_x, L)), hist_xa=np.zeros((n_hist, LAY.n_aug, L)),
+        hist_pdiag=np.zeros((n_hist, n_par, L)), hist_u=np.zeros((n_hist, LAY.n_u, L)),
+        hist_res=np.zeros((n_hist, n_res, L)), hist_exc=np.zeros((n_hist, N_EXC, L)),
         hist_block=np.zeros((n_hist, L), dtype=np.int64),
-        hist_wind=np.zeros((n_hist, 3, L)),
+        hist_wind=np.zeros((n_hist, N_WIND, L)),
         xa_end=np.zeros((n_est, L)))
 
 
