@@ -111,7 +111,7 @@ def _design_override(cfg, design, signature) -> dict | None:
 
 def campaign_config(config, *, trials=None, seed=None, signature=None, transitions=None,
                     controller=None, plant=None, turbulence=None, airframe=None,
-                    design=None):
+                    design=None, reset_log=None):
     """A validated campaign :class:`~ftc_mc.config.Config` with overrides.
 
     Parameters
@@ -132,6 +132,8 @@ def campaign_config(config, *, trials=None, seed=None, signature=None, transitio
         The designs to run (``--design``): ``paper``, ``swapped`` or keys of the
         ``designs`` section, on the same trials; replaces ``campaign.signature``
         and ``campaign.designs`` (the built-in designs run first).
+    reset_log : str, optional
+        ``campaign.reset_log``: ``all``, ``none`` or ``first-N``.
     """
     from .config import Config, ScenarioConfig, load_config as load_campaign
     from .config import parse_config, with_overrides
@@ -146,7 +148,7 @@ def campaign_config(config, *, trials=None, seed=None, signature=None, transitio
     else:
         cfg = load_campaign(config)
     over = {"campaign": {"trials": trials, "seed": seed, "signature": signature,
-                         "transitions": _listed(transitions)},
+                         "transitions": _listed(transitions), "reset_log": reset_log},
             "controller": {"kind": controller},
             "plant": {"kind": plant, "turbulence": turbulence},
             "model": {"airframe": None if airframe is None else str(airframe)}}
@@ -261,7 +263,8 @@ def _finished(out_dir: Path, kind: str, files, identity: dict) -> bool:
 # -- the commands -----------------------------------------------------------------
 
 def run_campaign(config, *, trials=None, seed=None, signature=None, controller=None,
-                 plant=None, turbulence=None, airframe=None, design=None, jobs: int = 1,
+                 plant=None, turbulence=None, airframe=None, design=None, reset_log=None,
+                 jobs: int = 1,
                  progress: bool = True,
                  backend: str = "threads", scheduler: str | None = None, out=None,
                  overwrite: bool = False, resume: bool = False,
@@ -272,7 +275,7 @@ def run_campaign(config, *, trials=None, seed=None, signature=None, controller=N
     ----------
     config : str, Path, dict or Config
         YAML path, parsed mapping or validated configuration.
-    trials, seed, signature, controller, plant, turbulence, airframe, design : optional
+    trials, seed, signature, controller, plant, turbulence, airframe, design, reset_log : optional
         Overrides of the config (:func:`campaign_config`).
     jobs : int
         Workers (``backend``); 1 runs here alone, -1 uses every core (or, on
@@ -299,8 +302,10 @@ def run_campaign(config, *, trials=None, seed=None, signature=None, controller=N
     CampaignResult or None
         ``.summary`` (one row per transition and variant), ``.trials`` (one
         row per trial and variant), ``.resets`` (one row per reset) and
-        ``.config``.  None if ``resume`` found the run already finished in
-        ``out`` (nothing was run).
+        ``.config``; with ``out``, ``.trials`` and ``.resets`` are read from
+        the files written there when asked for (a run of millions of trials
+        never holds them in memory).  None if ``resume`` found the run already
+        finished in ``out`` (nothing was run).
 
     Raises
     ------
@@ -308,16 +313,18 @@ def run_campaign(config, *, trials=None, seed=None, signature=None, controller=N
         A bad config or option, or an ``out`` that is busy, holds other results
         or (with ``resume``) no interrupted run; nothing is written then.
     KeyboardInterrupt
-        The finished chunks stay in ``out``; ``resume=True`` continues.
+        Ctrl-C (or :class:`ftc_mc.interrupt.Interrupted` for SIGINT/SIGTERM
+        under :func:`ftc_mc.interrupt.stop_on_signals`): the finished chunks
+        stay in ``out``; ``resume=True`` continues.
     """
     from .campaign.runner import run_campaign as run
     from .io.lock import acquire
-    from .io.results import prepare_output_dir, provenance, write_run
+    from .io.results import prepare_output_dir, provenance, write_summary
 
     _check_jobs(jobs)
     cfg = campaign_config(config, trials=trials, seed=seed, signature=signature,
                           controller=controller, plant=plant, turbulence=turbulence,
-                          airframe=airframe, design=design)
+                          airframe=airframe, design=design, reset_log=reset_log)
     kw = dict(jobs=jobs, progress=progress, backend=backend, scheduler=scheduler)
     out_dir = _check_out(out, resume)
     if out_dir is None:
@@ -330,14 +337,14 @@ def run_campaign(config, *, trials=None, seed=None, signature=None, controller=N
         prepare_output_dir(out_dir, overwrite)
         store = _open_chunks(out_dir, json.dumps(config_json, sort_keys=True), overwrite,
                              resume)
+        meta = provenance(config_json, cfg.campaign.seed, "run")
         try:
-            result = run(cfg, chunks=store, **kw)
+            result = run(cfg, chunks=store, out=out_dir, meta=meta, **kw)
         except Exception:  # e.g. draws outside the command range, no Dask scheduler
             store.discard_if_empty()
             raise
-        meta = provenance(config_json, cfg.campaign.seed, "run")
         md = "# ftc-mc run summary\n\n" + result.markdown() + "\n"
-        write_run(out_dir, result.trials, result.resets, result.summary, md, meta)
+        write_summary(out_dir, result.summary, md, meta)
         store.remove()
     return result
 
@@ -383,7 +390,8 @@ def run_sweep(config, thresholds=None, *, tq=None, tnx=None, transitions=None,
     -------
     SweepResult or None
         ``.table`` (one row per threshold point, transition and variant, with
-        the false resets per flight hour), ``.trials``, ``.points``,
+        the false resets per flight hour), ``.trials`` (None with ``out``: the
+        table is assembled from the chunks one point at a time), ``.points``,
         ``.saving``.  None if ``resume`` found the sweep already finished.
     """
     from .campaign.sweep import run_sweep as sweep, sweep_markdown, threshold_points
