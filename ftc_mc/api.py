@@ -234,6 +234,18 @@ def _open_chunks(out_dir: Path, identity_json: str, overwrite: bool, resume: boo
     return store
 
 
+def _prepare(out_dir: Path, overwrite: bool, resume: bool) -> None:
+    """Refuse an output folder that holds results (``io.results.prepare_output_dir``),
+    except when resuming a run whose chunks are still there: a run interrupted
+    while it wrote its result files (the last minutes of a big run) may have
+    written some of them, and resuming writes them again."""
+    from .io.chunks import ChunkStore
+    from .io.results import prepare_output_dir
+
+    if not (resume and not overwrite and ChunkStore(out_dir, "").exists()):
+        prepare_output_dir(out_dir, overwrite)
+
+
 def _finished(out_dir: Path, kind: str, files, identity: dict) -> bool:
     """Whether ``out_dir`` holds a finished ``kind`` with this identity.
 
@@ -319,7 +331,7 @@ def run_campaign(config, *, trials=None, seed=None, signature=None, controller=N
     """
     from .campaign.runner import run_campaign as run
     from .io.lock import acquire
-    from .io.results import prepare_output_dir, provenance, write_summary
+    from .io.results import provenance, write_summary
 
     _check_jobs(jobs)
     cfg = campaign_config(config, trials=trials, seed=seed, signature=signature,
@@ -334,7 +346,7 @@ def run_campaign(config, *, trials=None, seed=None, signature=None, controller=N
         if resume and not overwrite and _finished(out_dir, "run", RUN_OUTPUTS,
                                                   {"config": config_json}):
             return None
-        prepare_output_dir(out_dir, overwrite)
+        _prepare(out_dir, overwrite, resume)
         store = _open_chunks(out_dir, json.dumps(config_json, sort_keys=True), overwrite,
                              resume)
         meta = provenance(config_json, cfg.campaign.seed, "run")
@@ -397,7 +409,7 @@ def run_sweep(config, thresholds=None, *, tq=None, tnx=None, transitions=None,
     from .campaign.sweep import run_sweep as sweep, sweep_markdown, threshold_points
     from .io.atomic import write_text
     from .io.lock import acquire
-    from .io.results import prepare_output_dir, provenance, write_parquet
+    from .io.results import provenance, write_parquet
 
     cfg = campaign_config(config, trials=trials, seed=seed, signature=signature,
                           transitions=transitions, plant=plant, turbulence=turbulence,
@@ -420,7 +432,7 @@ def run_sweep(config, thresholds=None, *, tq=None, tnx=None, transitions=None,
                 out_dir, "sweep", SWEEP_OUTPUTS, {"config": config_json,
                                                    "points": point_list}):
             return None
-        prepare_output_dir(out_dir, overwrite)
+        _prepare(out_dir, overwrite, resume)
         store = _open_chunks(out_dir, json.dumps(identity, sort_keys=True), overwrite,
                              resume)
         try:

@@ -4,6 +4,7 @@ and never changes the summary; result files honour the umask; resuming lists the
 chunk folder once.
 """
 
+import json
 import os
 import stat
 
@@ -16,6 +17,8 @@ import yaml
 from click.testing import CliRunner
 
 import ftc_mc
+from ftc_mc.campaign.chunk import chunk_spec, run_chunk
+from ftc_mc.campaign.runner import plan_chunks
 from ftc_mc.campaign.summary import summarize
 from ftc_mc.cli import cli
 from ftc_mc.errors import UserError
@@ -147,3 +150,26 @@ def test_resume_lists_the_chunk_folder_once(tmp_path):
     assert store.finished() == {("sensor_bias:q", s) for s in range(0, 3000, 3)}
     ChunkStore(tmp_path, "{}").open(resume=True)
     assert not list(folder.glob(".*.tmp"))
+
+
+def test_resume_after_an_interrupt_while_writing_the_result_files(tmp_path):
+    """Interrupted after ``resets.parquet`` was written but before the summary: the
+    chunks are still there, and ``--resume`` writes the files again."""
+    out = tmp_path / "out"
+    ref = ftc_mc.run_campaign(MIXED, jobs=1, progress=False, out=out)
+    want = {f: pd.read_parquet(out / f"{f}.parquet") for f in ("trials", "resets", "summary")}
+    for f in ("summary.parquet", "summary.md", "trials.parquet"):
+        (out / f).unlink()
+    identity = json.dumps(ref.config.model_dump(mode="json"), sort_keys=True)
+    store = ChunkStore(out, identity)
+    store.open(resume=False)
+    spec = chunk_spec(ref.config)
+    for n, ids in plan_chunks(ref.config):
+        parts = run_chunk(spec, n, ids)
+        store.write(n, int(ids[0]), parts["trials"], resets=parts["resets"])
+    with pytest.raises(UserError, match="already holds results"):
+        ftc_mc.run_campaign(MIXED, progress=False, out=out)
+    res = ftc_mc.run_campaign(MIXED, progress=False, out=out, resume=True)
+    assert res is not None and not (out / ".chunks").exists()
+    for f, df in want.items():
+        _same_bits(pd.read_parquet(out / f"{f}.parquet"), df)
