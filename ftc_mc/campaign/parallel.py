@@ -22,15 +22,18 @@ chunk function runs everywhere, and results do not depend on where they ran.
 Kernels are compiled (and cached on disk) in the parent before fanning out;
 Dask workers on other machines compile their own copy once.
 
-The main thread only submits chunks, waits for the next one with a short
-timeout, and writes the finished ones to the chunk store (one at a time, in
-whatever order they finish: each chunk has its own files, and the results are
-assembled in chunk order later).  At most two chunks per worker are in flight,
-so the parent holds at most that many chunk results.  An interrupt
-(:mod:`ftc_mc.interrupt`) is therefore handled at once: chunks already stored
-stay, chunks in flight are dropped (a chunk file is written atomically, so it is
-whole or absent), the workers are told to stop (worker processes are killed),
-and the interrupt goes up to the command.
+The main thread only submits chunks and waits for the next one with a short
+timeout; one writer thread stores the finished ones in the chunk store (one at
+a time, in whatever order they finish: each chunk has its own files, and the
+results are assembled in chunk order later), so not even a slow disk (a
+``fsync``) delays the main thread.  At most two chunks per worker are in flight,
+and at most as many wait to be written, so the parent holds at most that many
+chunk results.  An interrupt (:mod:`ftc_mc.interrupt`) is therefore handled at
+once: chunks already stored stay, chunks in flight are dropped (a chunk's files
+are written atomically and its trials file last, so a chunk is whole or not
+counted, even when the process ends during its write), the workers are told
+to stop (worker processes are killed), and the interrupt goes up to the
+command.
 """
 
 from __future__ import annotations
@@ -309,33 +312,50 @@ def run_chunks(spec: ChunkSpec, units, *, n_jobs: int = 1, backend_name: str = "
         bar.update(total - sum(len(ids) for _, ids in todo))
         if todo:
             pool = _executor(backend_name, spec, max(1, n_jobs), scheduler)
-            aborted = True
-            pending = {}
+            writer = cf.ThreadPoolExecutor(1, thread_name_prefix="ftc-mc-write")
+            aborted, interrupted = True, False
+            pending, writing = {}, {}
             try:
                 queued = iter(todo)
                 depth = 2 * max(1, n_jobs)
-                for name, ids in queued:
-                    pending[pool.submit(name, ids)] = (name, ids)
-                    if len(pending) >= depth:
-                        break
-                while pending:
-                    ready, _ = cf.wait(pending, timeout=WAIT_S,
+
+                def refill():
+                    while len(pending) < depth and len(writing) < depth:
+                        nxt = next(queued, None)
+                        if nxt is None:
+                            return
+                        pending[pool.submit(*nxt)] = nxt
+
+                refill()
+                while pending or writing:
+                    ready, _ = cf.wait([*pending, *writing], timeout=WAIT_S,
                                        return_when=cf.FIRST_COMPLETED)
                     for fut in ready:
+                        if fut in writing:
+                            fut.result()  # a write that failed stops the run
+                            bar.update(len(writing.pop(fut)[1]))
+                            continue
                         name, ids = pending.pop(fut)
                         out = fut.result()
                         if chunks is not None:
-                            chunks.write(name, int(ids[0]), out[tables[0]],
-                                         **{t: out[t] for t in tables[1:]})
+                            writing[writer.submit(chunks.write, name, int(ids[0]),
+                                                  out[tables[0]],
+                                                  **{t: out[t] for t in tables[1:]})] = (
+                                name, ids)
                         else:
                             done[name, int(ids[0])] = out
+                            bar.update(len(ids))
                         del out
-                        bar.update(len(ids))
-                        for nxt in queued:
-                            pending[pool.submit(*nxt)] = nxt
-                            break
+                    refill()
                 aborted = False
+            except KeyboardInterrupt:
+                interrupted = True
+                raise
             finally:
+                # an interrupt does not wait for a write under way (the process
+                # ends at once; a chunk's trials file is written last); an error
+                # does, so that the caller finds the store as it stays
+                writer.shutdown(wait=not interrupted, cancel_futures=aborted)
                 if aborted:
                     for fut in pending:
                         fut.cancel()
