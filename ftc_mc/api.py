@@ -115,7 +115,7 @@ def _design_override(cfg, design, signature) -> dict | None:
 
 def campaign_config(config, *, trials=None, seed=None, signature=None, transitions=None,
                     controller=None, plant=None, turbulence=None, airframe=None,
-                    design=None):
+                    design=None, reset_log=None):
     """A validated campaign :class:`~ftc_mc.config.Config` with overrides.
 
     Parameters
@@ -136,6 +136,8 @@ def campaign_config(config, *, trials=None, seed=None, signature=None, transitio
         The designs to run (``--design``): ``paper``, ``swapped`` or keys of the
         ``designs`` section, on the same trials; replaces ``campaign.signature``
         and ``campaign.designs`` (the built-in designs run first).
+    reset_log : str, optional
+        ``campaign.reset_log``: ``all``, ``none`` or ``first-N``.
     """
     from .config import Config, ScenarioConfig, load_config as load_campaign
     from .config import parse_config, with_overrides
@@ -150,7 +152,7 @@ def campaign_config(config, *, trials=None, seed=None, signature=None, transitio
     else:
         cfg = load_campaign(config)
     over = {"campaign": {"trials": trials, "seed": seed, "signature": signature,
-                         "transitions": _listed(transitions)},
+                         "transitions": _listed(transitions), "reset_log": reset_log},
             "controller": {"kind": controller},
             "plant": {"kind": plant, "turbulence": turbulence},
             "model": {"airframe": None if airframe is None else str(airframe)}}
@@ -236,6 +238,18 @@ def _open_chunks(out_dir: Path, identity_json: str, overwrite: bool, resume: boo
     return store
 
 
+def _prepare(out_dir: Path, overwrite: bool, resume: bool) -> None:
+    """Refuse an output folder that holds results (``io.results.prepare_output_dir``),
+    except when resuming a run whose chunks are still there: a run interrupted
+    while it wrote its result files (the last minutes of a big run) may have
+    written some of them, and resuming writes them again."""
+    from .io.chunks import ChunkStore
+    from .io.results import prepare_output_dir
+
+    if not (resume and not overwrite and ChunkStore(out_dir, "").exists()):
+        prepare_output_dir(out_dir, overwrite)
+
+
 def _finished(out_dir: Path, kind: str, files, identity: dict) -> bool:
     """Whether ``out_dir`` holds a finished ``kind`` with this identity.
 
@@ -265,7 +279,8 @@ def _finished(out_dir: Path, kind: str, files, identity: dict) -> bool:
 # -- the commands -----------------------------------------------------------------
 
 def run_campaign(config, *, trials=None, seed=None, signature=None, controller=None,
-                 plant=None, turbulence=None, airframe=None, design=None, jobs: int = 1,
+                 plant=None, turbulence=None, airframe=None, design=None, reset_log=None,
+                 jobs: int = 1,
                  progress: bool = True,
                  backend: str = "threads", scheduler: str | None = None, out=None,
                  overwrite: bool = False, resume: bool = False,
@@ -276,7 +291,7 @@ def run_campaign(config, *, trials=None, seed=None, signature=None, controller=N
     ----------
     config : str, Path, dict or Config
         YAML path, parsed mapping or validated configuration.
-    trials, seed, signature, controller, plant, turbulence, airframe, design : optional
+    trials, seed, signature, controller, plant, turbulence, airframe, design, reset_log : optional
         Overrides of the config (:func:`campaign_config`).
     jobs : int
         Workers (``backend``); 1 runs here alone, -1 uses every core (or, on
@@ -303,8 +318,10 @@ def run_campaign(config, *, trials=None, seed=None, signature=None, controller=N
     CampaignResult or None
         ``.summary`` (one row per transition and variant), ``.trials`` (one
         row per trial and variant), ``.resets`` (one row per reset) and
-        ``.config``.  None if ``resume`` found the run already finished in
-        ``out`` (nothing was run).
+        ``.config``; with ``out``, ``.trials`` and ``.resets`` are read from
+        the files written there when asked for (a run of millions of trials
+        never holds them in memory).  None if ``resume`` found the run already
+        finished in ``out`` (nothing was run).
 
     Raises
     ------
@@ -312,16 +329,18 @@ def run_campaign(config, *, trials=None, seed=None, signature=None, controller=N
         A bad config or option, or an ``out`` that is busy, holds other results
         or (with ``resume``) no interrupted run; nothing is written then.
     KeyboardInterrupt
-        The finished chunks stay in ``out``; ``resume=True`` continues.
+        Ctrl-C (or :class:`ftc_mc.interrupt.Interrupted` for SIGINT/SIGTERM
+        under :func:`ftc_mc.interrupt.stop_on_signals`): the finished chunks
+        stay in ``out``; ``resume=True`` continues.
     """
     from .campaign.runner import run_campaign as run
     from .io.lock import acquire
-    from .io.results import prepare_output_dir, provenance, write_run
+    from .io.results import provenance, write_summary
 
     _check_jobs(jobs)
     cfg = campaign_config(config, trials=trials, seed=seed, signature=signature,
                           controller=controller, plant=plant, turbulence=turbulence,
-                          airframe=airframe, design=design)
+                          airframe=airframe, design=design, reset_log=reset_log)
     kw = dict(jobs=jobs, progress=progress, backend=backend, scheduler=scheduler)
     out_dir = _check_out(out, resume)
     if out_dir is None:
@@ -331,17 +350,17 @@ def run_campaign(config, *, trials=None, seed=None, signature=None, controller=N
         if resume and not overwrite and _finished(out_dir, "run", RUN_OUTPUTS,
                                                   {"config": config_json}):
             return None
-        prepare_output_dir(out_dir, overwrite)
+        _prepare(out_dir, overwrite, resume)
         store = _open_chunks(out_dir, json.dumps(config_json, sort_keys=True), overwrite,
                              resume)
+        meta = provenance(config_json, cfg.campaign.seed, "run")
         try:
-            result = run(cfg, chunks=store, **kw)
+            result = run(cfg, chunks=store, out=out_dir, meta=meta, **kw)
         except Exception:  # e.g. draws outside the command range, no Dask scheduler
             store.discard_if_empty()
             raise
-        meta = provenance(config_json, cfg.campaign.seed, "run")
         md = "# ftc-mc run summary\n\n" + result.markdown() + "\n"
-        write_run(out_dir, result.trials, result.resets, result.summary, md, meta)
+        write_summary(out_dir, result.summary, md, meta)
         store.remove()
     return result
 
@@ -387,13 +406,14 @@ def run_sweep(config, thresholds=None, *, tq=None, tnx=None, transitions=None,
     -------
     SweepResult or None
         ``.table`` (one row per threshold point, transition and variant, with
-        the false resets per flight hour), ``.trials``, ``.points``,
+        the false resets per flight hour), ``.trials`` (None with ``out``: the
+        table is assembled from the chunks one point at a time), ``.points``,
         ``.saving``.  None if ``resume`` found the sweep already finished.
     """
     from .campaign.sweep import run_sweep as sweep, sweep_markdown, threshold_points
     from .io.atomic import write_text
     from .io.lock import acquire
-    from .io.results import prepare_output_dir, provenance, write_parquet
+    from .io.results import provenance, write_parquet
 
     cfg = campaign_config(config, trials=trials, seed=seed, signature=signature,
                           transitions=transitions, plant=plant, turbulence=turbulence,
@@ -416,7 +436,7 @@ def run_sweep(config, thresholds=None, *, tq=None, tnx=None, transitions=None,
                 out_dir, "sweep", SWEEP_OUTPUTS, {"config": config_json,
                                                    "points": point_list}):
             return None
-        prepare_output_dir(out_dir, overwrite)
+        _prepare(out_dir, overwrite, resume)
         store = _open_chunks(out_dir, json.dumps(identity, sort_keys=True), overwrite,
                              resume)
         try:

@@ -225,18 +225,50 @@ def parallel_options(func):
 
 @contextlib.contextmanager
 def _interruptible(out_dir):
-    """Ctrl-C with finished chunks on disk: say where they are and how to continue."""
-    from .io.chunks import FOLDER
+    """SIGINT (Ctrl-C) or SIGTERM stops the command: one line says what is kept and
+    how to continue, and the process ends with 130 or 143 at once
+    (:mod:`ftc_mc.interrupt`; a second signal ends it at once, too)."""
+    from .interrupt import exit_code, hard_exit, stop_on_signals
+    from .io.chunks import FOLDER, ChunkStore
 
-    try:
-        yield
-    except KeyboardInterrupt:
-        folder = out_dir / FOLDER
-        if not (folder / "manifest.json").exists():
-            raise
-        click.echo(f"\ninterrupted: finished chunks are kept in {folder}; "
-                   f"continue with --resume --out {out_dir}", err=True)
-        sys.exit(130)
+    with stop_on_signals():
+        try:
+            yield
+        except KeyboardInterrupt as exc:
+            folder = out_dir / FOLDER
+            what = signal_name(exc)
+            if (folder / "manifest.json").exists():
+                n = len(ChunkStore(out_dir, "").finished())
+                click.echo(f"\ninterrupted ({what}): {n} finished chunk(s) kept in {folder}; "
+                           f"continue with: {resume_command(out_dir)}", err=True)
+            elif any((out_dir / f).exists() for f in ("summary.md", "sweep.md")):
+                click.echo(f"\ninterrupted ({what}) after the results were written to "
+                           f"{out_dir}", err=True)
+            else:
+                click.echo(f"\ninterrupted ({what}) before any chunk was finished; "
+                           "nothing to resume", err=True)
+            hard_exit(exit_code(exc))
+
+
+def signal_name(exc: BaseException) -> str:
+    """``SIGINT`` or ``SIGTERM``: the signal behind an interrupt."""
+    from .interrupt import Interrupted
+
+    return str(exc) if isinstance(exc, Interrupted) else "SIGINT"
+
+
+def resume_command(out_dir) -> str:
+    """The command line that continues this one: its own arguments without
+    ``--out``, ``--overwrite`` and ``--resume``, then ``--resume --out DIR``."""
+    args, skip = [], False
+    for a in sys.argv[1:]:
+        if skip:
+            skip = False
+        elif a == "--out":
+            skip = True
+        elif not (a.startswith("--out=") or a in ("--overwrite", "--resume")):
+            args.append(a)
+    return shlex.join(["ftc-mc", *args, "--resume", "--out", str(out_dir)])
 
 
 def terminal_table(summary) -> str:
@@ -289,11 +321,15 @@ def terminal_table(summary) -> str:
 @click.option("--overwrite", is_flag=True, help="Replace results already in --out.")
 @click.option("--resume", is_flag=True,
               help="Continue an interrupted run in --out, skipping its finished chunks.")
+@click.option("--reset-log", metavar="all|none|first-N",
+              help="Resets written to resets.parquet: all (the default), none, or the "
+              "first N of each trial; trials.parquet and the summary do not depend on "
+              "it (overrides campaign.reset_log).")
 @plant_options
 @parallel_options
 @user_errors
 def run(config, trials, seed, jobs, out, signature, design, controller, overwrite, resume,
-        backend, scheduler, quiet, plant, turbulence, airframe):
+        reset_log, backend, scheduler, quiet, plant, turbulence, airframe):
     """Run a Monte Carlo campaign (the paper's Tables 2-3) from CONFIG."""
     from pathlib import Path
 
@@ -301,7 +337,8 @@ def run(config, trials, seed, jobs, out, signature, design, controller, overwrit
 
     cfg = api.campaign_config(config, trials=trials, seed=seed, signature=signature,
                               controller=controller, plant=plant, turbulence=turbulence,
-                              airframe=airframe, design=list(design) or None)
+                              airframe=airframe, design=list(design) or None,
+                              reset_log=reset_log)
     if resume and not out:
         raise UserError("--resume: name the run's directory with --out")
     out_dir = Path(out) if out else _default_out(config, cfg)

@@ -108,25 +108,107 @@ def test_resume_without_interrupted_run(tmp_path, reference):
     assert res.exit_code == 2 and "no interrupted run" in res.output
 
 
-def test_sigint_keeps_finished_chunks(tmp_path, reference):
-    cfg, ref = reference
+LONGER = CONFIG.replace("trials: 24", "trials: 400").replace("chunk_size: 2", "chunk_size: 16")
+"""Long enough (50 chunks, a few seconds on two workers) for a signal sent after
+the third chunk to arrive while the run is going on."""
+
+
+@pytest.fixture(scope="module")
+def longer_reference(tmp_path_factory):
+    d = tmp_path_factory.mktemp("longer")
+    cfg = d / "cfg.yaml"
+    cfg.write_text(LONGER)
+    res = CliRunner().invoke(cli, ["run", str(cfg), "--out", str(d / "out"), "--jobs", "2",
+                                   "--quiet"])
+    assert res.exit_code == 0, res.output
+    return cfg, _data(d / "out")
+
+
+def _stopped(p, sig):
+    """Send ``sig`` to ``p``; its exit code, stderr and seconds to exit."""
+    t0 = time.monotonic()
+    p.send_signal(sig)
+    try:
+        err = p.communicate(timeout=60)[1]
+    finally:
+        p.kill()  # never left running by a failed test
+    return p.returncode, err if isinstance(err, str) else err.decode(), time.monotonic() - t0
+
+
+@pytest.mark.parametrize("backend, sig", [("threads", signal.SIGINT),
+                                          ("threads", signal.SIGTERM),
+                                          ("loky", signal.SIGTERM)])
+def test_a_signal_stops_the_run_keeps_finished_chunks_and_resumes(tmp_path, longer_reference,
+                                                                  backend, sig):
+    cfg, ref = longer_reference
     out = tmp_path / "out"
-    p = _run([str(cfg), "--out", str(out), "--jobs", "1", "--quiet"])
-    while len(list((out / ".chunks").glob("*.trials.parquet"))) < 3 and p.poll() is None:
+    chunks = out / ".chunks"
+    p = _run([str(cfg), "--out", str(out), "--jobs", "2", "--backend", backend, "--quiet"])
+    deadline = time.time() + 120
+    while len(list(chunks.glob("*.trials.parquet"))) < 3 and time.time() < deadline:
+        assert p.poll() is None, p.communicate()[1].decode()
         time.sleep(0.01)
-    p.send_signal(signal.SIGINT)
-    err = p.communicate(timeout=60)[1].decode()
-    if p.returncode == 130:
-        assert "--resume" in err and "Traceback" not in err
-        assert list((out / ".chunks").glob("*.trials.parquet"))
-        assert not (out / ".ftc-mc.lock").exists()
+    code, err, wait = _stopped(p, sig)
+    assert code == 128 + sig, err
+    assert wait < 3.0, f"{wait:.1f} s from the signal to the exit"
+    lines = [ln for ln in err.splitlines() if ln.strip()]
+    assert len(lines) == 1 and "Traceback" not in err, err
+    assert lines[0].startswith(f"interrupted ({signal.Signals(sig).name}): ")
+    assert f"--resume --out {out}" in lines[0]
+    kept = sorted(chunks.glob("*.trials.parquet"))
+    assert len(kept) >= 3 and f"{len(kept)} finished chunk(s)" in lines[0]
+    assert not (out / "summary.md").exists(), "the run finished before the signal"
+    assert not (out / ".ftc-mc.lock").exists()
+    for f in chunks.glob("*.parquet"):
+        pq.read_table(f)  # whole: an in-flight chunk is absent, not half-written
     res = CliRunner().invoke(cli, ["run", str(cfg), "--out", str(out), "--resume",
-                                   "--jobs", "1", "--quiet"])
-    if p.returncode == 130:
-        assert res.exit_code == 0, res.output
-        for f, df in ref.items():
-            pd.testing.assert_frame_equal(_data(out)[f], df, check_exact=True)
-    assert os.path.exists(out / "summary.md")
+                                   "--jobs", "2", "--quiet"])
+    assert res.exit_code == 0, res.output
+    got = _data(out)
+    for f, df in ref.items():
+        pd.testing.assert_frame_equal(got[f], df, check_exact=True)
+
+
+def test_a_signal_does_not_wait_for_long_chunks(tmp_path):
+    """Two chunks of 2048 trials each, several seconds of nogil kernel: the main
+    thread does not wait for them, and nothing of them is written."""
+    cfg = tmp_path / "cfg.yaml"
+    cfg.write_text(CONFIG.replace("trials: 24", "trials: 4096")
+                   .replace("chunk_size: 2", "chunk_size: 2048")
+                   .replace("duration_s: 6", "duration_s: 60"))
+    out = tmp_path / "out"
+    p = _run([str(cfg), "--out", str(out), "--jobs", "2", "--quiet"])
+    while not (out / ".chunks" / "manifest.json").exists():
+        assert p.poll() is None, p.communicate()[1].decode()
+        time.sleep(0.01)
+    time.sleep(1.5)  # the kernels are loaded and the two chunks under way
+    code, err, wait = _stopped(p, signal.SIGINT)
+    assert code == 130, err
+    assert wait < 3.0, f"{wait:.1f} s from the signal to the exit"
+    assert "0 finished chunk(s)" in err and "--resume" in err
+    assert [f.name for f in (out / ".chunks").iterdir()] == ["manifest.json"]
+
+
+def test_a_second_signal_stops_at_once(tmp_path):
+    """While the command cleans up after the first signal, a second one ends it."""
+    script = tmp_path / "slow_cleanup.py"
+    script.write_text(
+        "import os, signal, time\n"
+        "from ftc_mc.interrupt import Interrupted, stop_on_signals\n"
+        "with stop_on_signals():\n"
+        "    try:\n"
+        "        print('ready', flush=True)\n"
+        "        time.sleep(60)\n"
+        "    except Interrupted:\n"
+        "        print('cleaning up', flush=True)\n"
+        "        time.sleep(60)\n")
+    p = subprocess.Popen([sys.executable, str(script)], stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE, text=True)
+    assert p.stdout.readline() == "ready\n"
+    p.send_signal(signal.SIGINT)
+    assert p.stdout.readline() == "cleaning up\n"
+    code, err, wait = _stopped(p, signal.SIGINT)
+    assert code == 130 and wait < 1.0 and "again: stopping now" in err
 
 
 SWEEP = ["--thresholds", "6,12,25", "--flights", "8", "--jobs", "1", "--quiet"]

@@ -64,6 +64,10 @@ class ChunkSpec:
     sensor_ranges : dict of str to (float, float)
         Size magnitude range of each sensor transition of the config
         (``sensor_draws``).
+    resets_kept : int or None
+        Resets of each trial and design kept in the ``resets`` table
+        (``campaign.reset_log``; the first ones in time); None: all.  Only the
+        table is cut: the trials' columns are classified from every stored reset.
     """
 
     setup: SimSetup
@@ -75,6 +79,7 @@ class ChunkSpec:
     max_resets: int
     points: tuple | None = None
     sensor_ranges: dict = dataclasses.field(default_factory=dict)
+    resets_kept: int | None = None
 
     @property
     def tables(self) -> tuple:
@@ -104,7 +109,8 @@ def chunk_spec(cfg: Config, setup: SimSetup | None = None, points=None) -> Chunk
                      points=None if points is None else tuple(map(tuple, points)),
                      sensor_ranges={name: cfg.sensor_draws.size_range(tr.kind, tr.output)
                                     for name in cfg.campaign.transitions if is_sensor(name)
-                                    for tr in [transition_of(name)]})
+                                    for tr in [transition_of(name)]},
+                     resets_kept=cfg.campaign.resets_kept())
 
 
 def trial_inputs(spec: ChunkSpec, tr_name: str, trial_ids):
@@ -468,6 +474,20 @@ def _runs(spec: ChunkSpec):
             for tq, tnx in spec.points for v in spec.variants]
 
 
+def first_resets(resets: dict, n: int | None) -> dict:
+    """The rows of a chunk's ``resets`` columns (one design; rows by trial, then
+    time) that are among the first ``n`` of their trial; all of them for None."""
+    if n is None:
+        return resets
+    tid = np.asarray(resets["trial_id"])
+    idx = np.arange(len(tid))
+    new = np.ones(len(tid), dtype=bool)
+    new[1:] = tid[1:] != tid[:-1]
+    rank = idx - np.maximum.accumulate(np.where(new, idx, 0)) if len(tid) else idx
+    keep = rank < n
+    return {k: np.asarray(v)[keep] for k, v in resets.items()}
+
+
 def _columns(parts) -> dict:
     return {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
 
@@ -521,7 +541,7 @@ def run_chunk(spec: ChunkSpec, name: str, trial_ids) -> dict:
             t["t_q"] = np.full(L, tq)
             t["t_nx"] = np.full(L, tnx)
         trials.append(t)
-        resets.append(r)
+        resets.append(first_resets(r, spec.resets_kept))
     if spec.points is None:
         return {"trials": pd.DataFrame(_columns(trials)),
                 "resets": pd.DataFrame(_columns(resets))}

@@ -243,6 +243,9 @@ def run_endurance(cfg: Config, hours, *, flight_s: float | None = None, jobs: in
     n_jobs = (os.cpu_count() or 1) if jobs == -1 else max(1, int(jobs))
     out = run_chunks(spec, units, n_jobs=n_jobs, backend_name=backend, scheduler=scheduler,
                      progress=progress, chunks=chunks, desc="flights")
+    if chunks is not None:  # stored chunk by chunk: read back in chunk order (small tables)
+        out = [dict(zip(spec.tables, chunks.read(name, int(ids[0]), spec.tables)))
+               for name, ids in units]
     flights = pd.concat([o["trials"] for o in out], ignore_index=True)
     resets = pd.concat([o["resets"] for o in out], ignore_index=True)
     flights = _sorted(flights, spec.variants, ["flight_id"])

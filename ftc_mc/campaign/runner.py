@@ -11,20 +11,20 @@ The Python API behind ``ftc-mc run``::
 
 from __future__ import annotations
 
-import dataclasses
 import os
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
 from ..config.load import load_config, parse_config, with_overrides
 from ..config.schema import Config
+from .assemble import write_run_tables
 from .chunk import chunk_spec
 from .parallel import run_chunks
 from .summary import markdown_table, summarize
 
 
-@dataclasses.dataclass
 class CampaignResult:
     """Outputs of :func:`run_campaign`.
 
@@ -32,19 +32,35 @@ class CampaignResult:
     ----------
     trials : DataFrame
         One row per trial and signature variant (see
-        :func:`ftc_mc.campaign.chunk.classify` for the columns).
+        :func:`ftc_mc.campaign.chunk.classify` for the columns).  For a run
+        written to a folder, read from its ``trials.parquet`` when first asked
+        for (a big run's table need not fit in memory for the run to finish).
     resets : DataFrame
-        One row per covariance reset.
+        One row per covariance reset (``campaign.reset_log``), the same way.
     summary : DataFrame
         One row per transition and variant (:func:`~.summary.summarize`).
     config : Config
         The resolved configuration.
+    out : Path or None
+        The folder the tables were written to.
     """
 
-    trials: pd.DataFrame
-    resets: pd.DataFrame
-    summary: pd.DataFrame
-    config: Config
+    def __init__(self, trials=None, resets=None, summary=None, config=None, out=None):
+        self._trials, self._resets = trials, resets
+        self.summary, self.config = summary, config
+        self.out = None if out is None else Path(out)
+
+    @property
+    def trials(self) -> pd.DataFrame:
+        if self._trials is None and self.out is not None:
+            return pd.read_parquet(self.out / "trials.parquet")
+        return self._trials
+
+    @property
+    def resets(self) -> pd.DataFrame:
+        if self._resets is None and self.out is not None:
+            return pd.read_parquet(self.out / "resets.parquet")
+        return self._resets
 
     def markdown(self) -> str:
         """The summary table in Markdown."""
@@ -120,7 +136,7 @@ def sort_rows(df: pd.DataFrame, transitions, variants, extra) -> pd.DataFrame:
 
 def run_campaign(config, *, trials=None, seed=None, signature=None, jobs: int = 1,
                  progress: bool = True, chunks=None, backend: str = "threads",
-                 scheduler: str | None = None) -> CampaignResult:
+                 scheduler: str | None = None, out=None, meta=None) -> CampaignResult:
     """Run every transition of a configuration.
 
     Parameters
@@ -146,11 +162,20 @@ def run_campaign(config, *, trials=None, seed=None, signature=None, jobs: int = 
         Where finished chunks are stored as they complete; chunks already in it
         are not run again (resume).  The result is then assembled from the
         stored chunks, so it is the same whether or not the run was resumed.
+    out : Path, optional
+        With ``chunks``: write ``trials.parquet`` and ``resets.parquet`` there,
+        streamed from the chunk store one chunk at a time
+        (:mod:`~ftc_mc.campaign.assemble`), with ``meta`` as their provenance;
+        the summary comes from a chunked scan.  The result's tables are then
+        read from those files on demand.
+    meta : dict, optional
+        Provenance of the files written to ``out``.
 
     Returns
     -------
     CampaignResult
     """
+    out_dir = out
     cfg = resolve_config(config, trials, seed, signature)
     spec = chunk_spec(cfg)
     c = cfg.campaign
@@ -158,8 +183,15 @@ def run_campaign(config, *, trials=None, seed=None, signature=None, jobs: int = 
               else max(1, int(jobs)))
     if backend == "dask" and jobs == -1:
         n_jobs = os.cpu_count()
-    out = run_chunks(spec, plan_chunks(cfg), n_jobs=n_jobs, backend_name=backend,
+    units = plan_chunks(cfg)
+    out = run_chunks(spec, units, n_jobs=n_jobs, backend_name=backend,
                      scheduler=scheduler, progress=progress, chunks=chunks, desc="trials")
+    if chunks is not None and out_dir is not None:
+        summary = write_run_tables(chunks, units, spec.variants, Path(out_dir), meta or {})
+        return CampaignResult(summary=summary, config=cfg, out=out_dir)
+    if chunks is not None:
+        out = [dict(zip(spec.tables, chunks.read(n, int(ids[0]), spec.tables)))
+               for n, ids in units]
     trials_df = sort_rows(pd.concat([o["trials"] for o in out], ignore_index=True),
                           c.transitions, spec.variants, ["trial_id"])
     resets_df = sort_rows(pd.concat([o["resets"] for o in out], ignore_index=True),

@@ -79,48 +79,84 @@ def summarize(trials: pd.DataFrame) -> pd.DataFrame:
     DataFrame
         One row per (transition, variant), in the paper's row order.
     """
-    rows = []
+    rows = [summary_row(name, variant, g)
+            for (name, variant), g in trials.groupby(["transition", "variant"], sort=False)]
+    # designs in the order they were run (the signature variants, paper first, then
+    # campaign.designs)
+    return summary_frame(rows, trials["transition"].unique(),
+                         dict.fromkeys(trials["variant"]))
+
+
+SUMMARY_COLUMNS = ("transition", "variant", "judged", "no_reset", "small_b1",
+                   "lock_near_trim", "mode_changed", "status", "resets_truncated",
+                   "inappropriate", "correct", "first_reset_s", "correct_reset_s",
+                   "false_resets", "detected", "detection_s", "actuator_reset",
+                   "wrong_mode", "controller_switch", "envelope_exit", "actuator_reset_s",
+                   "wrong_mode_s", "controller_switch_s", "first_action_s",
+                   "sensor_bias_hat_end", "isolated", "first_reset_block")
+"""The ``trials.parquet`` columns :func:`summary_row` reads: a chunked scan reads
+only these (``campaign/assemble.py``)."""
+
+
+def summary_row(name: str, variant: str, g: pd.DataFrame) -> dict:
+    """The summary row of the trials ``g`` of one transition and variant
+    (:func:`summarize`; a sensor transition: :func:`sensor_row`).
+
+    Depends only on the rows of ``g``, so a summary built one (transition,
+    variant) at a time equals the summary of the whole table.
+    """
+    if is_sensor(name):
+        return sensor_row(name, variant, g)
+    ok = g[g["judged"]]
+    n = len(ok)
+    no_reset = ok["no_reset"].to_numpy()
+    explained = no_reset & (ok["small_b1"].to_numpy() | ok["lock_near_trim"].to_numpy())
+    changed = ok["mode_changed"].to_numpy()
+    paper = PAPER_TABLES[name]
+    row = {"transition": name, "label": TRANSITION_TABLE[name].label,
+           "variant": variant, "trials": n, "excluded": len(g) - n}
+    for reason in STATUS_NAMES[1:]:
+        row[f"stopped_{reason}"] = int((g["status"] == reason).sum())
+    row["resets_truncated"] = int(g["resets_truncated"].sum())
+    row.update(_rate("inappropriate", int(ok["inappropriate"].sum()), n))
+    row.update(_rate("no_reset", int(no_reset.sum()), n))
+    row["no_reset_explained"] = int(explained.sum())
+    row["no_reset_explained_share"] = (explained.sum() / no_reset.sum()
+                                       if no_reset.sum() else np.nan)
+    row.update(_rate("correct", int(ok["correct"].sum()), n))
+    row.update(_rate("correct_only", int((ok["correct"] & ~ok["inappropriate"]).sum()), n))
+    row.update(_quantiles("delay", ok["first_reset_s"].to_numpy()))
+    row.update(_quantiles("correct_delay", _column(ok, "correct_reset_s")))
+    row["false_alarm_trials"] = int((ok["false_resets"] > 0).sum())
+    row["false_resets"] = int(ok["false_resets"].sum())
+    row["mode_changes"] = int(changed.sum())
+    row["detected"] = int(ok["detected"].sum())
+    row.update(_quantiles("detection", ok["detection_s"].to_numpy()))
+    row.update({"paper_trials": paper[0], "paper_inappropriate": paper[1],
+                "paper_no_reset": paper[2]})
+    row.update(real_flight_scores(name, ok))  # ALFA and FDDBenchmark (scoring.py)
+    return row
+
+
+def summary_frame(rows, transitions, variants) -> pd.DataFrame:
+    """The summary table of :func:`summary_row` rows: transitions in the paper's
+    row order (others after them, in the order of ``transitions``), designs in
+    the order of ``variants``.
+
+    Parameters
+    ----------
+    rows : list of dict
+    transitions : iterable of str
+        The transitions in the order they appear in the trials table.
+    variants : iterable of str
+        The designs in the order they were run.
+    """
     order = {name: i for i, name in enumerate(TRANSITION_TABLE)}
-    for name in trials["transition"].unique():
+    for name in transitions:
         order.setdefault(name, len(order))
-    for (name, variant), g in trials.groupby(["transition", "variant"], sort=False):
-        if is_sensor(name):
-            rows.append(sensor_row(name, variant, g))
-            continue
-        ok = g[g["judged"]]
-        n = len(ok)
-        no_reset = ok["no_reset"].to_numpy()
-        explained = no_reset & (ok["small_b1"].to_numpy() | ok["lock_near_trim"].to_numpy())
-        changed = ok["mode_changed"].to_numpy()
-        paper = PAPER_TABLES[name]
-        row = {"transition": name, "label": TRANSITION_TABLE[name].label,
-               "variant": variant, "trials": n, "excluded": len(g) - n}
-        for reason in STATUS_NAMES[1:]:
-            row[f"stopped_{reason}"] = int((g["status"] == reason).sum())
-        row["resets_truncated"] = int(g["resets_truncated"].sum())
-        row.update(_rate("inappropriate", int(ok["inappropriate"].sum()), n))
-        row.update(_rate("no_reset", int(no_reset.sum()), n))
-        row["no_reset_explained"] = int(explained.sum())
-        row["no_reset_explained_share"] = (explained.sum() / no_reset.sum()
-                                           if no_reset.sum() else np.nan)
-        row.update(_rate("correct", int(ok["correct"].sum()), n))
-        row.update(_rate("correct_only", int((ok["correct"] & ~ok["inappropriate"]).sum()), n))
-        row.update(_quantiles("delay", ok["first_reset_s"].to_numpy()))
-        row.update(_quantiles("correct_delay", _column(ok, "correct_reset_s")))
-        row["false_alarm_trials"] = int((ok["false_resets"] > 0).sum())
-        row["false_resets"] = int(ok["false_resets"].sum())
-        row["mode_changes"] = int(changed.sum())
-        row["detected"] = int(ok["detected"].sum())
-        row.update(_quantiles("detection", ok["detection_s"].to_numpy()))
-        row.update({"paper_trials": paper[0], "paper_inappropriate": paper[1],
-                    "paper_no_reset": paper[2]})
-        row.update(real_flight_scores(name, ok))  # ALFA and FDDBenchmark (scoring.py)
-        rows.append(row)
     out = pd.DataFrame(rows)
     if len(out):
-        # designs in the order they were run (the signature variants, paper first,
-        # then campaign.designs)
-        vorder = {v: i for i, v in enumerate(dict.fromkeys(trials["variant"]))}
+        vorder = {v: i for i, v in enumerate(variants)}
         out = out.sort_values(["transition", "variant"],
                               key=lambda s: s.map(order if s.name == "transition" else vorder),
                               kind="stable").reset_index(drop=True)

@@ -23,6 +23,7 @@ import pandas as pd
 from ..config.schema import Config
 from ..errors import UserError
 from ..stats import poisson_rate
+from .assemble import sweep_rows
 from .chunk import FLIGHT, chunk_spec
 from .parallel import run_chunks
 from .runner import plan_chunks, sort_rows
@@ -92,8 +93,9 @@ class SweepResult:
         ``correct_delay_median_s`` / ``_p95_s`` [s]) plus the false-reset rate
         per flight hour with its exact Poisson 95 % interval and the flight
         hours between false resets (:func:`add_hours_per_false_reset`).
-    trials : DataFrame
-        Every trial at every point.
+    trials : DataFrame or None
+        Every trial at every point; None for a sweep run with a chunk store
+        (written to a folder), whose table is assembled one point at a time.
     simulated_steps, alone_steps : int
         Trial steps simulated, and what the points would cost run one by one.
     config : Config
@@ -168,8 +170,9 @@ def run_sweep(cfg: Config, points, *, flights: int | None = None, jobs: int = 1,
     backend, scheduler
         Where chunks run (:mod:`ftc_mc.campaign.parallel`).
     chunks : ChunkStore, optional
-        Finished chunks are stored there and skipped when resuming; the result
-        is assembled from the stored chunks either way.
+        Finished chunks are stored there and skipped when resuming; the table is
+        then assembled from the stored chunks one (transition, point) at a time
+        (:func:`~ftc_mc.campaign.assemble.sweep_rows`), the same as in memory.
     """
     spec = chunk_spec(cfg, points=points)
     c = cfg.campaign
@@ -180,24 +183,28 @@ def run_sweep(cfg: Config, points, *, flights: int | None = None, jobs: int = 1,
     n_jobs = (os.cpu_count() or 1) if jobs == -1 else max(1, int(jobs))
     out = run_chunks(spec, units, n_jobs=n_jobs, backend_name=backend, scheduler=scheduler,
                      progress=progress, chunks=chunks, desc="sweep")
-    parts = [o["trials"] for (n, _), o in zip(units, out) if n != FLIGHT]
-    frows = [o["trials"] for (n, _), o in zip(units, out) if n == FLIGHT]
-    sim = int(sum(int(o["steps"]["simulated"].iloc[0]) for o in out))
-    alone = int(sum(int(o["steps"]["alone"].iloc[0]) for o in out))
-    trials = sort_rows(pd.concat(parts, ignore_index=True), c.transitions, spec.variants,
-                       ["trial_id"])
-    trials = trials.sort_values(["t_q", "t_nx"], kind="stable").reset_index(drop=True)
-    flights_df = pd.concat(frows, ignore_index=True)
+    if chunks is not None:
+        tables, flights_df, (sim, alone) = sweep_rows(chunks, units, spec.variants, points,
+                                                      FLIGHT)
+        trials = None
+    else:
+        parts = [o["trials"] for (n, _), o in zip(units, out) if n != FLIGHT]
+        frows = [o["trials"] for (n, _), o in zip(units, out) if n == FLIGHT]
+        sim = int(sum(int(o["steps"]["simulated"].iloc[0]) for o in out))
+        alone = int(sum(int(o["steps"]["alone"].iloc[0]) for o in out))
+        trials = sort_rows(pd.concat(parts, ignore_index=True), c.transitions, spec.variants,
+                           ["trial_id"])
+        trials = trials.sort_values(["t_q", "t_nx"], kind="stable").reset_index(drop=True)
+        flights_df = pd.concat(frows, ignore_index=True)
+        tables = [(tq, tnx, summarize(g.drop(columns=["t_q", "t_nx"])))
+                  for (tq, tnx), g in trials.groupby(["t_q", "t_nx"], sort=True)]
     hours = cfg.timing.duration_s / 3600.0
     fsum = flights_df.groupby(["t_q", "t_nx", "variant"], as_index=False)[
         ["flights", "judged", "resets"]].sum()
-    tables = []
-    for (tq, tnx), g in trials.groupby(["t_q", "t_nx"], sort=True):
-        s = summarize(g.drop(columns=["t_q", "t_nx"]))
+    for tq, tnx, s in tables:
         s.insert(0, "t_nx", tnx)
         s.insert(0, "t_q", tq)
-        tables.append(s)
-    table = pd.concat(tables, ignore_index=True)
+    table = pd.concat([s for _, _, s in tables], ignore_index=True)
     rates = []
     for _, r in fsum.iterrows():
         exposure = r["judged"] * hours

@@ -510,6 +510,24 @@ class CampaignConfig(_Strict):
     """Trials per chunk (one kernel call, lanes); results do not depend on it."""
     max_resets: Annotated[int, NoBool, Field(gt=0, le=100_000)] | None = None
     """Resets stored per trial (more are counted, not stored); null: one per step, all."""
+    reset_log: str = "all"
+    """Resets written to resets.parquet: all, none or first-N (the first N per trial and design); trials and summary do not depend on it."""
+
+    @field_validator("reset_log")
+    @classmethod
+    def _reset_log(cls, v):
+        if v in ("all", "none"):
+            return v
+        head, _, n = v.partition("-")
+        if head != "first" or not n.isdigit() or int(n) < 1 or n != str(int(n)):
+            raise ValueError(f"must be all, none or first-N with N >= 1, got {v!r}")
+        return v
+
+    def resets_kept(self) -> int | None:
+        """Resets of each trial and design written to ``resets.parquet``
+        (``reset_log``): None for all of them."""
+        return (None if self.reset_log == "all" else 0 if self.reset_log == "none"
+                else int(self.reset_log.partition("-")[2]))
 
     @model_validator(mode="after")
     def _unique(self):

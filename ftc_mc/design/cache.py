@@ -11,6 +11,8 @@ import os
 import tempfile
 from pathlib import Path
 
+from ..io.atomic import new_file_mode
+
 
 def default_cache_dir() -> Path:
     """Folder of the design cache.
@@ -37,6 +39,7 @@ def write_atomic(path: Path, write) -> None:
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    os.fchmod(fd, new_file_mode())  # mkstemp's 0600 would survive the rename
     try:
         with os.fdopen(fd, "wb") as f:
             write(f)

@@ -7,14 +7,21 @@ Layout inside the output directory::
     .chunks/<transition>-<first id>.trials.parquet   written last: marks the chunk done
 
 Every file is written atomically (temporary name, then rename), so a chunk is
-either complete or absent whatever moment the process dies.  The final result
-files are assembled from the chunk files only, so a resumed run and an
-uninterrupted one produce the same bytes of result data.
+either complete or absent whatever moment the process dies or is interrupted;
+a temporary file left by a killed process is removed when the run resumes.
+The final result files are assembled from the chunk files only, one chunk at a
+time, so a resumed run and an uninterrupted one produce the same bytes of
+result data.
+
+Resuming looks at the folder once (:meth:`ChunkStore.finished`: one directory
+listing, whatever the number of chunks), so a run of 15 000 chunks resumes in
+time proportional to the chunks still to run (``scripts/bench_resume.py``).
 """
 
 from __future__ import annotations
 
 import json
+import os
 import shutil
 from pathlib import Path
 
@@ -68,6 +75,7 @@ class ChunkStore:
             if theirs != json.loads(self.config_json):
                 raise UserError(f"--resume: {self.folder.parent} was made by another "
                                 "configuration (or other --trials/--seed/--signature)")
+            self._remove_temporaries()
             return
         self.folder.mkdir(parents=True, exist_ok=True)
         write_text(manifest, json.dumps({"config": json.loads(self.config_json)},
@@ -76,9 +84,26 @@ class ChunkStore:
     def _path(self, name: str, start: int, table: str) -> Path:
         return self.folder / f"{name}-{start:09d}.{table}.parquet"
 
-    def done(self, name: str, start: int) -> bool:
-        """Whether chunk ``(name, start)`` was finished."""
-        return self._path(name, start, "trials").exists()
+    def finished(self) -> set:
+        """``(name, start)`` of every finished chunk, from one listing of the folder."""
+        out = set()
+        if not self.folder.is_dir():
+            return out
+        tail = ".trials.parquet"
+        with os.scandir(self.folder) as it:
+            for entry in it:
+                if entry.name.endswith(tail) and not entry.name.startswith("."):
+                    name, _, start = entry.name[:-len(tail)].rpartition("-")
+                    if start.isdigit():
+                        out.add((name, int(start)))
+        return out
+
+    def _remove_temporaries(self) -> None:
+        """Delete temporary files a killed process left (never under a final name)."""
+        with os.scandir(self.folder) as it:
+            for entry in it:
+                if entry.name.startswith(".") and entry.name.endswith(".tmp"):
+                    Path(entry.path).unlink(missing_ok=True)
 
     def write(self, name: str, start: int, trials: pd.DataFrame, **others: pd.DataFrame):
         """Store one finished chunk: the other tables first, then ``trials`` as the
@@ -90,6 +115,14 @@ class ChunkStore:
     def read(self, name: str, start: int, tables=("trials", "resets")):
         """DataFrames of a finished chunk, one per name in ``tables``."""
         return tuple(pq.read_table(self._path(name, start, t)).to_pandas() for t in tables)
+
+    def arrow(self, name: str, start: int, table: str, columns=None) -> pa.Table:
+        """One table of a finished chunk as Arrow (only ``columns`` if given)."""
+        return pq.read_table(self._path(name, start, table), columns=columns)
+
+    def schema(self, name: str, start: int, table: str) -> pa.Schema:
+        """The Arrow schema of one table of a finished chunk (its footer only)."""
+        return pq.read_schema(self._path(name, start, table))
 
     def discard_if_empty(self) -> None:
         """Delete the chunk folder if no chunk in it was finished (a run refused

@@ -259,7 +259,7 @@ def acquire(directory, command: str | None = None) -> OutputLock:
     --------
     >>> with acquire(out_dir, command="ftc-mc run cfg.yaml"):   # doctest: +SKIP
     ...     prepare_output_dir(out_dir, overwrite)
-    ...     write_run(out_dir, ...)
+    ...     write_summary(out_dir, ...)
     """
     return OutputLock(directory, command=command)
 

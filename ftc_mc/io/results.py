@@ -87,11 +87,9 @@ def prepare_output_dir(out: Path, overwrite: bool = False) -> None:
                         "directory or pass --overwrite")
 
 
-def write_run(out: Path, trials: pd.DataFrame, resets: pd.DataFrame,
-              summary: pd.DataFrame, summary_md: str, meta: dict) -> None:
-    """Write the four files of a run, each atomically (summary last)."""
-    out.mkdir(parents=True, exist_ok=True)
-    write_parquet(trials, out / "trials.parquet", meta)
-    write_parquet(resets, out / "resets.parquet", meta)
+def write_summary(out: Path, summary: pd.DataFrame, summary_md: str, meta: dict) -> None:
+    """Write ``summary.parquet`` and ``summary.md`` of a run, each atomically; the
+    last files of a run (``trials.parquet`` and ``resets.parquet`` are streamed
+    before them, ``campaign/assemble.py``)."""
     write_parquet(summary, out / "summary.parquet", meta)
     write_text(out / "summary.md", summary_md)

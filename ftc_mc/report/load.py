@@ -11,10 +11,12 @@ import dataclasses
 from pathlib import Path
 
 import pandas as pd
+import pyarrow.parquet as pq
 
 from ..errors import UserError
 from ..io.chunks import FOLDER as CHUNKS_FOLDER
 from ..io.lock import holder
+from ..campaign.summary import SUMMARY_COLUMNS
 from ..io.results import read_metadata
 
 RUN_TABLES = ("trials.parquet", "summary.parquet")
@@ -25,6 +27,15 @@ SWEEP_TABLES = ("sweep.parquet",)
 """Parquet file of a sweep directory."""
 ENDURANCE_TABLES = ("false_resets.parquet", "endurance.parquet")
 """Parquet files of an endurance directory (``ftc-mc endurance``)."""
+TRIAL_COLUMNS = ("transition", "variant", "trial_id", "correct", "inappropriate",
+                 "no_reset", "first_reset_s", "false_resets", "detection_s", "mode_changed",
+                 "detected", "small_b1", "lock_near_trim", "resets_truncated", "judged",
+                 "status", "stop_s", "sensor_output", "sensor_kind", "sensor_size",
+                 *SUMMARY_COLUMNS)
+"""The ``trials.parquet`` columns the report reads (its sections, figures and the
+summary function); only these are loaded, so the report of a run of millions
+of trials fits in memory (issue 27).  The others (draws, final estimates, the
+first reset's block, reset counts) are left on disk."""
 
 
 @dataclasses.dataclass
@@ -84,6 +95,15 @@ def _check_not_busy(path: Path) -> None:
                         f"{owner.get('pid')}); build the report when it has finished")
 
 
+def _read(file: Path) -> pd.DataFrame:
+    """A result table; of ``trials.parquet`` only :data:`TRIAL_COLUMNS`."""
+    if file.name != "trials.parquet":
+        return pd.read_parquet(file)
+    names = pq.read_schema(file).names
+    return pd.read_parquet(file, columns=[c for c in names
+                                          if c in set(TRIAL_COLUMNS)])
+
+
 def load_result_dir(path) -> ResultDir:
     """Read one run, scenario or sweep directory.
 
@@ -124,7 +144,7 @@ def load_result_dir(path) -> ResultDir:
     if kinds != {kind}:
         raise UserError(f"{path}: metadata kind {sorted(map(str, kinds))} does not match "
                         f"the {kind} files it holds")
-    tables = {f[:-len(".parquet")]: pd.read_parquet(path / f) for f in needed}
+    tables = {f[:-len(".parquet")]: _read(path / f) for f in needed}
     return ResultDir(path=path, kind=kind, meta=file_meta[needed[-1]],
                      file_meta=file_meta, tables=tables)
 

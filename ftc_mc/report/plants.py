@@ -23,9 +23,10 @@ from .markdown import (DEFAULT_PLANT, LABELS, airframe_of, label, num, plant_con
                        rel_link)
 from .runs import exclusion_reason, why, window_end_s
 
-IGNORED_CAMPAIGN_KEYS = ("trials", "seed", "chunk_size")
+IGNORED_CAMPAIGN_KEYS = ("trials", "seed", "chunk_size", "reset_log")
 """``campaign`` fields that may differ between compared runs without a warning
-(results do not depend on ``chunk_size``)."""
+(results do not depend on ``chunk_size``; the trials table and the summary not
+on ``reset_log``)."""
 PLANT_FIGURE = "plant_turbulence.png"
 """File name of the plant-comparison figure in the figure folder."""
 
