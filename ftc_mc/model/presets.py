@@ -87,6 +87,32 @@ class Preset:
     unused: str
 
 
+_LATERAL = dict(
+    b=2.1,                           # b
+    Jx=1.229,                        # Jx
+    Jz=0.8808,                       # Jz
+    Jxz=0.9343,                      # Jxz
+    C_D_beta1=-0.005842980345415388,  # C_D_beta1
+    C_D_beta2=0.14781193079241584,   # C_D_beta2
+    C_Y_0=0.0,                       # C_Y_0 (stored as the integer 0)
+    C_Y_beta=-0.22387215700254048,   # C_Y_beta
+    C_Y_p=-0.13735505263157893,      # C_Y_p
+    C_Y_r=0.08386876842105263,       # C_Y_r
+    C_Y_delta_a=0.043276402502774876,  # C_Y_delta_a
+    C_l_0=0.0,                       # C_l_0 (stored as the integer 0)
+    C_l_beta=-0.08489628639662417,   # C_l_beta
+    C_l_p=-0.40419799999999995,      # C_l_p
+    C_l_r=0.055520599999999996,      # C_l_r
+    C_l_delta_a=0.12018814125782745,  # C_l_delta_a
+    C_n_0=0.0,                       # C_n_0 (stored as the integer 0)
+    C_n_beta=0.0283,                 # C_n_beta
+    C_n_p=0.004365511578947368,      # C_n_p
+    C_n_r=-0.07200000000000001,      # C_n_r (XFLR's value times 6, README)
+    C_n_delta_a=-0.00339,            # C_n_delta_a
+)
+"""The lateral-directional data (6-DOF only), identical in both cited files."""
+
+
 _GRYTE2018 = Source(
     repo="krisgry/x8", path="x8_param.mat",
     commit="8bfb2d945dbff9abdfda6431b8f1d962c9d45b30", date="2018-06-14",
@@ -120,28 +146,7 @@ X8_GRYTE2018 = Airframe(
     S_prop=0.10178760197630929,      # S_prop
     k_motor=40.0,                    # k_motor (stored as the integer 40)
     C_prop=1.0,                      # C_prop (stored as the integer 1)
-    # lateral-directional (6-DOF only; identical in both files):
-    b=2.1,                           # b
-    Jx=1.229,                        # Jx
-    Jz=0.8808,                       # Jz
-    Jxz=0.9343,                      # Jxz
-    C_D_beta1=-0.005842980345415388,  # C_D_beta1
-    C_D_beta2=0.14781193079241584,   # C_D_beta2
-    C_Y_0=0.0,                       # C_Y_0 (stored as the integer 0)
-    C_Y_beta=-0.22387215700254048,   # C_Y_beta
-    C_Y_p=-0.13735505263157893,      # C_Y_p
-    C_Y_r=0.08386876842105263,       # C_Y_r
-    C_Y_delta_a=0.043276402502774876,  # C_Y_delta_a
-    C_l_0=0.0,                       # C_l_0 (stored as the integer 0)
-    C_l_beta=-0.08489628639662417,   # C_l_beta
-    C_l_p=-0.40419799999999995,      # C_l_p
-    C_l_r=0.055520599999999996,      # C_l_r
-    C_l_delta_a=0.12018814125782745,  # C_l_delta_a
-    C_n_0=0.0,                       # C_n_0 (stored as the integer 0)
-    C_n_beta=0.0283,                 # C_n_beta
-    C_n_p=0.004365511578947368,      # C_n_p
-    C_n_r=-0.07200000000000001,      # C_n_r (XFLR's value times 6, README)
-    C_n_delta_a=-0.00339,            # C_n_delta_a
+    **_LATERAL,  # lateral-directional (6-DOF only; identical in both files)
     k_T_P=0.0,                       # k_T_P (stored as the integer 0)
     k_Omega=0.0,                     # k_Omega (stored as the integer 0)
     # ours, not the file's (module docstring):
@@ -172,28 +177,7 @@ X8_PYFLY = Airframe(
     S_prop=0.10178760197630929,      # S_prop
     k_motor=37.42,                   # k_motor
     C_prop=0.248,                    # C_prop
-    # lateral-directional (6-DOF only; identical in both files):
-    b=2.1,                           # b
-    Jx=1.229,                        # Jx
-    Jz=0.8808,                       # Jz
-    Jxz=0.9343,                      # Jxz
-    C_D_beta1=-0.005842980345415388,  # C_D_beta1
-    C_D_beta2=0.14781193079241584,   # C_D_beta2
-    C_Y_0=0.0,                       # C_Y_0 (stored as the integer 0)
-    C_Y_beta=-0.22387215700254048,   # C_Y_beta
-    C_Y_p=-0.13735505263157893,      # C_Y_p
-    C_Y_r=0.08386876842105263,       # C_Y_r
-    C_Y_delta_a=0.043276402502774876,  # C_Y_delta_a
-    C_l_0=0.0,                       # C_l_0 (stored as the integer 0)
-    C_l_beta=-0.08489628639662417,   # C_l_beta
-    C_l_p=-0.40419799999999995,      # C_l_p
-    C_l_r=0.055520599999999996,      # C_l_r
-    C_l_delta_a=0.12018814125782745,  # C_l_delta_a
-    C_n_0=0.0,                       # C_n_0 (stored as the integer 0)
-    C_n_beta=0.0283,                 # C_n_beta
-    C_n_p=0.004365511578947368,      # C_n_p
-    C_n_r=-0.07200000000000001,      # C_n_r (XFLR's value times 6, README)
-    C_n_delta_a=-0.00339,            # C_n_delta_a
+    **_LATERAL,  # lateral-directional (6-DOF only; identical in both files)
     k_T_P=1.1871e-06,                # k_T_P
     k_Omega=797.1268,                # k_Omega
     # ours, not the file's (module docstring):
