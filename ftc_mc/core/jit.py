@@ -306,15 +306,15 @@ def needs_compile(dispatcher, first=None) -> bool | None:
     return None if cached is None else not cached
 
 
-def announce_compile(dispatcher, what="", duration="1 min", stream=None,
+def announce_compile(dispatcher, what="", duration="1-1.5 min", stream=None,
                      needed=None) -> bool:
     """Print :data:`COMPILE_NOTICE` to stderr if ``dispatcher`` is about to be
     compiled (:func:`needs_compile`, or ``needed`` when the caller has just
     asked it); return whether it was printed.
 
-    ``what`` names the path compiled, ``duration`` the time it takes
-    (``scripts/bench_campaign.py`` and ``docs/performance.md`` lesson 10
-    measure each path).
+    ``what`` names the path compiled, ``duration`` the time it takes: 52-92 s
+    for the paths of ``scripts/bench_compile.py`` on an empty cache, less when
+    the kernels they share are cached (``docs/performance.md`` lesson 11).
     """
     import sys
     if (needs_compile(dispatcher) if needed is None else needed) is not True:
