@@ -4,7 +4,7 @@ Numba types and compiles every branch a kernel can reach, whatever the values
 of run-time flags.  A run of the paper's design on the linear plant would
 therefore compile the dense and extended filters, the GLR test, the nonlinear
 plant and the controller selection it never calls (``docs/performance.md``,
-lesson 10).  Instead, the choices that select large kernels travel as
+lesson 11).  Instead, the choices that select large kernels travel as
 *types*: a :class:`Path` of empty marker namedtuples, one per choice, passed
 as the first argument of :func:`ftc_mc.core.longitudinal.trial.advance` and of the stages.
 At each point where the paths part, a dispatcher (a stub with a
