@@ -39,6 +39,7 @@ from ..core.sixdof.layout import (COMMAND, LAYOUT, N_COMMAND, N_OUTPUT, N_RIGID,
 from ..errors import UserError
 from .airframe import Airframe
 from .linear import _fmt, jacobian, zoh
+from .summary import mode_table
 
 _STILL_AIR = np.zeros(N_WIND)
 
@@ -544,17 +545,7 @@ def format_sixdof_summary(s: dict, name: str = "") -> str:
         f"{t['right_elevon_rad']:.4f} rad (elevator {t['elevator_rad']:.4f}, aileron "
         f"{t['aileron_rad']:.5f})",
         "",
-        f"  {'mode':<20} {'continuous [1/s]':>26} {'discrete':>24}"
-        f" {'wn [rad/s]':>10} {'zeta':>6}",
-    ]
-    for e in s["eigenvalues"]:
-        lc = complex(*e["continuous"])
-        ld = complex(*e["discrete"])
-        wn = abs(lc)
-        zeta = -lc.real / wn if wn > 1e-12 else float("nan")
-        lines.append(f"  {e['mode'].replace('_', ' '):<20} {lc.real:12.4f} "
-                     f"{lc.imag:+12.4f}j {ld.real:10.5f} {ld.imag:+10.5f}j "
-                     f"{wn:10.4f} {zeta:6.3f}")
+    ] + mode_table(s["eigenvalues"])
     return "\n".join(lines)
 
 

@@ -38,6 +38,30 @@ def model_summary(plant: LinearPlant) -> dict:
     }
 
 
+def mode_table(eigenvalues) -> list:
+    """Lines of the eigenvalue table of ``ftc-mc model`` (longitudinal and
+    6-DOF): each mode's continuous and discrete eigenvalue, natural frequency
+    and damping ratio.
+
+    Parameters
+    ----------
+    eigenvalues : list of dict
+        ``mode`` (name; ``_`` printed as a space), ``continuous`` and
+        ``discrete`` as ``[real, imag]``.
+    """
+    lines = [f"  {'mode':<20} {'continuous [1/s]':>26} {'discrete':>24}"
+             f" {'wn [rad/s]':>10} {'zeta':>6}"]
+    for e in eigenvalues:
+        lc = complex(*e["continuous"])
+        ld = complex(*e["discrete"])
+        wn = abs(lc)
+        zeta = -lc.real / wn if wn > 1e-12 else float("nan")
+        lines.append(f"  {e['mode'].replace('_', ' '):<20} {lc.real:12.4f} "
+                     f"{lc.imag:+12.4f}j {ld.real:10.5f} {ld.imag:+10.5f}j "
+                     f"{wn:10.4f} {zeta:6.3f}")
+    return lines
+
+
 def format_summary(s: dict) -> str:
     """Human-readable text of :func:`model_summary`."""
     t = s["trim"]
@@ -49,16 +73,7 @@ def format_summary(s: dict) -> str:
         f"  elevons (each)   {t['elevon_rad']:8.4f} rad "
         f"({math.degrees(t['elevon_rad']):.3f} deg)",
         "",
-        f"  {'mode':<20} {'continuous [1/s]':>26} {'discrete':>24}"
-        f" {'wn [rad/s]':>10} {'zeta':>6}",
-    ]
-    for e in s["eigenvalues"]:
-        lc = complex(*e["continuous"])
-        ld = complex(*e["discrete"])
-        wn = abs(lc)
-        zeta = -lc.real / wn if wn > 1e-12 else float("nan")
-        lines.append(f"  {e['mode']:<20} {lc.real:12.4f} {lc.imag:+12.4f}j "
-                     f"{ld.real:10.5f} {ld.imag:+10.5f}j {wn:10.4f} {zeta:6.3f}")
+    ] + mode_table(s["eigenvalues"])
     r = s["redundancy"]
     lines += [
         "",

@@ -158,8 +158,32 @@ def dryden_model(level: str = "moderate", V: float = 20.0, altitude_m: float = 1
     Cc[2, 1:3] = -Cw / (V * T_q)
     Cc[2, 3] = 1.0 / (V * T_q)
 
-    # Van Loan: expm([[-A, B B^T], [0, A^T]] dt) = [[., F12], [0, F22]]
-    n = 4
+    Ad, Bd, P0 = _discretise(Ac, Bc, dt)
+    P0_chol = _psd_sqrt(P0)
+    sigma_q = math.sqrt(max(float(Cc[2] @ P0 @ Cc[2]), 0.0))
+    return DrydenModel(Ad=Ad, Bd=Bd, Cd=Cc.copy(), P0=P0, P0_chol=P0_chol, Ac=Ac,
+                       Bc=Bc, Cc=Cc, sigma_u=sigma_u, sigma_w=sigma_w,
+                       sigma_q=sigma_q, L_u=L_u, L_w=L_w, T_q=T_q, V=float(V),
+                       dt=float(dt), level=level, altitude_m=float(altitude_m),
+                       span=float(span))
+
+
+def _discretise(Ac: np.ndarray, Bc: np.ndarray, dt: float):
+    """Exact discretisation of a shaping filter ``ds = Ac s dt + Bc dW`` over ``dt``.
+
+    Van Loan: ``expm([[-A, B B^T], [0, A^T]] dt) = [[., F12], [0, F22]]`` gives
+    ``Ad = F22^T`` and the discrete noise covariance ``Qd = Ad F12``.
+
+    Returns
+    -------
+    Ad : ndarray
+        Discrete transition.
+    Bd : ndarray
+        Symmetric square root of ``Qd`` (the noise input of a standard normal draw).
+    P0 : ndarray
+        Stationary state covariance (continuous Lyapunov equation).
+    """
+    n = Ac.shape[0]
     M = np.zeros((2 * n, 2 * n))
     M[:n, :n] = -Ac
     M[:n, n:] = Bc @ Bc.T
@@ -168,16 +192,8 @@ def dryden_model(level: str = "moderate", V: float = 20.0, altitude_m: float = 1
     Ad = F[n:, n:].T
     Qd = Ad @ F[:n, n:]
     Qd = 0.5 * (Qd + Qd.T)
-    Bd = _psd_sqrt(Qd)
     P0 = scipy.linalg.solve_continuous_lyapunov(Ac, -Bc @ Bc.T)
-    P0 = 0.5 * (P0 + P0.T)
-    P0_chol = _psd_sqrt(P0)
-    sigma_q = math.sqrt(max(float(Cc[2] @ P0 @ Cc[2]), 0.0))
-    return DrydenModel(Ad=Ad, Bd=Bd, Cd=Cc.copy(), P0=P0, P0_chol=P0_chol, Ac=Ac,
-                       Bc=Bc, Cc=Cc, sigma_u=sigma_u, sigma_w=sigma_w,
-                       sigma_q=sigma_q, L_u=L_u, L_w=L_w, T_q=T_q, V=float(V),
-                       dt=float(dt), level=level, altitude_m=float(altitude_m),
-                       span=float(span))
+    return Ad, _psd_sqrt(Qd), 0.5 * (P0 + P0.T)
 
 
 def _psd_sqrt(Q: np.ndarray) -> np.ndarray:
@@ -304,18 +320,7 @@ def dryden_lateral_model(level: str = "moderate", V: float = 20.0,
     Cc[1, 3] = 1.0                       # p_g
     Cc[2, 0:2] = Cv / (V * T_r)          # r_g = (v_g - s_r) / (V T_r)
     Cc[2, 2] = -1.0 / (V * T_r)
-    n = 4
-    M = np.zeros((2 * n, 2 * n))
-    M[:n, :n] = -Ac
-    M[:n, n:] = Bc @ Bc.T
-    M[n:, n:] = Ac.T
-    F = scipy.linalg.expm(M * dt)
-    Ad = F[n:, n:].T
-    Qd = Ad @ F[:n, n:]
-    Qd = 0.5 * (Qd + Qd.T)
-    Bd = _psd_sqrt(Qd)
-    P0 = scipy.linalg.solve_continuous_lyapunov(Ac, -Bc @ Bc.T)
-    P0 = 0.5 * (P0 + P0.T)
+    Ad, Bd, P0 = _discretise(Ac, Bc, dt)
     var = np.diag(Cc @ P0 @ Cc.T)
     return DrydenLateralModel(
         Ad=Ad, Bd=Bd, Cd=Cc.copy(), P0=P0, P0_chol=_psd_sqrt(P0), Ac=Ac, Bc=Bc, Cc=Cc,
