@@ -9,8 +9,12 @@ function per command (see :mod:`ftc_mc.api`)::
     res.summary
 """
 
-from .api import (build_report, load_config, run_campaign, run_endurance, run_scenario,
-                  run_sweep)
+from .blas import pin_openblas
+
+pin_openblas()  # before numpy loads OpenBLAS (ftc_mc/blas.py)
+
+from .api import (build_report, load_config, run_campaign, run_endurance,  # noqa: E402
+                  run_scenario, run_sweep)
 
 __all__ = ["run_campaign", "run_sweep", "run_endurance", "run_scenario", "build_report",
            "load_config"]

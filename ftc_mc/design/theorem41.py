@@ -74,6 +74,7 @@ from __future__ import annotations
 
 import hashlib
 import math
+import os
 from pathlib import Path
 from typing import NamedTuple
 
@@ -366,9 +367,10 @@ def _hash_array(h, name, a):
 def engine_tables_key(plant, b0_grid=None, b1_grid=None, Q=None, R=None, alpha=None) -> str:
     """SHA-256 cache key of every input of :func:`engine_fault_tables`.
 
-    Covers ``A``, ``B``, ``u0``, both grids, ``Q``, ``R``, ``alpha`` and
-    :data:`TABLES_VERSION` (defaults resolved first, so passing a default
-    explicitly gives the same key).
+    Covers ``A``, ``B``, ``u0``, both grids, ``Q``, ``R``, ``alpha``,
+    :data:`TABLES_VERSION` and the OpenBLAS kernels in force (``ftc_mc/blas.py``:
+    tables computed with other kernels differ in their last bits), defaults
+    resolved first, so passing a default explicitly gives the same key.
 
     Returns
     -------
@@ -378,6 +380,7 @@ def engine_tables_key(plant, b0_grid=None, b1_grid=None, Q=None, R=None, alpha=N
     b0_grid, b1_grid, Q, R, alpha = _defaults(plant, b0_grid, b1_grid, Q, R, alpha)
     h = hashlib.sha256()
     h.update(TABLES_VERSION.encode())
+    h.update(f"blas:{os.environ.get('OPENBLAS_CORETYPE')}".encode())
     for name, a in (("A", plant.A), ("B", plant.B), ("u0", plant.u0), ("b0_grid", b0_grid),
                     ("b1_grid", b1_grid), ("Q", Q), ("R", R), ("alpha", [alpha])):
         _hash_array(h, name, a)
