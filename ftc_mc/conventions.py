@@ -110,8 +110,9 @@ STATUS_NONFINITE = 1
 STATUS_NOT_PSD = 2
 STATUS_AIRSPEED = 3
 STATUS_ALPHA = 4
+STATUS_BANK = 5
 STATUS_NAMES = ("ok", "nonfinite", "covariance_not_psd", "airspeed_out_of_bounds",
-                "alpha_out_of_bounds")
+                "alpha_out_of_bounds", "bank_out_of_bounds")
 """Why a trial stopped being trusted (``ok``: it ran to its end)."""
 
 # ------------------------------------------------------------------ campaigns, plants

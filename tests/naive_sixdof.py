@@ -155,3 +155,103 @@ def rk4_ref(x, cmd, p, wind, dt, n_sub):
         k4 = f(x + h * k3)
         x = x + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
     return x
+
+
+# ------------------------------------------------------------------ trial truth step
+LATERAL_MEASURED = ("phi", "v", "p", "r", "psi")
+"""The lateral loop's measured states (then its two elevon-model states)."""
+LONGITUDINAL_AS_SIXDOF = {"thrust": "throttle", "elevon_left": "left",
+                          "elevon_right": "right", "CAS": "Va"}
+"""Longitudinal names whose 6-DOF state or output has another name."""
+
+
+def sixdof_truth_ref(scheme, flight, inp, k, st, rec, u):
+    """The 6-DOF truth over step ``k``, written from the module docstring of
+    ``ftc_mc/core/sixdof/truth.py`` with whole vectors and names, one lane at a
+    time: the lateral loop's aileron and the summed, saturated commands; the
+    elevon model; eq. (2); the longitudinal and lateral Dryden gusts; RK4 (or
+    the linear 6-DOF model); the longitudinal measurements, the lateral ones,
+    the air data, the bank angle and the squared bank and heading.
+
+    Returns a dict of the new ``u``, ``e``, ``x``, ``gust``, ``glat``, ``lat``,
+    ``z``, ``va``, ``alpha``, ``bank``, ``sq_lat``.
+    """
+    from ftc_mc.conventions import LONGITUDINAL
+    from ftc_mc.model.faults import effect
+    from naive import sensor_fault_ref
+
+    fm, ctl, pl = scheme.filter, scheme.controller, flight.plant
+    L = st.x.shape[1]
+    n_meas = len(LATERAL_MEASURED)
+    u = np.array(u, dtype=float, copy=True)
+    lat = st.lat.copy()
+    for l in range(L):
+        da = -pl.K_lat @ st.lat[:, l]
+        mix = np.zeros(3)
+        mix[LAYOUT.commands.index("left")], mix[LAYOUT.commands.index("right")] = da, -da
+        u[:, l] = np.clip(u[:, l] + pl.u_ff + mix, ctl.lo_dev, ctl.hi_dev)
+        for row, side in ((n_meas, "left"), (n_meas + 1, "right")):
+            c = LAYOUT.commands.index(side)
+            lat[row, l] = pl.a_act * st.lat[row, l] + (1 - pl.a_act) * (u[c, l] - pl.u_ff[c])
+    ev = int(np.searchsorted(inp.k_switch, k, side="right")) - 1
+    e = np.column_stack([effect(u[:, l], fm.u0, inp.b0[ev][:, l], inp.b1[ev][:, l])
+                         for l in range(L)])
+    gust, glat = st.gust.copy(), st.glat.copy()
+    lon_w = np.zeros((3, L))
+    lon_wn = np.zeros((3, L))
+    lat_w = np.zeros((3, L))
+    lat_wn = np.zeros((3, L))
+    if pl.turb:
+        lon_w = pl.Cd @ st.gust
+        gust = pl.Ad @ st.gust + pl.Bd @ inp.eta[k]
+        lon_wn = pl.Cd @ gust
+        lat_w = pl.Cdl @ st.glat
+        glat = pl.Adl @ st.glat + pl.Bdl @ inp.eta_lat[k]
+        lat_wn = pl.Cdl @ glat
+
+    def wind(lon, latw, l):
+        w = np.zeros(len(LAYOUT.wind))
+        for j, name in enumerate(("u_g", "w_g", "q_g")):
+            w[LAYOUT.wind.index(name)] = lon[j, l]
+        for j, name in enumerate(("v_g", "p_g", "r_g")):
+            w[LAYOUT.wind.index(name)] = latw[j, l]
+        return w
+
+    six_state = [LAYOUT.states.index(LONGITUDINAL_AS_SIXDOF.get(n, n))
+                 for n in LONGITUDINAL.states]
+    six_out = [LAYOUT.outputs.index(LONGITUDINAL_AS_SIXDOF.get(n, n))
+               for n in LONGITUDINAL.outputs]
+    x = np.zeros_like(st.x)
+    z = np.zeros((len(LONGITUDINAL.outputs), L))
+    va, alpha, bank = np.zeros(L), np.zeros(L), np.zeros(L)
+    sq = rec.sq_lat.copy()
+    for l in range(L):
+        cmd = fm.u0 + e[:, l]
+        if pl.kind == 3:  # linear 6-DOF
+            xd = pl.A @ st.x[:, l] + pl.B @ (cmd - pl.u0) + pl.Bw @ wind(lon_w, lat_w, l)
+        else:
+            xd = rk4_ref(pl.x0 + st.x[:, l], cmd, pl.p, wind(lon_w, lat_w, l), pl.dt,
+                         pl.n_sub) - pl.x0
+        xd[six_state] += inp.w[k][:, l]
+        x[:, l] = xd
+        wn = wind(lon_wn, lat_wn, l)
+        if pl.kind == 3:
+            y = pl.y0 + pl.C @ xd + pl.Dw @ wn
+        else:
+            y = outputs_ref(pl.x0 + xd, pl.p, wn)
+        z[:, l] = y[six_out] - pl.y0[six_out] + inp.v[k][:, l]
+        meas = [LAYOUT.outputs.index(n) for n in LATERAL_MEASURED]
+        lat[:n_meas, l] = y[meas] - pl.y0[meas] + inp.v_lat[k][:, l]
+        va[l] = y[LAYOUT.outputs.index("Va")]
+        alpha[l] = y[LAYOUT.outputs.index("alpha")]
+        bank[l] = pl.x0[LAYOUT.states.index("phi")] + xd[LAYOUT.states.index("phi")]
+        if st.alive[l]:
+            sq[0, l] += xd[LAYOUT.states.index("phi")] ** 2
+            sq[1, l] += xd[LAYOUT.states.index("psi")] ** 2
+    zhold = st.zhold.copy()
+    for l in range(L):
+        z[:, l], zhold[l] = sensor_fault_ref(
+            z[:, l], inp.v[k][:, l], zhold[l], k, pl.dt, int(inp.sensor_out[l]),
+            int(inp.sensor_kind[l]), float(inp.sensor_size[l]), int(inp.sensor_k[l]))
+    return dict(u=u, e=e, x=x, gust=gust, glat=glat, lat=lat, z=z, va=va, alpha=alpha,
+                bank=bank, sq_lat=sq, zhold=zhold)

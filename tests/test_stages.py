@@ -138,6 +138,7 @@ def random_lanes(setup, rng, k, L=L):
                      ecount=np.zeros(L, dtype=np.int64),
                      last_k=k - rng.integers(1, 40, L).astype(np.int64),
                      last_block=rng.integers(0, 3, L).astype(np.int64),
+                     lat=np.zeros((0, L)), glat=np.zeros((0, L)),
                      **trim_jacobians(fm, L))
 
 
@@ -174,7 +175,8 @@ def random_inputs(setup, rng, n_steps, L=L):
         P0=setup.P0, w=setup.q_std[None, :, None] * rng.standard_normal((n_steps, 9, L)),
         v=setup.r_std[None, :, None] * rng.standard_normal((n_steps, 12, L)),
         eta=rng.standard_normal((n_steps if turb else 0, 4, L)),
-        g0=np.zeros((4, L)), **random_sensor_faults(rng, L))
+        g0=np.zeros((4, L)), v_lat=np.zeros((0, 0, L)), eta_lat=np.zeros((0, 0, L)),
+        g0_lat=np.zeros((0, L)), **random_sensor_faults(rng, L))
 
 
 def random_sensor_faults(rng, L):
@@ -203,7 +205,8 @@ def new_rec(tim, L=L, max_resets=4, history=True):
         hist_x=np.zeros((n_hist, 9, L)), hist_xa=np.zeros((n_hist, N_AUG, L)),
         hist_pdiag=np.zeros((n_hist, 5, L)), hist_u=np.zeros((n_hist, 3, L)),
         hist_res=np.zeros((n_hist, 3, L)), hist_exc=np.zeros((n_hist, 4, L)),
-        hist_block=np.zeros((n_hist, L), i8), hist_wind=np.zeros((n_hist, 3, L)))
+        hist_block=np.zeros((n_hist, L), i8), hist_wind=np.zeros((n_hist, 3, L)),
+        sq_lat=np.zeros((2, L)))
 
 
 # ------------------------------------------------------------------ comparisons
@@ -609,7 +612,7 @@ def assert_loop_matches(scheme, flight, inp, n_steps, tol):
     same initial state: discrete record fields exactly, continuous ones and the
     final lane state to ``tol``.  Returns the kernel's record and state."""
     rec = new_rec(flight.timing, max_resets=16)
-    st = trial.new_state(L, inp.xa0.shape[0], scheme.detection.window)
+    st = trial.new_state(L, inp.xa0.shape[0], scheme.detection.window, N_X, 0, 0)
     trial.init_state(inp, st, rec)
     trial.init_jacobians(scheme.filter, st)
     rec_n, st_n = naive.advance_ref(scheme, flight, inp, copy_nt(rec), copy_nt(st), 0,

@@ -23,6 +23,14 @@ and draws from it in this order (:func:`draw_lane`):
    gust state ``g0 = gust_chol @ N(0, I_4)``; drawn last so that the still-air
    draws of a lane are the same with and without turbulence.
 
+On the 6-DOF plant (``plant.dof: 6``) a lane also owns a second stream,
+``numpy.random.default_rng([trial_id, root_seed, LATERAL_STREAM])``, for what
+the longitudinal plants do not have (:func:`draw_lateral`): the noise of the
+lateral loop's measured states (``n_steps x 5``), then in turbulence the
+lateral gust draws (``n_steps x 4``) and the initial lateral gust state.  So a
+6-DOF trial flies the same longitudinal draws as the longitudinal trial of the
+same id.
+
 Trial ``i`` of every transition uses the same stream (common random numbers),
 and the signature variants run on identical inputs.  A scenario is lane 0 of
 its own seed.  Results depend only on the trial ids and the seed, never on the
@@ -53,6 +61,9 @@ LaneDraws = namedtuple("LaneDraws", [
     "v",      # (n_steps, 12, L) measurement noise, scaled
     "eta",    # (n_steps, 4, L) gust draws, or (0, 4, L) in still air
     "g0",     # (4, L) initial gust states (zeros in still air)
+    "v_lat",    # (n_steps, 5, L) lateral measurement noise, or (0, 5, L) (3 DOF)
+    "eta_lat",  # (n_steps, 4, L) lateral gust draws, or (0, 0, L) (3 DOF)
+    "g0_lat",   # (4, L) initial lateral gust states, or (0, L) (3 DOF)
 ])
 """Every random number of a chunk of lanes (module docstring)."""
 
@@ -63,6 +74,9 @@ SensorFaults = namedtuple("SensorFaults", [
     "k",     # (L,) int64 onset step
 ])
 """Per-lane sensor faults (``TrialInputs.sensor_*``, ``core/longitudinal/plant.py``)."""
+
+LATERAL_STREAM = 6
+"""Third key of a lane's lateral stream (module docstring)."""
 
 FLIGHT_FAULT_RANGE = (0.0, 1.0)
 """Range of the fault value a fault-free flight draws and ignores."""
@@ -111,6 +125,45 @@ def draw_lane(rng: np.random.Generator, n_steps: int, q_std: np.ndarray, r_std: 
     return value, w, v, gust
 
 
+def lateral_arrays(setup, n: int, L: int):
+    """Zeroed ``(v_lat, eta_lat, g0_lat)`` of ``L`` lanes: sized for the 6-DOF
+    family's lateral loop and gusts (:mod:`ftc_mc.core.sixdof.truth`, imported
+    only then), empty on the longitudinal plants."""
+    if getattr(setup, "dof", 3) != 6:
+        return np.zeros((0, 0, L)), np.zeros((0, 0, L)), np.zeros((0, L))
+    from ..core.sixdof.truth import N_LAT_GUST_NOISE, N_LAT_GUST_STATE
+
+    turb = setup.gust_lat_chol is not None
+    return (np.zeros((n, len(setup.lat_std), L)),
+            np.zeros((n if turb else 0, N_LAT_GUST_NOISE, L)),
+            np.zeros((N_LAT_GUST_STATE, L)))
+
+
+def draw_lateral(trial_id: int, seed: int, n_steps: int, lat_std: np.ndarray,
+                 gust_lat_chol=None, n_noise: int = 0):
+    """One lane's lateral draws on the 6-DOF plant, from its lateral stream
+    (module docstring).
+
+    ``gust_lat_chol`` (4, 4) is the Cholesky factor of the lateral gust states'
+    stationary covariance (``None`` in still air), driven by ``n_noise`` draws
+    per step.
+
+    Returns
+    -------
+    v_lat : ndarray, shape (n_steps, 5)
+        Noise of the lateral loop's measured states, scaled by ``lat_std``.
+    gust : tuple or None
+        ``(eta_lat, g0_lat)`` of shapes (n_steps, 4) and (4,); ``None`` in still air.
+    """
+    rng = np.random.default_rng([int(trial_id), seed, LATERAL_STREAM])
+    v_lat = rng.standard_normal((n_steps, len(lat_std))) * lat_std
+    gust = None
+    if gust_lat_chol is not None:
+        eta = rng.standard_normal((n_steps, n_noise))
+        gust = eta, gust_lat_chol @ rng.standard_normal(gust_lat_chol.shape[0])
+    return v_lat, gust
+
+
 def draw_lanes(setup, trial_ids, seed: int, fault_range=None) -> LaneDraws:
     """Every lane's draws (:func:`draw_lane`), lane-last.
 
@@ -136,13 +189,21 @@ def draw_lanes(setup, trial_ids, seed: int, fault_range=None) -> LaneDraws:
     turbulent = setup.gust_chol is not None
     eta = np.zeros((n if turbulent else 0, 4, L))
     g0 = np.zeros((4, L))
+    six = getattr(setup, "dof", 3) == 6
+    v_lat, eta_lat, g0_lat = lateral_arrays(setup, n, L)
     for l, tid in enumerate(trial_ids):
         fault[l], w[:, :, l], v[:, :, l], gust = draw_lane(
             trial_stream(tid, seed), n, setup.q_std, setup.r_std, setup.gust_chol,
             fault_range)
         if gust is not None:
             eta[:, :, l], g0[:, l] = gust
-    return LaneDraws(fault=fault, w=w, v=v, eta=eta, g0=g0)
+        if six:
+            v_lat[:, :, l], gust_lat = draw_lateral(tid, seed, n, setup.lat_std,
+                                                    setup.gust_lat_chol, eta_lat.shape[1])
+            if gust_lat is not None:
+                eta_lat[:, :, l], g0_lat[:, l] = gust_lat
+    return LaneDraws(fault=fault, w=w, v=v, eta=eta, g0=g0, v_lat=v_lat, eta_lat=eta_lat,
+                     g0_lat=g0_lat)
 
 
 def entry_modes(schedule: Schedule, beta) -> np.ndarray:
@@ -180,7 +241,8 @@ def build_inputs(setup, schedule: Schedule, draws: LaneDraws,
                        mode_pre=modes[0].copy(), mode_post=modes[-1].copy(), xa0=xa0,
                        P0=setup.P0, w=draws.w, v=draws.v, eta=draws.eta, g0=draws.g0,
                        sensor_out=sensor.out, sensor_kind=sensor.kind,
-                       sensor_size=sensor.size, sensor_k=sensor.k)
+                       sensor_size=sensor.size, sensor_k=sensor.k, v_lat=draws.v_lat,
+                       eta_lat=draws.eta_lat, g0_lat=draws.g0_lat)
 
 
 def design_inputs(inp: TrialInputs, design) -> TrialInputs:

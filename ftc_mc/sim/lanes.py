@@ -34,15 +34,23 @@ from ..core.longitudinal.trial import advance, init_jacobians, init_state, new_s
 from .inputs import design_inputs
 from .paths import path_of
 
+N_SQ_LAT = 2
+"""``TrialRecord.sq_lat``: the squared bank and heading deviations' sums."""
+
 HISTORY_RESETS = 100_000
 """Resets stored per lane when every step is kept (a scenario)."""
 
 
-def start_lanes(scheme, inp: TrialInputs, rec: TrialRecord):
+def start_lanes(scheme, flight, inp: TrialInputs, rec: TrialRecord):
     """The lane state of every trial of ``inp`` at step 0, and ``rec``'s per-lane
     fields initialised (:func:`ftc_mc.core.longitudinal.trial.init_state`; the extended
-    filter's Jacobians at trim, :func:`~ftc_mc.core.longitudinal.trial.init_jacobians`)."""
-    st = new_state(inp.w.shape[2], inp.xa0.shape[0], scheme.detection.window)
+    filter's Jacobians at trim, :func:`~ftc_mc.core.longitudinal.trial.init_jacobians`).
+    The truth's sizes are the flight's plant's (the 6-DOF one has 15 states and
+    its lateral loop's)."""
+    pl = flight.plant
+    n_lat = pl.K_lat.shape[0] if hasattr(pl, "K_lat") else 0
+    st = new_state(inp.w.shape[2], inp.xa0.shape[0], scheme.detection.window,
+                   pl.x0.shape[0], n_lat, inp.g0_lat.shape[0])
     init_state(inp, st, rec)
     init_jacobians(scheme.filter, st)
     return st
@@ -59,7 +67,7 @@ def run_trials(scheme, flight, inp: TrialInputs, rec: TrialRecord) -> None:
     caller links in, so a wrapper kernel cost the cold compile about 20 s
     (``docs/performance.md``, lesson 6).
     """
-    st = start_lanes(scheme, inp, rec)
+    st = start_lanes(scheme, flight, inp, rec)
     advance(path_of(scheme, flight), scheme, flight, inp, rec, st, 0, flight.timing.n_steps)
 
 
@@ -84,12 +92,12 @@ def new_record(setup, L: int, max_resets: int, history: bool = False,
         detect_k=np.zeros(L, dtype=np.int64), status=np.zeros(L, dtype=np.int64),
         stop_k=np.zeros(L, dtype=np.int64),
         controller=np.zeros((n_per, L), dtype=np.int64),
-        hist_x=np.zeros((n_hist, LAY.n_x, L)), hist_xa=np.zeros((n_hist, LAY.n_aug, L)),
+        hist_x=np.zeros((n_hist, setup.truth.x0.shape[0], L)), hist_xa=np.zeros((n_hist, LAY.n_aug, L)),
         hist_pdiag=np.zeros((n_hist, n_par, L)), hist_u=np.zeros((n_hist, LAY.n_u, L)),
         hist_res=np.zeros((n_hist, n_res, L)), hist_exc=np.zeros((n_hist, N_EXC, L)),
         hist_block=np.zeros((n_hist, L), dtype=np.int64),
         hist_wind=np.zeros((n_hist, N_WIND, L)),
-        xa_end=np.zeros((n_est, L)))
+        xa_end=np.zeros((n_est, L)), sq_lat=np.zeros((N_SQ_LAT, L)))
 
 
 def run_alone(setup, name: str, det, inp: TrialInputs, max_resets: int,
@@ -162,7 +170,7 @@ def _shared_start(setup, name: str, inp: TrialInputs, max_resets: int, k_share: 
     dinp = design_inputs(inp, setup.designs[name])
     rec0 = new_record(setup, L, max_resets, n_est=setup.designs[name].n_aug)
     scheme = setup.scheme(name, setup.detection(name, math.inf, math.inf))
-    st0 = start_lanes(scheme, dinp, rec0)
+    st0 = start_lanes(scheme, setup.flight, dinp, rec0)
     advance(path_of(scheme, setup.flight), scheme, setup.flight, dinp, rec0, st0, 0, k_share)
     return rec0, st0
 

@@ -11,7 +11,7 @@ from __future__ import annotations
 from ..conventions import TEST_GLR
 from ..core.shared.paths import (DENSE_FILTER, EXTENDED_FILTER, GLR_TEST, LINEAR_PLANT,
                                  NOMINAL_CONTROL, NONLINEAR_PLANT, ONE_STEP_TEST, PAPER_FILTER,
-                                 RECONFIGURING, Path)
+                                 RECONFIGURING, SIXDOF_PLANT, Path)
 from ..core.longitudinal.settings import Flight, Scheme
 
 
@@ -22,7 +22,9 @@ def path_of(scheme: Scheme, flight: Flight | None = None) -> Path:
     The filter is the paper's when its estimate has the paper's 14 states
     (``FilterModel.G`` has no column: no gust or bias states) and it predicts
     with the linear model; extended when it predicts with the airframe
-    (``FilterModel.nl``); dense otherwise.
+    (``FilterModel.nl``); dense otherwise.  The plant is the 6-DOF family's
+    for a ``SixDofTruth`` (``kind`` 2 or 3: nonlinear or linear, a run-time
+    choice inside that family's kernel).
     """
     fm = scheme.filter
     if fm.nl != 0:
@@ -31,8 +33,9 @@ def path_of(scheme: Scheme, flight: Flight | None = None) -> Path:
         filt = PAPER_FILTER
     else:
         filt = DENSE_FILTER
-    linear = flight is None or flight.plant.kind == 0
-    return Path(plant=LINEAR_PLANT if linear else NONLINEAR_PLANT,
+    kind = 0 if flight is None else flight.plant.kind
+    plant = (LINEAR_PLANT, NONLINEAR_PLANT)[kind] if kind < 2 else SIXDOF_PLANT
+    return Path(plant=plant,
                 filter=filt,
                 test=GLR_TEST if scheme.detection.test == TEST_GLR else ONE_STEP_TEST,
                 control=NOMINAL_CONTROL if scheme.reconfig.kind == 0 else RECONFIGURING)

@@ -34,7 +34,7 @@ from ..model.turbulence import DrydenModel
 from .designs import Design, build_designs
 from .estimator import (EstimatorSettings, belief_settings, detection, filter_model,
                         initial_covariance)
-from .truth import truth_plant
+from .truth import lateral_noise, sixdof_truth_plant, truth_plant
 
 
 @dataclasses.dataclass(frozen=True)
@@ -74,6 +74,13 @@ class SimSetup:
         The gust model (None in still air).
     gust_chol : ndarray or None
         Cholesky factor of the stationary gust-state covariance (None in still air).
+    dof : int
+        3 (longitudinal truth) or 6 (``truth`` a ``SixDofTruth``).
+    lat_std : ndarray or None
+        6-DOF: noise standard deviations (5,) of the lateral loop's measured states.
+    gust_lat_chol : ndarray or None
+        6-DOF in turbulence: Cholesky factor of the lateral gust states' stationary
+        covariance.
     """
 
     plant: LinearPlant
@@ -95,6 +102,9 @@ class SimSetup:
     truth: TruthPlant
     gust: DrydenModel | None
     gust_chol: np.ndarray | None
+    dof: int = 3
+    lat_std: np.ndarray | None = None
+    gust_lat_chol: np.ndarray | None = None
 
     def scheme(self, name: str, detection: Detection | None = None) -> Scheme:
         """The kernels' :class:`Scheme` of the design ``name``: its filter, and its
@@ -193,9 +203,18 @@ def build_setup(cfg: Config | ScenarioConfig) -> SimSetup:
                    va_max=vc.airspeed_max_mps, alpha_trim=plant.trim.alpha,
                    alpha_min=math.radians(vc.alpha_min_deg),
                    alpha_max=math.radians(vc.alpha_max_deg),
-                   psd_every=cfg.steps(vc.psd_check_period_s))
+                   psd_every=cfg.steps(vc.psd_check_period_s),
+                   bank_max=math.radians(vc.bank_max_deg))
     pc = cfg.plant
-    truth, gust = truth_plant(plant, pc.kind, pc.substeps, pc.turbulence, pc.altitude_m)
+    r_std = cfg.noise.measurement_scale * np.sqrt(fm.r_diag)
+    lat_std = gust_lat_chol = None
+    if pc.dof == 6:
+        truth, gust, gust_lat = sixdof_truth_plant(plant, pc.kind, pc.substeps,
+                                                   pc.turbulence, pc.altitude_m)
+        lat_std = lateral_noise(r_std)
+        gust_lat_chol = None if gust_lat is None else gust_lat.P0_chol
+    else:
+        truth, gust = truth_plant(plant, pc.kind, pc.substeps, pc.turbulence, pc.altitude_m)
     return SimSetup(
         plant=plant, est=est, fm=fm, det={n: d.det for n, d in designs.items()},
         designs=designs, bs=bs, ctl=ctl, exc=exc, tim=timing_of(cfg),
@@ -204,6 +223,7 @@ def build_setup(cfg: Config | ScenarioConfig) -> SimSetup:
         # are run, so trials share their pre-fault part across a threshold sweep
         P0=initial_covariance(fm, detection(plant, EstimatorSettings())),
         q_std=cfg.noise.process_scale * np.sqrt(fm.q_diag[:LONGITUDINAL.n_x]),
-        r_std=cfg.noise.measurement_scale * np.sqrt(fm.r_diag),
+        r_std=r_std,
         beta=(cfg.estimator.beta_engine, cfg.estimator.beta_elevon),
-        truth=truth, gust=gust, gust_chol=None if gust is None else gust.P0_chol)
+        truth=truth, gust=gust, gust_chol=None if gust is None else gust.P0_chol,
+        dof=pc.dof, lat_std=lat_std, gust_lat_chol=gust_lat_chol)

@@ -33,7 +33,7 @@ from ...conventions import (N_U, N_X, N_Z, OUT_ALPHA, OUT_VA, SENSOR_BIAS, SENSO
 from ..shared.dryden import N_GUST_OUT, N_GUST_STATE, gust_step
 from ..jit import kernel
 from .nonlinear import outputs_nb, propagate
-from ..shared.paths import LINEAR_PLANT, NONLINEAR_PLANT, on_path
+from ..shared.paths import LINEAR_PLANT, NONLINEAR_PLANT, SIXDOF_PLANT, on_path
 
 
 @kernel
@@ -332,3 +332,18 @@ def truth_step(path, model, flight, inp, k, st, work):
         gust_lanes(pl, inp.eta[k], st.gust, work.wind, work.wind_next, work)
     plant_step(path, model, flight, inp.w[k], inp.v[k], st.x, work)
     sensor_fault(inp, k, pl.dt, inp.v[k], st.zhold, work.z)
+
+
+@kernel
+def longitudinal_truth(plant, scheme, flight, inp, k, st, work, rec):
+    """:func:`truth_step` on a longitudinal plant (``plant`` its marker), as a
+    kernel of its own."""
+    truth_step(plant, scheme.filter, flight, inp, k, st, work)
+
+
+@on_path("plant", {LINEAR_PLANT: longitudinal_truth, NONLINEAR_PLANT: longitudinal_truth,
+                   SIXDOF_PLANT: "ftc_mc.core.sixdof.truth:sixdof_truth"}, passes="marker")
+def truth(path, scheme, flight, inp, k, st, work, rec):
+    """Stage 2 of the path's plant family: :func:`truth_step` on the
+    longitudinal plants, :func:`ftc_mc.core.sixdof.truth.sixdof_truth` on the
+    6-DOF one (imported only by a path that flies it)."""

@@ -114,6 +114,10 @@ TrialInputs = namedtuple("TrialInputs", [
     "sensor_kind",  # (L,) int64 conventions.SENSOR_* kind (bias, stuck, drift, noise)
     "sensor_size",  # (L,) bias [unit], drift [unit/s] or noise factor [-]; stuck: unused
     "sensor_k",     # (L,) int64 onset step: z_{k+1} is faulty from truth step k on
+    # the 6-DOF family's lateral draws (core/sixdof/truth.py; zero-sized otherwise)
+    "v_lat",      # (n_steps, 5, L) noise of the measured lateral states, scaled, or (0, 5, L)
+    "eta_lat",    # (n_steps, 4, L) lateral Dryden draws, or (0, 4, L) in still air
+    "g0_lat",     # (4, L) initial lateral gust state (stationary draw, or zeros), or (0, L)
 ])
 """Per-lane inputs of :func:`ftc_mc.sim.lanes.run_trials` (a fault schedule)."""
 
@@ -141,6 +145,8 @@ TrialRecord = namedtuple("TrialRecord", [
                     #      then 1.0 where each signal started at that step
     "hist_block",   # (n_hist, L) int64 block reset at each step
     "hist_wind",    # (n_hist, 3, L) gust u_g, w_g [m/s], q_g [rad/s] held over each step
+    "sq_lat",       # (2, L) sums over the valid steps of the squared bank and heading
+                    #      deviations [rad^2] (6-DOF plant; zeros otherwise)
 ])
 """Per-lane outputs of :func:`ftc_mc.sim.lanes.run_trials`."""
 
@@ -152,6 +158,7 @@ Validity = namedtuple("Validity", [
     "alpha_min",   # lowest angle of attack [rad]
     "alpha_max",   # highest [rad]
     "psd_every",   # steps between full positive-semi-definiteness checks of P
+    "bank_max",    # largest |bank angle| [rad] (6-DOF plant; the longitudinal ones have none)
 ])
 """Where a trial stops as numerically or physically invalid (see core/longitudinal/trial.py)."""
 
@@ -186,7 +193,7 @@ Flight = namedtuple("Flight", [
 """What the scheme flies: the truth plant, how long, and its validity envelope."""
 
 LaneState = namedtuple("LaneState", [
-    "x",        # (9, L) true plant state (deviation from trim)
+    "x",        # (n_x, L) true plant state (deviation from trim; 15 on the 6-DOF plant)
     "xa",       # (n, L) augmented estimate [x, b, g] (n = 14 for the paper's filter)
     "P",        # (n, n, L) covariance
     "d_start",  # (L,) int64 step the running doublet started at (or far past)
@@ -202,6 +209,11 @@ LaneState = namedtuple("LaneState", [
     "ecount",   # (L,) int64 innovations in the window since the start or last reset
     "last_k",   # (L,) int64 step of the last reset (Detection.settle), or far past
     "last_block",  # (L,) int64 block of the last reset, or 0
+    # the 6-DOF family's lateral loop (core/sixdof/truth.py; zero rows otherwise)
+    "lat",      # (7, L) the lateral loop's measured state: bank, side velocity, roll
+                #        and yaw rates, heading (deviations), then its model of the
+                #        commanded left and right elevon positions
+    "glat",     # (4, L) lateral Dryden gust state, or (0, L)
     # the extended filter's Jacobians about the lane's estimate (FilterModel.relin > 0;
     # the trim matrices otherwise, never read)
     "JA",       # (9, 9, L)  d x_{k+1} / d x_k of the one-period airframe map

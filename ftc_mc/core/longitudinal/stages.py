@@ -35,7 +35,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...conventions import (C_ELEVON, I_B1_LEFT, I_B1_THRUST, N_AUG, N_FAULT, N_MODES, N_U, N_X,
-                            NO_RESET, RESET_THRUST, STATUS_AIRSPEED, STATUS_ALPHA,
+                            NO_RESET, RESET_THRUST, STATUS_AIRSPEED, STATUS_ALPHA, STATUS_BANK,
                             STATUS_NONFINITE, STATUS_NOT_PSD, STATUS_OK)
 from .batch import (filter_correct_lanes, filter_predict_lanes, innovations_lanes, signature_lanes)
 from ..shared.glr import glr_lanes, glr_restart
@@ -356,7 +356,8 @@ def check_validity(validity, st, kn, work, rec):
     its covariance or its air data are not finite (``STATUS_NONFINITE``), its
     covariance fails the Cholesky test (every ``psd_every`` steps,
     ``STATUS_NOT_PSD``), or the true airspeed (``STATUS_AIRSPEED``) or angle of
-    attack (``STATUS_ALPHA``) leave the validity bounds.  Both are
+    attack (``STATUS_ALPHA``) leave the validity bounds, or the true bank angle
+    exceeds ``bank_max`` (``STATUS_BANK``; only the 6-DOF plant banks).  Both are
     air-relative, as the aerodynamics see them: the inertial angle of attack
     would be the wrong test in turbulence (the aircraft follows the air mass,
     so its inertial angle swings with the gust, 1 sigma 4.8 deg in moderate
@@ -370,7 +371,7 @@ def check_validity(validity, st, kn, work, rec):
     kn : int
         Step reached (``k + 1``).
     work : TrialWork
-        Reads ``va``, ``alpha``; buffers ``finite`` and ``chol``.
+        Reads ``va``, ``alpha``, ``bank``; buffers ``finite`` and ``chol``.
     rec : TrialRecord
         ``status`` and ``stop_k`` written for the lanes that stop.
     """
@@ -400,6 +401,8 @@ def check_validity(validity, st, kn, work, rec):
             status = STATUS_AIRSPEED
         elif not (validity.alpha_min <= al <= validity.alpha_max):
             status = STATUS_ALPHA
+        elif abs(work.bank[l]) > validity.bank_max:
+            status = STATUS_BANK
         if status != STATUS_OK:
             st.alive[l] = False
             rec.status[l] = status

@@ -16,7 +16,9 @@ A step ``k -> k+1`` (time ``t = k dt``) is a sequence of stage kernels, each
 described where it is defined:
 
 1. :func:`ftc_mc.core.longitudinal.stages.commands` -- ``u_k = f(U(x_hat_k), s_k, A_k)``;
-2. :func:`ftc_mc.core.longitudinal.plant.truth_step` -- effect, gusts, plant, ``z_{k+1}``;
+2. :func:`ftc_mc.core.longitudinal.plant.truth` -- effect, gusts, plant, ``z_{k+1}``
+   (the longitudinal :func:`~ftc_mc.core.longitudinal.plant.truth_step`, or the
+   6-DOF family's :func:`ftc_mc.core.sixdof.truth.sixdof_truth`);
 3. :func:`ftc_mc.core.longitudinal.stages.filter_update` -- the filter with ``u_k``, ``z_{k+1}``;
 4. :func:`ftc_mc.core.longitudinal.stages.check_validity`;
 5. :func:`ftc_mc.core.longitudinal.stages.handle_resets` -- resets and excitation requests;
@@ -35,7 +37,7 @@ from ...conventions import (N_AUG, N_MODES, N_U, N_X, N_Z, STATUS_AIRSPEED,  # n
 from ..shared.dryden import N_GUST_STATE
 from .gustfilter import N_WIND
 from ..jit import kernel
-from .plant import truth_step
+from .plant import truth
 from .settings import LaneState
 from .stages import (check_validity, commands, filter_update, handle_resets,  # noqa: F401
                      is_psd, reconfigure, record_end, record_step)
@@ -88,7 +90,7 @@ def advance(path, scheme, flight, inp, rec, st, k0, k1):
     for k in range(k0, k1):
         kn = k + 1
         commands(path, scheme, st, k, work)
-        truth_step(path, scheme.filter, flight, inp, k, st, work)
+        truth(path, scheme, flight, inp, k, st, work, rec)
         filter_update(path, scheme, st, k, work)
         check_validity(flight.validity, st, kn, work, rec)
         handle_resets(scheme.excitation, st, kn, work, rec)
@@ -129,17 +131,25 @@ def init_state(inp, st, rec):
         for i in range(st.gust.shape[0]):
             st.gust[i, l] = inp.g0[i, l]
         st.zhold[l] = 0.0
+        for i in range(st.glat.shape[0]):
+            st.glat[i, l] = inp.g0_lat[i, l]
+        for i in range(st.lat.shape[0]):
+            st.lat[i, l] = 0.0
+        for i in range(rec.sq_lat.shape[0]):
+            rec.sq_lat[i, l] = 0.0
         st.ecount[l] = 0
         st.last_k[l] = NO_SIGNAL
         st.last_block[l] = 0
 
 
 @kernel
-def new_state(L, n, window):
+def new_state(L, n, window, n_x, n_lat, n_glat):
     """A :class:`LaneState` of ``L`` lanes, an ``n``-state estimate (14: the
-    paper's filter; 18 with gust states) and a GLR window of ``window`` steps
-    (1 for the one-step test); contents set by :func:`init_state`."""
-    return LaneState(x=np.zeros((N_X, L)), xa=np.zeros((n, L)),
+    paper's filter; 18 with gust states), a GLR window of ``window`` steps
+    (1 for the one-step test) and an ``n_x``-state truth (9 longitudinal, 15
+    on the 6-DOF plant, with its lateral loop's ``n_lat`` and lateral gusts'
+    ``n_glat`` states; 0 otherwise); contents set by :func:`init_state`."""
+    return LaneState(x=np.zeros((n_x, L)), xa=np.zeros((n, L)),
                      P=np.zeros((n, n, L)),
                      d_start=np.zeros(L, dtype=np.int64),
                      s_start=np.zeros(L, dtype=np.int64),
@@ -150,6 +160,7 @@ def new_state(L, n, window):
                      ecount=np.zeros(L, dtype=np.int64),
                      last_k=np.zeros(L, dtype=np.int64),
                      last_block=np.zeros(L, dtype=np.int64),
+                     lat=np.zeros((n_lat, L)), glat=np.zeros((n_glat, L)),
                      JA=np.zeros((N_X, N_X, L)), JB=np.zeros((N_X, N_U, L)),
                      JW=np.zeros((N_X, N_WIND, L)), JC=np.zeros((N_Z, N_X, L)),
                      JHW=np.zeros((N_Z, N_WIND, L)))

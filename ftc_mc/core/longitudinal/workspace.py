@@ -67,6 +67,7 @@ TrialWork = namedtuple("TrialWork", [
     "z",          # (N_Z, L) measurements (deviations from the trim outputs)
     "va",         # (L,) true airspeed [m/s] (air-relative)
     "alpha",      # (L,) true angle of attack [rad] (air-relative)
+    "bank",       # (L,) true bank angle [rad] (6-DOF plant; zeros otherwise)
     "phi",        # (N_X, N_FAULT, L) filter work (batch.filter_step_lanes)
     "T",          # (n, n, L) filter work (the paper's filter uses N_X rows)
     "fwork",      # (step_rows(n), n, L) filter work
@@ -120,7 +121,7 @@ def new_trial_work(L, n):
         u=np.zeros((N_U, L)), exc=np.zeros((N_EXC, L)), e=np.zeros((N_U, L)),
         wind=np.zeros((N_GUST_OUT, L)), wind_next=np.zeros((N_GUST_OUT, L)),
         x_next=np.zeros((N_X, L)), z=np.zeros((N_Z, L)), va=np.zeros(L),
-        alpha=np.zeros(L), phi=np.zeros((N_X, N_FAULT, L)), T=np.zeros((n, n, L)),
+        alpha=np.zeros(L), bank=np.zeros(L), phi=np.zeros((N_X, N_FAULT, L)), T=np.zeros((n, n, L)),
         fwork=np.zeros((step_rows(n), n, L)), res=np.zeros((N_RES, L)),
         block=np.zeros(L, dtype=np.int64), innov=np.zeros((N_RES, L)),
         xsel=np.zeros((N_AUG, L)), Psel=np.zeros((N_AUG, N_AUG, L)),

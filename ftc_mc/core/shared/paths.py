@@ -15,8 +15,10 @@ its first use and cached on disk like any other.
 
 The choices:
 
-* ``plant``: :data:`LINEAR_PLANT` (eq. 1) or :data:`NONLINEAR_PLANT` (the
-  airframe's equations, RK4);
+* ``plant``: :data:`LINEAR_PLANT` (eq. 1), :data:`NONLINEAR_PLANT` (the
+  airframe's equations, RK4) or :data:`SIXDOF_PLANT` (the 6-DOF family's
+  truth, :mod:`ftc_mc.core.sixdof.truth`, named by its import path so that a
+  longitudinal path never imports it);
 * ``filter``: :data:`PAPER_FILTER` (the 14-state filter of eqs. 4-11, with
   the block structure of :mod:`ftc_mc.core.longitudinal.batch`), :data:`DENSE_FILTER`
   (the general filter with extra states, :mod:`ftc_mc.core.longitudinal.gustfilter`) or
@@ -34,6 +36,7 @@ from the settings in one place, :func:`ftc_mc.sim.paths.path_of`.
 
 from __future__ import annotations
 
+import importlib
 import inspect
 from collections import namedtuple
 
@@ -65,6 +68,7 @@ def _marker(name: str):
 
 LinearPlant = _marker("LinearPlant")
 NonlinearPlant = _marker("NonlinearPlant")
+SixdofPlant = _marker("SixdofPlant")
 PaperFilter = _marker("PaperFilter")
 DenseFilter = _marker("DenseFilter")
 ExtendedFilter = _marker("ExtendedFilter")
@@ -73,12 +77,13 @@ GlrTest = _marker("GlrTest")
 NominalControl = _marker("NominalControl")
 Reconfiguring = _marker("Reconfiguring")
 
-LINEAR_PLANT, NONLINEAR_PLANT = LinearPlant(), NonlinearPlant()
+LINEAR_PLANT, NONLINEAR_PLANT, SIXDOF_PLANT = LinearPlant(), NonlinearPlant(), SixdofPlant()
 PAPER_FILTER, DENSE_FILTER, EXTENDED_FILTER = PaperFilter(), DenseFilter(), ExtendedFilter()
 ONE_STEP_TEST, GLR_TEST = OneStepTest(), GlrTest()
 NOMINAL_CONTROL, RECONFIGURING = NominalControl(), Reconfiguring()
 
 NAMES = {LinearPlant: "linear plant", NonlinearPlant: "nonlinear plant",
+         SixdofPlant: "6-DOF plant",
          PaperFilter: "paper filter", DenseFilter: "dense filter",
          ExtendedFilter: "extended filter", OneStepTest: "one-step test",
          GlrTest: "GLR test", NominalControl: "nominal controller",
@@ -147,12 +152,13 @@ def on_path(field: str, impls: dict, passes: str | None = None):
         ``"plant"``, ``"filter"``, ``"test"`` or ``"control"``.
     impls : dict
         Marker (e.g. :data:`PAPER_FILTER`) -> kernel taking the stub's
-        parameters after the first.
+        parameters after the first, or its import path ``"module:name"``
+        (imported only when a path takes it: another family's kernel).
     passes : {None, "marker", "path"}
         What the kernel gets first, if anything.
     """
     assert passes in (None, "marker", "path"), passes
-    table = {type(m): f for m, f in impls.items()}
+    table = _LazyTable({type(m): f for m, f in impls.items()})
 
     def decorate(stub):
         params = list(inspect.signature(stub).parameters)
@@ -174,6 +180,19 @@ def on_path(field: str, impls: dict, passes: str | None = None):
         overload(stub, jit_options=_JIT_OPTIONS)(scope["overload_of"])
         return stub
     return decorate
+
+
+class _LazyTable(dict):
+    """Marker class -> kernel, importing a kernel given as ``"module:name"``
+    the first time it is asked for."""
+
+    def get(self, key, default=None):
+        impl = super().get(key, default)
+        if isinstance(impl, str):
+            module, _, name = impl.partition(":")
+            impl = getattr(importlib.import_module(module), name)
+            self[key] = impl
+        return impl
 
 
 def _is_path(arg_type) -> bool:
