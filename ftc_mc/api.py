@@ -114,7 +114,7 @@ def _design_override(cfg, design, signature) -> dict | None:
 
 
 def campaign_config(config, *, trials=None, seed=None, signature=None, transitions=None,
-                    controller=None, plant=None, turbulence=None, airframe=None,
+                    controller=None, plant=None, turbulence=None, dof=None, airframe=None,
                     design=None, reset_log=None):
     """A validated campaign :class:`~ftc_mc.config.Config` with overrides.
 
@@ -129,6 +129,8 @@ def campaign_config(config, *, trials=None, seed=None, signature=None, transitio
     controller : {"nominal", "reconfiguring"}, optional
     plant : {"linear", "nonlinear"}, optional
     turbulence : {"none", "light", "moderate", "severe"}, optional
+    dof : {3, 6}, optional
+        ``plant.dof``: the longitudinal truth or the 6-DOF flying wing.
     airframe : str or Path, optional
         ``model.airframe``: a preset name, an airframe YAML file or a linear
         model (``.npz``/``.mat``).
@@ -154,7 +156,7 @@ def campaign_config(config, *, trials=None, seed=None, signature=None, transitio
     over = {"campaign": {"trials": trials, "seed": seed, "signature": signature,
                          "transitions": _listed(transitions), "reset_log": reset_log},
             "controller": {"kind": controller},
-            "plant": {"kind": plant, "turbulence": turbulence},
+            "plant": {"kind": plant, "turbulence": turbulence, "dof": dof},
             "model": {"airframe": None if airframe is None else str(airframe)}}
     over = {k: v for k, v in over.items() if any(x is not None for x in v.values())}
     cfg = with_overrides(cfg, **over) if over else cfg
@@ -162,13 +164,14 @@ def campaign_config(config, *, trials=None, seed=None, signature=None, transitio
     return cfg if runs is None else with_overrides(cfg, campaign=runs)
 
 
-def scenario_config(config, *, plant=None, turbulence=None, airframe=None, design=None):
+def scenario_config(config, *, plant=None, turbulence=None, dof=None, airframe=None,
+                    design=None):
     """A validated :class:`~ftc_mc.config.ScenarioConfig` with plant overrides.
 
     Parameters
     ----------
     config : str, Path, dict or ScenarioConfig
-    plant, turbulence, airframe : str, optional
+    plant, turbulence, dof, airframe : optional
         As in :func:`campaign_config`.
     design : str, optional
         The one design to fly (``--design``): ``paper``, ``swapped`` (then
@@ -188,7 +191,7 @@ def scenario_config(config, *, plant=None, turbulence=None, airframe=None, desig
         sc = validate_model(ScenarioConfig, config, "config")
     else:
         sc = load_scenario(config)
-    over = {"plant": {"kind": plant, "turbulence": turbulence},
+    over = {"plant": {"kind": plant, "turbulence": turbulence, "dof": dof},
             "model": {"airframe": None if airframe is None else str(airframe)}}
     over = {k: v for k, v in over.items() if any(x is not None for x in v.values())}
     sc = with_overrides(sc, **over) if over else sc
@@ -279,7 +282,7 @@ def _finished(out_dir: Path, kind: str, files, identity: dict) -> bool:
 # -- the commands -----------------------------------------------------------------
 
 def run_campaign(config, *, trials=None, seed=None, signature=None, controller=None,
-                 plant=None, turbulence=None, airframe=None, design=None, reset_log=None,
+                 plant=None, turbulence=None, dof=None, airframe=None, design=None, reset_log=None,
                  jobs: int = 1,
                  progress: bool = True,
                  backend: str = "threads", scheduler: str | None = None, out=None,
@@ -339,7 +342,7 @@ def run_campaign(config, *, trials=None, seed=None, signature=None, controller=N
 
     _check_jobs(jobs)
     cfg = campaign_config(config, trials=trials, seed=seed, signature=signature,
-                          controller=controller, plant=plant, turbulence=turbulence,
+                          controller=controller, plant=plant, turbulence=turbulence, dof=dof,
                           airframe=airframe, design=design, reset_log=reset_log)
     kw = dict(jobs=jobs, progress=progress, backend=backend, scheduler=scheduler)
     out_dir = _check_out(out, resume)
@@ -380,7 +383,7 @@ def _spec(values, option: str):
 
 def run_sweep(config, thresholds=None, *, tq=None, tnx=None, transitions=None,
               signature=None, trials=None, seed=None, flights: int | None = None,
-              plant=None, turbulence=None, airframe=None, design=None, jobs: int = 1,
+              plant=None, turbulence=None, dof=None, airframe=None, design=None, jobs: int = 1,
               progress: bool = True, backend: str = "threads", scheduler: str | None = None,
               out=None, overwrite: bool = False, resume: bool = False,
               command: str | None = None):
@@ -416,7 +419,7 @@ def run_sweep(config, thresholds=None, *, tq=None, tnx=None, transitions=None,
     from .io.results import provenance, write_parquet
 
     cfg = campaign_config(config, trials=trials, seed=seed, signature=signature,
-                          transitions=transitions, plant=plant, turbulence=turbulence,
+                          transitions=transitions, plant=plant, turbulence=turbulence, dof=dof,
                           airframe=airframe, design=design)
     points = threshold_points(_spec(thresholds, "--thresholds"), _spec(tq, "--tq"),
                               _spec(tnx, "--tnx"))
@@ -454,7 +457,7 @@ def run_sweep(config, thresholds=None, *, tq=None, tnx=None, transitions=None,
 
 
 def run_endurance(config, hours, *, flight_s: float | None = None, seed=None,
-                  signature=None, plant=None, turbulence=None, airframe=None, design=None,
+                  signature=None, plant=None, turbulence=None, dof=None, airframe=None, design=None,
                   jobs: int = 1, progress: bool = True, backend: str = "threads",
                   scheduler: str | None = None, out=None, overwrite: bool = False,
                   resume: bool = False, command: str | None = None):
@@ -490,7 +493,7 @@ def run_endurance(config, hours, *, flight_s: float | None = None, seed=None,
     from .io.results import prepare_output_dir, provenance, write_parquet
 
     cfg = campaign_config(config, seed=seed, signature=signature, plant=plant,
-                          turbulence=turbulence, airframe=airframe, design=design)
+                          turbulence=turbulence, dof=dof, airframe=airframe, design=design)
     hours = check_hours(hours)
     cfg = endurance_config(cfg, flight_s)
     _check_jobs(jobs)
@@ -523,7 +526,7 @@ def run_endurance(config, hours, *, flight_s: float | None = None, seed=None,
     return res
 
 
-def run_scenario(config, *, seed: int | None = None, plant=None, turbulence=None,
+def run_scenario(config, *, seed: int | None = None, plant=None, turbulence=None, dof=None,
                  airframe=None, design=None, out=None, overwrite: bool = False, command: str | None = None):
     """Fly one closed-loop scenario: the paper's Table 4 by default (``ftc-mc scenario``).
 
@@ -552,7 +555,7 @@ def run_scenario(config, *, seed: int | None = None, plant=None, turbulence=None
     from .io.results import prepare_output_dir, provenance
     from .scenario import run_scenario as run, write_scenario
 
-    sc = scenario_config(config, plant=plant, turbulence=turbulence, airframe=airframe,
+    sc = scenario_config(config, plant=plant, turbulence=turbulence, dof=dof, airframe=airframe,
                          design=design)
     if seed is not None and seed < 0:
         raise UserError(f"--seed: must be >= 0, got {seed}")

@@ -182,6 +182,8 @@ def _default_out(config_path: str, cfg=None):
     if cfg is not None and (cfg.plant.kind, cfg.plant.turbulence) != ("linear", "none"):
         stem += f"-{cfg.plant.kind}" + (f"-{cfg.plant.turbulence}"
                                         if cfg.plant.turbulence != "none" else "")
+    if cfg is not None and cfg.plant.dof != 3:
+        stem += f"-{cfg.plant.dof}dof"
     base = Path("results") / stem
     cand, n = base, 1
     while cand.exists() and (any((cand / f).exists() for f in RUN_FILES)
@@ -200,9 +202,14 @@ DESIGN_HELP = ("A design to run: paper, swapped or a key of the config's designs
 
 
 def plant_options(func):
-    """``--airframe``, ``--plant`` and ``--turbulence`` of ``run``, ``sweep`` and
-    ``scenario``."""
+    """``--airframe``, ``--plant``, ``--turbulence`` and ``--dof`` of ``run``,
+    ``sweep``, ``endurance`` and ``scenario``."""
     func = click.option("--airframe", metavar="NAME|PATH", help=AIRFRAME_HELP)(func)
+    func = click.option("--dof", type=click.Choice(["3", "6"]), default=None,
+                        callback=lambda _c, _p, v: None if v is None else int(v),
+                        help="Degrees of freedom of the truth plant: 3 (longitudinal) or "
+                        "6 (the flying wing with its lateral motion and a lateral "
+                        "autopilot; overrides plant.dof).")(func)
     func = click.option("--turbulence",
                         type=click.Choice(["none", "light", "moderate", "severe"]),
                         help="MIL-F-8785C Dryden gusts on the truth plant (overrides "
@@ -329,14 +336,14 @@ def terminal_table(summary) -> str:
 @parallel_options
 @user_errors
 def run(config, trials, seed, jobs, out, signature, design, controller, overwrite, resume,
-        reset_log, backend, scheduler, quiet, plant, turbulence, airframe):
+        reset_log, backend, scheduler, quiet, plant, turbulence, dof, airframe):
     """Run a Monte Carlo campaign (the paper's Tables 2-3) from CONFIG."""
     from pathlib import Path
 
     from . import api
 
     cfg = api.campaign_config(config, trials=trials, seed=seed, signature=signature,
-                              controller=controller, plant=plant, turbulence=turbulence,
+                              controller=controller, plant=plant, turbulence=turbulence, dof=dof,
                               airframe=airframe, design=list(design) or None,
                               reset_log=reset_log)
     if resume and not out:
@@ -373,14 +380,14 @@ def run(config, trials, seed, jobs, out, signature, design, controller, overwrit
 @click.option("--overwrite", is_flag=True, help="Replace results already in --out.")
 @plant_options
 @user_errors
-def scenario(config, out, seed, design, overwrite, plant, turbulence, airframe):
+def scenario(config, out, seed, design, overwrite, plant, turbulence, dof, airframe):
     """Run the closed-loop scenario of CONFIG (the paper's Table 4 by default)."""
     from pathlib import Path
 
     from . import api
     from .scenario import summary_markdown
 
-    sc = api.scenario_config(config, plant=plant, turbulence=turbulence, airframe=airframe,
+    sc = api.scenario_config(config, plant=plant, turbulence=turbulence, dof=dof, airframe=airframe,
                              design=design)
     out_dir = Path(out) if out else _default_out(config, sc)
     res = api.run_scenario(sc, seed=seed, out=out_dir, overwrite=overwrite,
@@ -412,7 +419,7 @@ def scenario(config, out, seed, design, overwrite, plant, turbulence, airframe):
 @parallel_options
 @user_errors
 def sweep(config, thresholds, tq, tnx, transitions, signature, design, trials, flights, jobs,
-          out, overwrite, resume, backend, scheduler, quiet, plant, turbulence, airframe):
+          out, overwrite, resume, backend, scheduler, quiet, plant, turbulence, dof, airframe):
     """Sweep the Table 1 thresholds: Tables 2-3 and false resets per flight hour."""
     from pathlib import Path
 
@@ -420,7 +427,7 @@ def sweep(config, thresholds, tq, tnx, transitions, signature, design, trials, f
     from .campaign.sweep import sweep_markdown
 
     cfg = api.campaign_config(config, trials=trials, signature=signature,
-                              transitions=transitions, plant=plant, turbulence=turbulence,
+                              transitions=transitions, plant=plant, turbulence=turbulence, dof=dof,
                               airframe=airframe, design=list(design) or None)
     if resume and not out:
         raise UserError("--resume: name the sweep's directory with --out")
@@ -460,7 +467,7 @@ def sweep(config, thresholds, tq, tnx, transitions, signature, design, trials, f
 @parallel_options
 @user_errors
 def endurance(config, hours, flight_s, seed, signature, design, jobs, out, overwrite, resume,
-              backend, scheduler, quiet, plant, turbulence, airframe):
+              backend, scheduler, quiet, plant, turbulence, dof, airframe):
     """Fly every design fault-free for H flight hours: false resets per flight hour."""
     from pathlib import Path
 
@@ -474,7 +481,7 @@ def endurance(config, hours, flight_s, seed, signature, design, jobs, out, overw
         except ValueError:
             raise UserError(f"--flight-s: expected seconds, got {flight_s!r}") from None
     cfg = api.campaign_config(config, seed=seed, signature=signature, plant=plant,
-                              turbulence=turbulence, airframe=airframe,
+                              turbulence=turbulence, dof=dof, airframe=airframe,
                               design=list(design) or None)
     cfg = endurance_config(cfg, flight_s)
     if resume and not out:

@@ -21,8 +21,10 @@ the sensor-aware design of issue 14 (the paper's filter with three sensor biases
 17 states on the general filter); ratios against ``swapped``.
 
 The last line is ``linear_trials_per_s=<a> nonlinear_trials_per_s=<b>
-nonlinear_moderate_trials_per_s=<c> ratio=<a/b>`` (nominal controller unless
-told otherwise).
+nonlinear_moderate_trials_per_s=<c> ratio=<a/b> sixdof_trials_per_s=<d>
+sixdof_vs_nonlinear=<d/b>`` (nominal controller unless told otherwise; the last
+ratio is issue 24's: the 6-DOF nonlinear plant's full trial against the
+longitudinal nonlinear one's, target at least 0.5).
 """
 
 from __future__ import annotations
@@ -46,8 +48,10 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from ftc_mc.campaign.chunk import chunk_spec, run_chunk  # noqa: E402
 from ftc_mc.config import Config  # noqa: E402
 
-PLANTS = (("linear", "none"), ("nonlinear", "none"), ("linear", "moderate"),
-          ("nonlinear", "moderate"))
+PLANTS = (("linear", "none", 3), ("nonlinear", "none", 3), ("linear", "moderate", 3),
+          ("nonlinear", "moderate", 3), ("nonlinear", "none", 6), ("nonlinear", "moderate", 6))
+"""(plant, turbulence, degrees of freedom) timed; the 6-DOF rows fly the 6-DOF
+flying wing with its lateral loop (issue 24)."""
 TRANSITIONS = ("elevon_lock", "engine_loss")
 
 DESIGNS = {
@@ -62,7 +66,7 @@ DESIGNS = {
 paper's filter, the reference)."""
 
 
-def trials_per_s(kind, turbulence, controller, lanes, repeat, design=None):
+def trials_per_s(kind, turbulence, controller, lanes, repeat, design=None, dof=3):
     """Median trials/s of one chunk per transition (both variants count as trials;
     with ``design``, that design alone)."""
     campaign = {"transitions": list(TRANSITIONS), "signature": "both"}
@@ -77,7 +81,7 @@ def trials_per_s(kind, turbulence, controller, lanes, repeat, design=None):
     cfg = Config.model_validate({
         "campaign": campaign, "designs": designs,
         "controller": {"kind": controller},
-        "plant": {"kind": kind, "turbulence": turbulence}})
+        "plant": {"kind": kind, "turbulence": turbulence, "dof": dof}})
     spec = chunk_spec(cfg)
     ids = np.arange(lanes)
 
@@ -102,17 +106,18 @@ def main():
     ap.add_argument("--controller", choices=("nominal", "reconfiguring"), default="nominal")
     args = ap.parse_args()
     rows = {}
-    for kind, turb in PLANTS:
-        rows[kind, turb], n_steps = trials_per_s(kind, turb, args.controller, args.lanes,
-                                                 args.repeat)
-    ref = rows["linear", "none"]
+    for kind, turb, dof in PLANTS:
+        rows[kind, turb, dof], n_steps = trials_per_s(kind, turb, args.controller,
+                                                      args.lanes, args.repeat, dof=dof)
+    ref = rows["linear", "none", 3]
     print(f"one thread, chunks of {args.lanes} trials, {n_steps} steps per trial, "
           f"controller {args.controller}, transitions {', '.join(TRANSITIONS)}, "
           f"both variants")
-    print(f"{'plant':>10} {'turbulence':>10} {'trials/s':>10} {'trial steps/s':>14} "
-          f"{'vs linear':>10}")
-    for (kind, turb), r in rows.items():
-        print(f"{kind:>10} {turb:>10} {r:10.1f} {r * n_steps:14.3g} {r / ref:10.3f}")
+    print(f"{'plant':>10} {'turbulence':>10} {'dof':>4} {'trials/s':>10} "
+          f"{'trial steps/s':>14} {'vs linear':>10}")
+    for (kind, turb, dof), r in rows.items():
+        print(f"{kind:>10} {turb:>10} {dof:>4} {r:10.1f} {r * n_steps:14.3g} "
+              f"{r / ref:10.3f}")
     drows = {name: trials_per_s("nonlinear", "moderate", args.controller, args.lanes,
                                 args.repeat, (name, dc))[0]
              for name, dc in DESIGNS.items()}
@@ -120,10 +125,12 @@ def main():
     print(f"{'design':>14} {'trials/s':>10} {'trial steps/s':>14} {'vs swapped':>10}")
     for name, r in drows.items():
         print(f"{name:>14} {r:10.1f} {r * n_steps:14.3g} {r / drows['swapped']:10.3f}")
-    nl = rows["nonlinear", "none"]
+    nl = rows["nonlinear", "none", 3]
+    six = rows["nonlinear", "none", 6]
     print(f"linear_trials_per_s={ref:.1f} nonlinear_trials_per_s={nl:.1f} "
-          f"nonlinear_moderate_trials_per_s={rows['nonlinear', 'moderate']:.1f} "
-          f"ratio={ref / nl:.2f}")
+          f"nonlinear_moderate_trials_per_s={rows['nonlinear', 'moderate', 3]:.1f} "
+          f"ratio={ref / nl:.2f} sixdof_trials_per_s={six:.1f} "
+          f"sixdof_vs_nonlinear={six / nl:.3f}")
 
 
 if __name__ == "__main__":

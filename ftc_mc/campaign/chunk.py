@@ -465,6 +465,16 @@ def classify_flights(variant: str, flight_ids, rec: TrialRecord, dt: float, n_s:
     return flights, resets
 
 
+def lateral_columns(rec: TrialRecord, n_steps: int) -> dict:
+    """The 6-DOF plant's lateral columns of each trial: ``bank_rms_deg`` and
+    ``heading_rms_deg``, the RMS of the bank and heading deviations from trim
+    [deg] over the steps the trial flew (to its end, or to its exit from the
+    validity envelope)."""
+    flown = np.maximum(np.where(rec.stop_k >= 0, rec.stop_k, n_steps), 1)
+    return {"bank_rms_deg": np.degrees(np.sqrt(rec.sq_lat[0] / flown)),
+            "heading_rms_deg": np.degrees(np.sqrt(rec.sq_lat[1] / flown))}
+
+
 def _runs(spec: ChunkSpec):
     """``(t_q, t_nx, variant, Detection)`` of every run of a chunk, point-major."""
     setup = spec.setup
@@ -521,6 +531,9 @@ def run_chunk(spec: ChunkSpec, name: str, trial_ids) -> dict:
         recs, _ = simulate(setup, inp, [r[2:] for r in runs], spec.max_resets)
         parts = [classify_flights(v, trial_ids, rec, setup.plant.dt, n * setup.plant.dt)
                  for (_, _, v, _), rec in zip(runs, recs)]
+        if setup.dof == 6:
+            for (t, _), rec in zip(parts, recs):
+                t.update(lateral_columns(rec, n))
         return {"trials": pd.DataFrame(_columns([p[0] for p in parts])),
                 "resets": pd.DataFrame(_columns([p[1] for p in parts]))}
     if name == FLIGHT:
@@ -537,6 +550,8 @@ def run_chunk(spec: ChunkSpec, name: str, trial_ids) -> dict:
     trials, resets = [], []
     for (tq, tnx, v, _), rec in zip(runs, recs):
         t, r = classify(spec, name, v, trial_ids, values, inp, rec)
+        if setup.dof == 6:
+            t.update(lateral_columns(rec, n))
         if spec.points is not None:
             t["t_q"] = np.full(L, tq)
             t["t_nx"] = np.full(L, tnx)

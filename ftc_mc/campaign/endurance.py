@@ -40,6 +40,7 @@ from ..stats import hours_to_show, poisson_rate, poisson_upper
 from .chunk import ENDURANCE, chunk_spec
 from .parallel import run_chunks
 from .runner import sort_rows
+from .summary import lateral_summary
 
 FALSE_RESET_TARGET_PER_H = 0.01
 """Default false-alarm target: one false reset per 100 flight hours [1/h]."""
@@ -182,6 +183,7 @@ def summarize_endurance(flights: pd.DataFrame, resets: pd.DataFrame, cfg: Config
             "hours_to_show": hours_to_show(k, target),
             "early_false_resets": int((r["time_s"] <= EARLY_S).sum()),
             "median_false_reset_s": float(r["time_s"].median()) if len(r) else np.nan})
+        row.update(lateral_summary(f))  # 6-DOF: bank and heading RMS
         rows.append(row)
     return pd.DataFrame(rows)
 

@@ -93,7 +93,8 @@ SUMMARY_COLUMNS = ("transition", "variant", "judged", "no_reset", "small_b1",
                    "false_resets", "detected", "detection_s", "actuator_reset",
                    "wrong_mode", "controller_switch", "envelope_exit", "actuator_reset_s",
                    "wrong_mode_s", "controller_switch_s", "first_action_s",
-                   "sensor_bias_hat_end", "isolated", "first_reset_block")
+                   "sensor_bias_hat_end", "isolated", "first_reset_block",
+                   "bank_rms_deg", "heading_rms_deg")
 """The ``trials.parquet`` columns :func:`summary_row` reads: a chunked scan reads
 only these (``campaign/assemble.py``)."""
 
@@ -135,7 +136,22 @@ def summary_row(name: str, variant: str, g: pd.DataFrame) -> dict:
     row.update({"paper_trials": paper[0], "paper_inappropriate": paper[1],
                 "paper_no_reset": paper[2]})
     row.update(real_flight_scores(name, ok))  # ALFA and FDDBenchmark (scoring.py)
+    row.update(lateral_summary(g))
     return row
+
+
+def lateral_summary(g: pd.DataFrame) -> dict:
+    """6-DOF runs: the bank and heading RMS [deg] over every trial of ``g``
+    (``sqrt`` of the mean square, each trial weighted equally) and the largest
+    trial's; ``{}`` for a longitudinal run (no such columns)."""
+    if "bank_rms_deg" not in g:
+        return {}
+    out = {}
+    for key in ("bank_rms_deg", "heading_rms_deg"):
+        v = g[key].to_numpy(dtype=float)
+        out[key] = float(np.sqrt(np.mean(v ** 2))) if len(v) else np.nan
+        out[f"{key}_max"] = float(v.max()) if len(v) else np.nan
+    return out
 
 
 def summary_frame(rows, transitions, variants) -> pd.DataFrame:

@@ -145,6 +145,12 @@ class PlantConfig(_Strict):
     """MIL-F-8785C Dryden gusts: W20 = 0, 15, 30, 45 kt."""
     altitude_m: Annotated[float, NoBool, Field(ge=3.048, le=304.8, allow_inf_nan=False)] = 100.0
     """Altitude for the Dryden scale lengths [m] (low-altitude model: 10-1000 ft)."""
+    dof: Literal[3, 6] = 3
+    """Degrees of freedom of the truth plant: 3, the longitudinal plane (the
+    paper's); 6, the flying wing with its lateral-directional motion, left and
+    right elevons as separate actuators and a lateral autopilot beside the
+    paper's loop (``ftc_mc/core/sixdof/truth.py``).  The filter and the
+    controllers keep the longitudinal model either way."""
 
 
 class EstimatorConfig(_Strict):
@@ -276,6 +282,10 @@ class ValidityConfig(_Strict):
     """Highest angle of attack [deg] (below stall, range of the aerodynamic fit)."""
     psd_check_period_s: Pos = 1.0
     """Period of the full Cholesky check of the filter covariance [s]."""
+    bank_max_deg: Annotated[float, NoBool, Field(gt=0, le=90, allow_inf_nan=False)] = 60.0
+    """Largest bank angle [deg] (6-DOF plant): beyond it the longitudinal filter's
+    model no longer describes the flight (its load factor and pitch channels
+    mix with the turn), and a small flying wing's autopilot would not fly it."""
 
     @model_validator(mode="after")
     def _ordered(self):

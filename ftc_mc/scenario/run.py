@@ -90,6 +90,12 @@ def run_scenario(sc: ScenarioConfig, seed: int | None = None,
                           status=status)
 
 
+LATERAL_COLUMNS = ("y", "phi", "psi", "v", "p", "r")
+"""6-DOF scenario: the lateral states written as ``<name>_true`` (cross-track
+position [m], bank and heading [rad], side velocity [m/s], roll and yaw rates
+[rad/s]), deviations from trim."""
+
+
 def _timeseries(setup, sc, rec, k_sw, b0, b1) -> pd.DataFrame:
     """Columns: time, true and estimated states, tracking errors, true and
     estimated fault parameters with their standard deviations, residuals and
@@ -101,9 +107,17 @@ def _timeseries(setup, sc, rec, k_sw, b0, b1) -> pd.DataFrame:
     t = (np.arange(n) + 1) * dt
     lay = LONGITUDINAL
     cols = {"time_s": t}
+    # the truth's row of each longitudinal state: its own on the longitudinal
+    # plants, the 6-DOF state of the same name on the 6-DOF one
+    rows = setup.truth.lon_state if setup.dof == 6 else range(lay.n_x)
     for i, nm in enumerate(lay.states):
-        cols[f"{nm}_true"] = rec.hist_x[:, i, 0]
+        cols[f"{nm}_true"] = rec.hist_x[:, rows[i], 0]
         cols[f"{nm}_est"] = rec.hist_xa[:, i, 0]
+    if setup.dof == 6:  # the lateral motion (deviations from trim)
+        from ..core.sixdof.layout import STATE
+
+        for nm in LATERAL_COLUMNS:
+            cols[f"{nm}_true"] = rec.hist_x[:, STATE[nm], 0]
     g = plant.trim.gamma0
     ix, iz = lay.state("x"), lay.state("z")
     x, z = rec.hist_x[:, ix, 0], rec.hist_x[:, iz, 0]
