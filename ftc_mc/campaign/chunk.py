@@ -28,8 +28,8 @@ from ..sim.paths import path_of
 from ..sim.inputs import build_inputs, draw_lanes, flight_inputs, sensor_faults
 from ..sim.lanes import simulate
 from ..sim.setup import SimSetup, build_setup, runs_of
-from .transitions import (TRANSITION_TABLE, FaultRanges, SensorTransition, fault_ranges, is_sensor,
-                          transition_of)
+from .transitions import (ENGINE, TRANSITION_TABLE, FaultRanges, SensorTransition,
+                          fault_ranges, is_sensor, transition_of)
 
 FLIGHT = "fault_free"
 """Chunk name of the fault-free flights of a sweep (false resets per flight hour)."""
@@ -203,8 +203,8 @@ def classify(spec: ChunkSpec, tr_name: str, variant: str, trial_ids, values,
     detected = changed & (rec.detect_k >= 0)
     a = tr.actuator
     u0 = setup.plant.u0[a]
-    beta = setup.beta[0 if a == 0 else 1]
-    near = spec.near_trim[0 if a == 0 else 1]
+    beta = setup.beta[0 if a == ENGINE else 1]  # (engine, elevon)
+    near = spec.near_trim[0 if a == ENGINE else 1]
     is_lock = tr.kind == "lock"
     small_b1 = np.zeros(L, dtype=bool) if is_lock else values < beta
     near_trim = np.abs(values - u0) < near if is_lock else np.zeros(L, dtype=bool)

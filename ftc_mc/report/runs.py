@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 
 from ..conventions import VARIANTS
@@ -25,8 +26,21 @@ SIGNIFICANCE = 0.05
 # ------------------------------------------------------------------ Tables 2-3
 
 
+def _has_paper(r: pd.Series) -> bool:
+    """Whether the paper ran row ``r`` (the right elevon's rows it did not: NaN)."""
+    return bool(np.isfinite(float(r["paper_trials"])))
+
+
+def _paper_count(r: pd.Series, col: str) -> str:
+    if not _has_paper(r):
+        return "-"
+    return count(int(r[f"paper_{col}"]), int(r["paper_trials"]))
+
+
 def _vs_paper(r: pd.Series) -> str:
     """Where our 95 % interval lies wholly above or below the paper's."""
+    if not _has_paper(r):
+        return "not in the paper"
     notes = []
     for col in ("inappropriate", "no_reset"):
         lo, hi = wilson(r[f"paper_{col}"], r["paper_trials"])
@@ -43,10 +57,9 @@ def _paper_row(r: pd.Series) -> dict:
     return {
         "transition": r["label"], "judged": n,
         "inappropriate: ours": count(int(r["inappropriate"]), n),
-        "inappropriate: paper": count(int(r["paper_inappropriate"]),
-                                      int(r["paper_trials"])),
+        "inappropriate: paper": _paper_count(r, "inappropriate"),
         "no reset: ours": count(int(r["no_reset"]), n),
-        "no reset: paper": count(int(r["paper_no_reset"]), int(r["paper_trials"])),
+        "no reset: paper": _paper_count(r, "no_reset"),
         "no reset explained": num(100 * r["no_reset_explained_share"], "{:.0f} %"),
         "correct block": count(int(r["correct"]), n, ci=False),
         "reset delay median / p95 [s]":
@@ -77,9 +90,10 @@ def paper_tables(summary: pd.DataFrame) -> list:
                   pd.DataFrame([_paper_row(r) for _, r in g.iterrows()])
                   .to_markdown(index=False), ""]
     lines += ["Counts are `k/n (rate %, 95 % Wilson CI)`, over judged trials only; the "
-              "paper's counts are from its Tables 2-3 (one set for both variants). "
-              "*95 % CIs vs paper* says where our interval lies wholly above or below "
-              "the paper's.", ""]
+              "paper's counts are from its Tables 2-3 (one set for both variants; its "
+              "faulty elevon is the left one, and it ran no right-elevon row). "
+              "*95 % CIs vs paper* says where our interval lies wholly above or "
+              "below the paper's.", ""]
     return lines
 
 
