@@ -62,8 +62,14 @@ def summarize(trials: pd.DataFrame) -> pd.DataFrame:
     ``detection_median_s`` / ``detection_p95_s``: the belief's detection time [s];
     the real-flight metrics of :mod:`ftc_mc.campaign.scoring` (ALFA precision,
     recall and delays; average detection delay ``add_s`` and correct diagnosis
-    rate ``cdr``).  The paper's counts (``paper_*``) are NaN in the right
-    elevon's rows, which the paper did not run.
+    rate ``cdr``); ``correct_side`` (with ``_rate``, ``_ci_low``, ``_ci_high``)
+    and ``correct_side_trials``: of the judged trials of an elevon row whose
+    final mode is an elevon mode (``correct_side_trials`` of them), those whose
+    more probable elevon mode at the end of the judging window is the faulty
+    side (the ``correct_side`` trial column; rate NaN where no trial applies:
+    engine rows, recoveries, and tables written before the column existed).
+    The paper's counts (``paper_*``) are NaN in the right elevon's rows, which
+    the paper did not run.
 
     Only judged trials (``judged`` column: no numerical failure, inside the
     validity envelope through the judging window, all resets stored) enter the
@@ -94,7 +100,7 @@ SUMMARY_COLUMNS = ("transition", "variant", "judged", "no_reset", "small_b1",
                    "false_resets", "detected", "detection_s", "actuator_reset",
                    "wrong_mode", "controller_switch", "envelope_exit", "actuator_reset_s",
                    "wrong_mode_s", "controller_switch_s", "first_action_s",
-                   "sensor_bias_hat_end", "isolated", "first_reset_block")
+                   "sensor_bias_hat_end", "isolated", "first_reset_block", "correct_side")
 """The ``trials.parquet`` columns :func:`summary_row` reads: a chunked scan reads
 only these (``campaign/assemble.py``)."""
 
@@ -136,6 +142,10 @@ def summary_row(name: str, variant: str, g: pd.DataFrame) -> dict:
     row.update({"paper_trials": paper[0], "paper_inappropriate": paper[1],
                 "paper_no_reset": paper[2]})
     row.update(real_flight_scores(name, ok))  # ALFA and FDDBenchmark (scoring.py)
+    side = _column(ok, "correct_side")
+    applies = np.isfinite(side)
+    row["correct_side_trials"] = int(applies.sum())
+    row.update(_rate("correct_side", int((side[applies] == 1.0).sum()), int(applies.sum())))
     return row
 
 
@@ -240,7 +250,8 @@ def sensor_markdown_table(summary: pd.DataFrame, intervals: bool = True) -> str:
 
 _COUNTS = ("inappropriate", "no_reset", "no_reset_explained", "correct", "correct_only",
            "false_alarm_trials", "mode_changes", "detected", "paper_trials",
-           "paper_inappropriate", "paper_no_reset", "alfa_tp", "alfa_fp", "alfa_fn")
+           "paper_inappropriate", "paper_no_reset", "alfa_tp", "alfa_fp", "alfa_fn",
+           "correct_side", "correct_side_trials")
 
 
 def actuator_rows(summary: pd.DataFrame) -> pd.DataFrame:
@@ -266,12 +277,26 @@ def paper_text(r) -> str:
     return f"{i} / {nr} of {n}"
 
 
+def side_text(r, intervals: bool = True) -> str:
+    """``correct_side`` of a summary row as ``k/n (rate %, CI)``; ``-`` where it
+    does not apply (or the summary predates it)."""
+    if "correct_side_rate" not in r or not np.isfinite(r["correct_side_rate"]):
+        return "-"
+    k, n = int(r["correct_side"]), int(r["correct_side_trials"])
+    if not intervals:
+        return f"{k}/{n} ({100 * r['correct_side_rate']:.1f} %)"
+    return (f"{k}/{n} ({100 * r['correct_side_rate']:.1f} %, "
+            f"{100 * r['correct_side_ci_low']:.1f}-{100 * r['correct_side_ci_high']:.1f})")
+
+
 def markdown_table(summary: pd.DataFrame) -> str:
     """The summary as the paper's columns plus ours, in Markdown.
 
     Columns: transition, variant, trials, inappropriate (rate, 95 % CI), no reset
     (rate, CI, share explained), correct, median / p95 reset delay, false alarms,
-    detection median, and the paper's counts (``-`` for the right elevon's rows).
+    detection median, correct side (``k/n``, rate, 95 % CI; ``-`` outside the
+    elevon-fault trials), and the paper's counts (``-`` for the right elevon's
+    rows).
     """
     def pct(r, p):
         return (f"{r[p]} ({100 * r[p + '_rate']:.1f} %, "
@@ -296,6 +321,7 @@ def markdown_table(summary: pd.DataFrame) -> str:
             "delay median / p95 [s]": f"{num(r['delay_median_s'])} / {num(r['delay_p95_s'])}",
             "false-alarm trials": r["false_alarm_trials"],
             "detection median [s]": num(r["detection_median_s"]),
+            "correct side (%, 95% CI)": side_text(r),
             "paper: inappropriate / no reset": paper_text(r),
         })
     table = pd.DataFrame(rows).to_markdown(index=False)

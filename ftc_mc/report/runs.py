@@ -37,6 +37,14 @@ def _paper_count(r: pd.Series, col: str) -> str:
     return count(int(r[f"paper_{col}"]), int(r["paper_trials"]))
 
 
+def _side(r: pd.Series) -> str:
+    """``correct_side`` as ``k/n (rate %, CI)``; ``-`` where no trial applies
+    (engine rows, recoveries) or the summary predates the column."""
+    if "correct_side_rate" not in r or not np.isfinite(r["correct_side_rate"]):
+        return "-"
+    return count(int(r["correct_side"]), int(r["correct_side_trials"]))
+
+
 def _vs_paper(r: pd.Series) -> str:
     """Where our 95 % interval lies wholly above or below the paper's."""
     if not _has_paper(r):
@@ -67,6 +75,7 @@ def _paper_row(r: pd.Series) -> dict:
         "detection median / p95 [s]":
             f"{num(r['detection_median_s'])} / {num(r['detection_p95_s'])}",
         "false-alarm trials": int(r["false_alarm_trials"]),
+        "correct side": _side(r),
         "95 % CIs vs paper": _vs_paper(r),
     }
 
@@ -92,7 +101,10 @@ def paper_tables(summary: pd.DataFrame) -> list:
     lines += ["Counts are `k/n (rate %, 95 % Wilson CI)`, over judged trials only; the "
               "paper's counts are from its Tables 2-3 (one set for both variants; its "
               "faulty elevon is the left one, and it ran no right-elevon row). "
-              "*95 % CIs vs paper* says where our interval lies wholly above or "
+              "*Correct side*: of the judged trials whose final mode is an elevon fault, "
+              "those whose belief at the end of the judging window holds the faulty "
+              "elevon more probable than the other (`correct_side_rate`; `-` in other "
+              "rows). *95 % CIs vs paper* says where our interval lies wholly above or "
               "below the paper's.", ""]
     return lines
 
