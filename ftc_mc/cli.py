@@ -283,22 +283,28 @@ def terminal_table(summary) -> str:
 
     Per transition and variant: trials judged, inappropriate and no-reset
     rates, the share of no-reset trials explained by a small ``b1`` or a lock
-    near trim, the median reset delay, and the paper's counts (of 1000).  The
-    full table, with 95 % intervals, is in ``summary.md``.
+    near trim, the median reset delay, and the paper's counts of inappropriate
+    and no-reset trials (of 1000; ``-`` in the right elevon's rows, which the
+    paper did not run).  The full table, with 95 % intervals and the
+    ``correct_side`` rate, is in ``summary.md``.
     """
     import math
+
+    def paper(r):
+        i, nr = r["paper_inappropriate"], r["paper_no_reset"]
+        return f"{int(i)} / {int(nr)}" if math.isfinite(i) and math.isfinite(nr) else "-"
 
     def num(x, fmt):
         return "-" if not math.isfinite(x) else fmt.format(x)
 
     head = ("transition", "variant", "judged", "inappr. %", "no reset %", "explained",
-            "delay med [s]", "paper inappr/no reset")
+            "delay med [s]", "paper inap/nr")
     rows = [(r["transition"], r["variant"], str(r["trials"]),
              num(100 * r["inappropriate_rate"], "{:.1f}"),
              num(100 * r["no_reset_rate"], "{:.1f}"),
              num(100 * r["no_reset_explained_share"], "{:.0f} %"),
              num(r["delay_median_s"], "{:.1f}"),
-             f"{r['paper_inappropriate']} / {r['paper_no_reset']}")
+             paper(r))
             for _, r in summary.iterrows()]
     widths = [max(len(c) for c in col) for col in zip(head, *rows)]
 

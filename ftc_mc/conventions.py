@@ -116,9 +116,15 @@ STATUS_NAMES = ("ok", "nonfinite", "covariance_not_psd", "airspeed_out_of_bounds
 """Why a trial stopped being trusted (``ok``: it ran to its end)."""
 
 # ------------------------------------------------------------------ campaigns, plants
-TRANSITIONS = ("elevon_lock", "elevon_unlock", "elevon_loss", "elevon_loss_recover",
-               "engine_lock", "engine_unlock", "engine_loss", "engine_loss_recover")
-"""The eight transitions of Tables 2-3 (docs/paper-map.md)."""
+PAPER_TRANSITIONS = ("elevon_lock", "elevon_unlock", "elevon_loss", "elevon_loss_recover",
+                     "engine_lock", "engine_unlock", "engine_loss", "engine_loss_recover")
+"""The eight transitions of Tables 2-3 (docs/paper-map.md); their faulty elevon is
+the left one, as in the paper."""
+RIGHT_ELEVON_TRANSITIONS = ("right_elevon_lock", "right_elevon_unlock", "right_elevon_loss",
+                            "right_elevon_loss_recover")
+"""The four elevon rows with the right elevon faulty (issue 24; not in the paper)."""
+TRANSITIONS = PAPER_TRANSITIONS + RIGHT_ELEVON_TRANSITIONS
+"""Every actuator transition: the paper's eight, then the right elevon's four."""
 
 AIRFRAME_PRESETS = ("x8-pyfly", "x8-gryte2018")
 """Airframe presets (:mod:`ftc_mc.model.presets`), the default first."""

@@ -28,8 +28,8 @@ from ..sim.paths import path_of
 from ..sim.inputs import build_inputs, draw_lanes, flight_inputs, sensor_faults
 from ..sim.lanes import simulate
 from ..sim.setup import SimSetup, build_setup, runs_of
-from .transitions import (TRANSITION_TABLE, FaultRanges, SensorTransition, fault_ranges, is_sensor,
-                          transition_of)
+from .transitions import (ELEVON_MODES, ENGINE, TRANSITION_TABLE, FaultRanges,
+                          SensorTransition, fault_ranges, is_sensor, transition_of)
 
 FLIGHT = "fault_free"
 """Chunk name of the fault-free flights of a sweep (false resets per flight hour)."""
@@ -161,7 +161,11 @@ def classify(spec: ChunkSpec, tr_name: str, variant: str, trial_ids, values,
     * ``status``/``stop_s``: why and when a trial stopped (``ok`` if it ran to
       the end); ``judged``: the trial counts in the rates, i.e. it never failed
       numerically, left the validity envelope (if at all) only after the window,
-      and stored all its resets.
+      and stored all its resets;
+    * ``correct_side``: for a judged trial of an elevon row (left or right)
+      whose final mode is an elevon mode, 1.0 when the belief's more probable
+      elevon mode at the end of the window is the faulty side, else 0.0; NaN
+      for every other trial (:func:`correct_side`).
 
     Parameters
     ----------
@@ -203,8 +207,8 @@ def classify(spec: ChunkSpec, tr_name: str, variant: str, trial_ids, values,
     detected = changed & (rec.detect_k >= 0)
     a = tr.actuator
     u0 = setup.plant.u0[a]
-    beta = setup.beta[0 if a == 0 else 1]
-    near = spec.near_trim[0 if a == 0 else 1]
+    beta = setup.beta[0 if a == ENGINE else 1]  # (engine, elevon)
+    near = spec.near_trim[0 if a == ENGINE else 1]
     is_lock = tr.kind == "lock"
     small_b1 = np.zeros(L, dtype=bool) if is_lock else values < beta
     near_trim = np.abs(values - u0) < near if is_lock else np.zeros(L, dtype=bool)
@@ -246,8 +250,54 @@ def classify(spec: ChunkSpec, tr_name: str, variant: str, trial_ids, values,
         "judged": judged & ~truncated,
         "status": np.array([STATUS_NAMES[s] for s in rec.status], dtype=object),
         "stop_s": np.where(rec.stop_k >= 0, rec.stop_k * dt, np.nan),
+        "correct_side": correct_side(tr, inp.mode_post, rec.belief, judged & ~truncated,
+                                     kf + window_steps, setup.tim.reconf_every),
     }
     return trials, resets
+
+
+def correct_side(tr, mode_post, belief, judged, k_end: int, every: int) -> np.ndarray:
+    """Per lane: whether the belief names the faulty elevon at the window's end.
+
+    The belief at the end of the judging window is the one of the last update
+    at or before step ``k_end`` (period ``k_end // every - 1``; period ``p``
+    ends at step ``(p + 1) every``).  The *most probable elevon mode* is the
+    larger of its left- and right-elevon probabilities; a tie names neither
+    side and counts as wrong.
+
+    Parameters
+    ----------
+    tr : Transition
+    mode_post : ndarray of int, shape (L,)
+        Each lane's final mode.
+    belief : ndarray, shape (n_periods, 4, L)
+        The belief after each reconfiguration period (``TrialRecord.belief``).
+    judged : ndarray of bool, shape (L,)
+    k_end : int
+        Last step of the judging window.
+    every : int
+        Steps per reconfiguration period.
+
+    Returns
+    -------
+    ndarray of float, shape (L,)
+        1.0 (the faulty side is the more probable) or 0.0 for the judged lanes
+        of an elevon transition whose final mode is an elevon mode; NaN for the
+        others (engine rows, recoveries, losses inside the nominal box,
+        unjudged trials, and a window ending before the first update).
+    """
+    mode_post = np.asarray(mode_post)
+    L = len(mode_post)
+    out = np.full(L, np.nan)
+    p = k_end // every - 1
+    if not tr.is_elevon or not 0 <= p < belief.shape[0]:
+        return out
+    applies = np.isin(mode_post, ELEVON_MODES) & np.asarray(judged, dtype=bool)
+    lanes = np.nonzero(applies)[0]
+    faulty = mode_post[lanes]
+    other = np.where(faulty == ELEVON_MODES[0], ELEVON_MODES[1], ELEVON_MODES[0])
+    out[lanes] = belief[p, faulty, lanes] > belief[p, other, lanes]
+    return out
 
 
 def _reset_columns(tr_name, variant, trial_ids, rec, kf, window_steps, dt):
@@ -373,6 +423,7 @@ def classify_sensor(spec: ChunkSpec, tr_name: str, variant: str, trial_ids, size
         "judged": ~numeric_fail & ~truncated,
         "status": np.array([STATUS_NAMES[s] for s in rec.status], dtype=object),
         "stop_s": np.where(rec.stop_k >= 0, rec.stop_k * dt, np.nan),
+        "correct_side": np.full(L, np.nan),  # no actuator is faulty
         "sensor_output": np.full(L, tr.output, dtype=object),
         "sensor_kind": np.full(L, tr.kind, dtype=object),
         "sensor_size": np.asarray(sizes, dtype=float),

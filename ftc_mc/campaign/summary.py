@@ -17,7 +17,7 @@ import pandas as pd
 from ..core.longitudinal.trial import STATUS_NAMES
 from ..stats import median_p95, wilson
 from .scoring import real_flight_scores
-from .transitions import PAPER_TABLES, TRANSITION_TABLE, is_sensor, transition_of
+from .transitions import TRANSITION_TABLE, is_sensor, paper_counts, transition_of
 
 SENSOR_RATES = ("actuator_reset", "wrong_mode", "controller_switch", "misattributed",
                 "envelope_exit")
@@ -62,7 +62,14 @@ def summarize(trials: pd.DataFrame) -> pd.DataFrame:
     ``detection_median_s`` / ``detection_p95_s``: the belief's detection time [s];
     the real-flight metrics of :mod:`ftc_mc.campaign.scoring` (ALFA precision,
     recall and delays; average detection delay ``add_s`` and correct diagnosis
-    rate ``cdr``).
+    rate ``cdr``); ``correct_side`` (with ``_rate``, ``_ci_low``, ``_ci_high``)
+    and ``correct_side_trials``: of the judged trials of an elevon row whose
+    final mode is an elevon mode (``correct_side_trials`` of them), those whose
+    more probable elevon mode at the end of the judging window is the faulty
+    side (the ``correct_side`` trial column; rate NaN where no trial applies:
+    engine rows, recoveries, and tables written before the column existed).
+    The paper's counts (``paper_*``) are NaN in the right elevon's rows, which
+    the paper did not run.
 
     Only judged trials (``judged`` column: no numerical failure, inside the
     validity envelope through the judging window, all resets stored) enter the
@@ -93,7 +100,7 @@ SUMMARY_COLUMNS = ("transition", "variant", "judged", "no_reset", "small_b1",
                    "false_resets", "detected", "detection_s", "actuator_reset",
                    "wrong_mode", "controller_switch", "envelope_exit", "actuator_reset_s",
                    "wrong_mode_s", "controller_switch_s", "first_action_s",
-                   "sensor_bias_hat_end", "isolated", "first_reset_block",
+                   "sensor_bias_hat_end", "isolated", "first_reset_block", "correct_side",
                    "bank_rms_deg", "heading_rms_deg")
 """The ``trials.parquet`` columns :func:`summary_row` reads: a chunked scan reads
 only these (``campaign/assemble.py``)."""
@@ -113,7 +120,7 @@ def summary_row(name: str, variant: str, g: pd.DataFrame) -> dict:
     no_reset = ok["no_reset"].to_numpy()
     explained = no_reset & (ok["small_b1"].to_numpy() | ok["lock_near_trim"].to_numpy())
     changed = ok["mode_changed"].to_numpy()
-    paper = PAPER_TABLES[name]
+    paper = paper_counts(name)
     row = {"transition": name, "label": TRANSITION_TABLE[name].label,
            "variant": variant, "trials": n, "excluded": len(g) - n}
     for reason in STATUS_NAMES[1:]:
@@ -136,6 +143,10 @@ def summary_row(name: str, variant: str, g: pd.DataFrame) -> dict:
     row.update({"paper_trials": paper[0], "paper_inappropriate": paper[1],
                 "paper_no_reset": paper[2]})
     row.update(real_flight_scores(name, ok))  # ALFA and FDDBenchmark (scoring.py)
+    side = _column(ok, "correct_side")
+    applies = np.isfinite(side)
+    row["correct_side_trials"] = int(applies.sum())
+    row.update(_rate("correct_side", int((side[applies] == 1.0).sum()), int(applies.sum())))
     row.update(lateral_summary(g))
     return row
 
@@ -255,19 +266,43 @@ def sensor_markdown_table(summary: pd.DataFrame, intervals: bool = True) -> str:
 
 _COUNTS = ("inappropriate", "no_reset", "no_reset_explained", "correct", "correct_only",
            "false_alarm_trials", "mode_changes", "detected", "paper_trials",
-           "paper_inappropriate", "paper_no_reset", "alfa_tp", "alfa_fp", "alfa_fn")
+           "paper_inappropriate", "paper_no_reset", "alfa_tp", "alfa_fp", "alfa_fn",
+           "correct_side", "correct_side_trials")
 
 
 def actuator_rows(summary: pd.DataFrame) -> pd.DataFrame:
     """The rows of actuator transitions (Tables 2-3), without the sensor columns and
-    with their counts as integers again (a run mixing both kinds has NaN there)."""
+    with their counts as integers again (a run mixing both kinds has NaN there;
+    the paper's counts stay NaN in the right elevon's rows)."""
     if "transition" not in summary or not summary["transition"].map(is_sensor).any():
         return summary
     sensor = summary["transition"].map(is_sensor)
     act = summary[~sensor]
     only = [c for c in summary if act[c].isna().all() and summary.loc[sensor, c].notna().any()]
     sub = act.drop(columns=only)
-    return sub.astype({c: "int64" for c in _COUNTS if c in sub})
+    return sub.astype({c: "int64" for c in _COUNTS if c in sub and sub[c].notna().all()})
+
+
+def paper_text(r) -> str:
+    """``inappropriate / no reset of trials`` of the paper's row ``r``; ``-`` for a
+    row the paper did not run (NaN counts)."""
+    counts = [r[f"paper_{c}"] for c in ("inappropriate", "no_reset", "trials")]
+    if not all(np.isfinite(float(x)) for x in counts):
+        return "-"
+    i, nr, n = (int(x) for x in counts)
+    return f"{i} / {nr} of {n}"
+
+
+def side_text(r, intervals: bool = True) -> str:
+    """``correct_side`` of a summary row as ``k/n (rate %, CI)``; ``-`` where it
+    does not apply (or the summary predates it)."""
+    if "correct_side_rate" not in r or not np.isfinite(r["correct_side_rate"]):
+        return "-"
+    k, n = int(r["correct_side"]), int(r["correct_side_trials"])
+    if not intervals:
+        return f"{k}/{n} ({100 * r['correct_side_rate']:.1f} %)"
+    return (f"{k}/{n} ({100 * r['correct_side_rate']:.1f} %, "
+            f"{100 * r['correct_side_ci_low']:.1f}-{100 * r['correct_side_ci_high']:.1f})")
 
 
 def markdown_table(summary: pd.DataFrame) -> str:
@@ -275,7 +310,9 @@ def markdown_table(summary: pd.DataFrame) -> str:
 
     Columns: transition, variant, trials, inappropriate (rate, 95 % CI), no reset
     (rate, CI, share explained), correct, median / p95 reset delay, false alarms,
-    detection median, and the paper's counts.
+    detection median, correct side (``k/n``, rate, 95 % CI; ``-`` outside the
+    elevon-fault trials), and the paper's counts (``-`` for the right elevon's
+    rows).
     """
     def pct(r, p):
         return (f"{r[p]} ({100 * r[p + '_rate']:.1f} %, "
@@ -300,8 +337,8 @@ def markdown_table(summary: pd.DataFrame) -> str:
             "delay median / p95 [s]": f"{num(r['delay_median_s'])} / {num(r['delay_p95_s'])}",
             "false-alarm trials": r["false_alarm_trials"],
             "detection median [s]": num(r["detection_median_s"]),
-            "paper: inappropriate / no reset": f"{r['paper_inappropriate']} / "
-                                               f"{r['paper_no_reset']} of {r['paper_trials']}",
+            "correct side (%, 95% CI)": side_text(r),
+            "paper: inappropriate / no reset": paper_text(r),
         })
     table = pd.DataFrame(rows).to_markdown(index=False)
     return table + ("\n\n" + sensor if sensor else "")

@@ -1,7 +1,8 @@
-"""The eight fault transitions of Tables 2-3 and the ranges of their fault draws.
+"""The fault transitions of Tables 2-3 and the ranges of their fault draws.
 
-A transition names the actuator (the faulty elevon is the left one,
-``docs/paper-map.md``), the fault kind (lock or loss of effectiveness) and the direction
+A transition names the actuator (the paper's eight rows fault the left elevon,
+``docs/paper-map.md``; the ``right_elevon_*`` rows, issue 24, the same four
+elevon rows on the right elevon), the fault kind (lock or loss of effectiveness) and the direction
 (``onset``: nominal -> faulty; ``recovery``: faulty -> nominal).  Its trials fly
 a two-entry schedule (:meth:`Transition.schedule`): the initial mode from the
 start, the final mode from the fault step on.  Each trial's fault value (lock
@@ -16,11 +17,18 @@ import dataclasses
 import numpy as np
 
 from ..config.schema import parse_sensor_transition
-from ..conventions import (LONGITUDINAL, OUTPUT_NAMES, RESET_ELEVONS, RESET_THRUST,
-                           SENSOR_FAULT_KINDS, SENSOR_PREFIX)
+from ..conventions import (ACTUATOR_NAMES, LONGITUDINAL, MODE_LEFT_ELEVON, MODE_NAMES,
+                           MODE_RIGHT_ELEVON, OUTPUT_NAMES, PAPER_TRANSITIONS,
+                           RESET_ELEVONS, RESET_THRUST, SENSOR_FAULT_KINDS, SENSOR_PREFIX,
+                           TRANSITIONS)
 from ..sim.inputs import Schedule
 
-ENGINE, LEFT, RIGHT = 0, 1, 2
+ENGINE, LEFT, RIGHT = (ACTUATOR_NAMES.index(n) for n in ("engine", "left_elevon",
+                                                         "right_elevon"))
+ELEVONS = (LEFT, RIGHT)
+"""Actuator indices (command order, :data:`~ftc_mc.conventions.ACTUATOR_NAMES`)."""
+ELEVON_MODES = (MODE_LEFT_ELEVON, MODE_RIGHT_ELEVON)
+"""The belief's elevon modes, whose argmax names the side (``correct_side``)."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -31,7 +39,8 @@ class Transition:
     ----------
     name : str
     actuator : int
-        0 engine, 1 left elevon.
+        Index into :data:`~ftc_mc.conventions.ACTUATOR_NAMES` (:data:`ENGINE`,
+        :data:`LEFT`, :data:`RIGHT`).
     kind : str
         ``"lock"`` or ``"loss"``.
     onset : bool
@@ -45,6 +54,18 @@ class Transition:
     kind: str
     onset: bool
     label: str
+
+    @property
+    def fault_mode(self) -> int:
+        """The belief mode of the faulty actuator (:data:`~ftc_mc.conventions.MODE_NAMES`,
+        named as the actuator): the final mode of an onset whose fault value lies
+        outside the nominal box."""
+        return MODE_NAMES.index(ACTUATOR_NAMES[self.actuator])
+
+    @property
+    def is_elevon(self) -> bool:
+        """Whether the faulty actuator is an elevon (left or right)."""
+        return self.actuator in ELEVONS
 
     @property
     def correct_block(self) -> int:
@@ -74,8 +95,9 @@ class Transition:
             for an onset, faulty then nominal for a recovery.
         """
         L = len(values)
-        nominal = np.zeros((2, 3, L))
-        b0, b1 = np.zeros((3, L)), np.zeros((3, L))
+        n_a = len(LONGITUDINAL.actuators)
+        nominal = np.zeros((2, n_a, L))
+        b0, b1 = np.zeros((n_a, L)), np.zeros((n_a, L))
         if self.kind == "lock":
             b1[self.actuator] = 1.0
             b0[self.actuator] = values
@@ -101,8 +123,20 @@ TRANSITION_TABLE = {
                    "Engine nominal → Engine less efficient"),
         Transition("engine_loss_recover", ENGINE, "loss", False,
                    "Engine less efficient → Engine nominal"),
+        # issue 24: the elevon rows on the right elevon (not in the paper)
+        Transition("right_elevon_lock", RIGHT, "lock", True,
+                   "Right elevon nominal → Right elevon locked"),
+        Transition("right_elevon_unlock", RIGHT, "lock", False,
+                   "Right elevon locked → Right elevon nominal"),
+        Transition("right_elevon_loss", RIGHT, "loss", True,
+                   "Right elevon nominal → Right elevon less efficient"),
+        Transition("right_elevon_loss_recover", RIGHT, "loss", False,
+                   "Right elevon less efficient → Right elevon nominal"),
     ]
 }
+"""Every actuator transition by name, the paper's eight rows first (their order in
+tables), then the right elevon's (:data:`~ftc_mc.conventions.TRANSITIONS`)."""
+assert tuple(TRANSITION_TABLE) == TRANSITIONS
 
 PAPER_TABLES = {
     # name: (simulations, inappropriate resets, no reset) -- paper Tables 2 and 3
@@ -115,7 +149,15 @@ PAPER_TABLES = {
     "engine_loss": (1000, 0, 165),
     "engine_loss_recover": (1000, 0, 179),
 }
-"""The paper's own Monte Carlo counts, for side-by-side reports."""
+"""The paper's own Monte Carlo counts, for side-by-side reports (its eight rows
+only: it ran no right-elevon fault)."""
+assert tuple(PAPER_TABLES) == PAPER_TRANSITIONS
+
+
+def paper_counts(name: str) -> tuple:
+    """``(simulations, inappropriate, no reset)`` of the paper for transition
+    ``name``; NaN for a row the paper did not run (the right elevon's)."""
+    return PAPER_TABLES.get(name, (np.nan, np.nan, np.nan))
 
 
 @dataclasses.dataclass(frozen=True)
@@ -125,7 +167,8 @@ class FaultRanges:
     Attributes
     ----------
     lock : dict of int to (float, float)
-        Absolute lock position range per actuator index (0 engine, 1 left elevon).
+        Absolute lock position range per actuator index (:data:`ENGINE`,
+        :data:`LEFT`, :data:`RIGHT`).
     loss : (float, float)
         Range of the effectiveness loss ``b1``.
     """
@@ -142,10 +185,13 @@ def fault_ranges(draws, u_lower, u_upper) -> FaultRanges:
     """The :class:`FaultRanges` of a validated ``draws`` section.
 
     A lock range left null is the actuator's whole command range
-    ``[u_lower, u_upper]`` (the schema keeps a given range inside it).
+    ``[u_lower, u_upper]`` (the schema keeps a given range inside it).  Both
+    elevons draw their locks over ``draws.elevon_lock_range_rad``, each within its
+    own command limits when it is null.
     """
-    lock = {0: tuple(draws.engine_lock_range or (u_lower[0], u_upper[0])),
-            1: tuple(draws.elevon_lock_range_rad or (u_lower[1], u_upper[1]))}
+    lock = {ENGINE: tuple(draws.engine_lock_range or (u_lower[ENGINE], u_upper[ENGINE]))}
+    for a in ELEVONS:
+        lock[a] = tuple(draws.elevon_lock_range_rad or (u_lower[a], u_upper[a]))
     for a, (lo, hi) in lock.items():
         assert u_lower[a] <= lo < hi <= u_upper[a], (a, lo, hi)
     return FaultRanges(lock=lock, loss=tuple(draws.loss_b1_range))

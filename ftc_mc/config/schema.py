@@ -224,7 +224,7 @@ class DrawsConfig(_Strict):
     engine_lock_range: tuple[Finite, Finite] | None = None
     """Absolute throttle lock position range; null = the command range [0, 1]."""
     elevon_lock_range_rad: tuple[Finite, Finite] | None = None
-    """Absolute left-elevon lock position range [rad]; null = the command range."""
+    """Absolute elevon lock position range [rad], of the left (elevon_*) and the right (right_elevon_*) rows; null = the command range."""
     loss_b1_range: tuple[Annotated[float, NoBool, Field(ge=0, le=1)],
                          Annotated[float, NoBool, Field(ge=0, le=1)]] = (0.0, 1.0)
     """Uniform range of the effectiveness loss b1."""
@@ -505,7 +505,7 @@ class CampaignConfig(_Strict):
 
     transitions: list[TransitionName] = Field(default_factory=lambda: ["elevon_lock"],
                                               min_length=1)
-    """Transitions to run (elevon or engine x lock, unlock, loss, loss_recover), or
+    """Transitions to run (elevon, right_elevon or engine x lock, unlock, loss, loss_recover; elevon is the paper's left elevon), or
     sensor faults ``sensor_<kind>:<output>`` (kind bias, stuck, drift, noise; output
     one of the 12, e.g. ``sensor_bias:q``) from nominal at timing.fault_time_s."""
     trials: Annotated[int, NoBool, Field(gt=0, le=10_000_000)] = 1000
@@ -591,11 +591,14 @@ class Config(_Sampled):
                              f"({t.duration_s:g} s), got {self.controller.horizon_s:g}")
         _check_length("timing.duration_s", t.duration_s, dt)
         lower, upper = _check_airframe_use(self)
-        for a, name in ((0, "engine_lock_range"), (1, "elevon_lock_range_rad")):
+        for actuator, name in (("engine", "engine_lock_range"),
+                               ("left_elevon", "elevon_lock_range_rad"),
+                               ("right_elevon", "elevon_lock_range_rad")):
+            a = ACTUATOR_NAMES.index(actuator)
             r = getattr(self.draws, name)
             if r is not None and (r[0] < lower[a] or r[1] > upper[a]):
-                raise ValueError(f"draws.{name}: must lie within the command range "
-                                 f"[{lower[a]:g}, {upper[a]:g}], got {list(r)}")
+                raise ValueError(f"draws.{name}: must lie within the {actuator} command "
+                                 f"range [{lower[a]:g}, {upper[a]:g}], got {list(r)}")
         for i, name in enumerate(self.campaign.transitions):
             sensor = parse_sensor_transition(name)
             if sensor and sensor[0] == "noise" and self.noise.measurement_scale == 0:

@@ -56,7 +56,7 @@ def real_flight_lines(trials: pd.DataFrame) -> list:
              f"and recall {100 * k['precision']:.2f} %, mean detection delay "
              f"{k['delay_mean_s']:.2f} s and maximum {k['delay_max_s']:.1f} s. **The aircraft, "
              "the faults, the sensors and the detector differ from ours** (a simulated X8 "
-             "flying wing, single locks and effectiveness losses of the engine or the left "
+             "flying wing, single locks and effectiveness losses of the engine or one "
              "elevon), so these figures are not a target and the comparison is not like "
              "for like.", ""]
     for variant, g in t.groupby("variant", sort=False):

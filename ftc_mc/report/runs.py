@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 
 from ..conventions import VARIANTS
@@ -25,8 +26,29 @@ SIGNIFICANCE = 0.05
 # ------------------------------------------------------------------ Tables 2-3
 
 
+def _has_paper(r: pd.Series) -> bool:
+    """Whether the paper ran row ``r`` (the right elevon's rows it did not: NaN)."""
+    return bool(np.isfinite(float(r["paper_trials"])))
+
+
+def _paper_count(r: pd.Series, col: str) -> str:
+    if not _has_paper(r):
+        return "-"
+    return count(int(r[f"paper_{col}"]), int(r["paper_trials"]))
+
+
+def _side(r: pd.Series) -> str:
+    """``correct_side`` as ``k/n (rate %, CI)``; ``-`` where no trial applies
+    (engine rows, recoveries) or the summary predates the column."""
+    if "correct_side_rate" not in r or not np.isfinite(r["correct_side_rate"]):
+        return "-"
+    return count(int(r["correct_side"]), int(r["correct_side_trials"]))
+
+
 def _vs_paper(r: pd.Series) -> str:
     """Where our 95 % interval lies wholly above or below the paper's."""
+    if not _has_paper(r):
+        return "not in the paper"
     notes = []
     for col in ("inappropriate", "no_reset"):
         lo, hi = wilson(r[f"paper_{col}"], r["paper_trials"])
@@ -43,10 +65,9 @@ def _paper_row(r: pd.Series) -> dict:
     return {
         "transition": r["label"], "judged": n,
         "inappropriate: ours": count(int(r["inappropriate"]), n),
-        "inappropriate: paper": count(int(r["paper_inappropriate"]),
-                                      int(r["paper_trials"])),
+        "inappropriate: paper": _paper_count(r, "inappropriate"),
         "no reset: ours": count(int(r["no_reset"]), n),
-        "no reset: paper": count(int(r["paper_no_reset"]), int(r["paper_trials"])),
+        "no reset: paper": _paper_count(r, "no_reset"),
         "no reset explained": num(100 * r["no_reset_explained_share"], "{:.0f} %"),
         "correct block": count(int(r["correct"]), n, ci=False),
         "reset delay median / p95 [s]":
@@ -54,6 +75,7 @@ def _paper_row(r: pd.Series) -> dict:
         "detection median / p95 [s]":
             f"{num(r['detection_median_s'])} / {num(r['detection_p95_s'])}",
         "false-alarm trials": int(r["false_alarm_trials"]),
+        "correct side": _side(r),
         "95 % CIs vs paper": _vs_paper(r),
     }
 
@@ -77,9 +99,13 @@ def paper_tables(summary: pd.DataFrame) -> list:
                   pd.DataFrame([_paper_row(r) for _, r in g.iterrows()])
                   .to_markdown(index=False), ""]
     lines += ["Counts are `k/n (rate %, 95 % Wilson CI)`, over judged trials only; the "
-              "paper's counts are from its Tables 2-3 (one set for both variants). "
-              "*95 % CIs vs paper* says where our interval lies wholly above or below "
-              "the paper's.", ""]
+              "paper's counts are from its Tables 2-3 (one set for both variants; its "
+              "faulty elevon is the left one, and it ran no right-elevon row). "
+              "*Correct side*: of the judged trials whose final mode is an elevon fault, "
+              "those whose belief at the end of the judging window holds the faulty "
+              "elevon more probable than the other (`correct_side_rate`; `-` in other "
+              "rows). *95 % CIs vs paper* says where our interval lies wholly above or "
+              "below the paper's.", ""]
     return lines
 
 
