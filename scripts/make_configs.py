@@ -96,6 +96,17 @@ def campaign_configs() -> dict:
              "nonlinear X8 in moderate turbulence (issue 13: extended filter with gust "
              "states, GLR over 5 s of changes at least 1 s long, 6 s settling after a reset), beside the paper's "
              "design (swapped), all eight transitions", omit=no_sensor)
+    cfg = Config.model_validate({
+        "campaign": {"transitions": list(TRANSITION_TABLE), "signature": "both",
+                     "designs": ["robust"]},
+        "plant": {"kind": "nonlinear", "dof": 6},
+        "designs": {"robust": ROBUST_MODERATE}})
+    files["sixdof_tables.yaml"] = render_yaml(
+        cfg, "ftc-mc run configs/sixdof_tables.yaml -- the paper's scheme on the 6-DOF "
+             "flying wing (issue 24): the twelve rows (left and right elevon, engine), the "
+             "paper's Table 1 (paper, swapped) and the robust design side by side, with the "
+             "lateral autopilot beside the paper's loop; add --turbulence moderate for "
+             "gusts", omit=no_sensor)
     files["paper_scenario.yaml"] = render_yaml(
         ScenarioConfig(), "ftc-mc scenario configs/paper_scenario.yaml -- the paper's 100 s "
                           "landing approach (Table 4) with the full reconfiguring loop")
