@@ -48,7 +48,8 @@ def cli():
               "the default preset].")
 @click.option("--save", type=click.Path(dir_okay=False, writable=True),
               help="Write the linear model (A, B, C, trim, limits, dt, gust matrices) to "
-              "this .npz file; it can be flown with --airframe FILE.npz.")
+              "this .npz or MATLAB .mat file; it can be flown with --airframe FILE "
+              "(with --dof 6: the 6-DOF model and its airframe, lateral data included).")
 @click.option("--export", type=click.Path(dir_okay=False, writable=True),
               help="Write the airframe's parameters to this YAML file (every field with "
               "its unit): edit it and fly it with --airframe FILE.yaml.")
@@ -73,20 +74,21 @@ def model(as_json, airframe, save, export, airspeed, gamma_deg, dt, dof):
     from .model.summary import format_summary, model_summary, save_npz
 
     spec = airframe or DEFAULT_AIRFRAME
-    if save is not None and not save.endswith(".npz"):
-        raise UserError(f"--save: file name must end in .npz, got {save!r}")
+    if save is not None and not save.endswith((".npz", ".mat")):
+        raise UserError(f"--save: file name must end in .npz or .mat, got {save!r}")
+    suffix = None if save is None else save[save.rindex("."):]
     if export is not None and not export.endswith((".yaml", ".yml")):
         raise UserError(f"--export: file name must end in .yaml, got {export!r}")
     if export is not None and is_linear_model(spec):
         raise UserError(f"--export: {spec} is a linear model, it has no airframe "
                         "parameters to export")
     if dof == "6":
-        return _model_sixdof(spec, as_json, save, export, airspeed, gamma_deg, dt)
+        return _model_sixdof(spec, as_json, save, export, airspeed, gamma_deg, dt, suffix)
     plant = load_plant(spec, airspeed, gamma_deg, dt)
     summary = model_summary(plant) if plant.airframe is not None else None
     if save is not None:
         with atomic_path(save) as tmp, open(tmp, "wb") as f:
-            save_npz(plant, f)
+            save_npz(plant, f, suffix)
     if export is not None:
         source = str(PRESETS[spec].source) if spec in PRESETS else str(spec)
         with atomic_path(export) as tmp:
@@ -102,7 +104,7 @@ def model(as_json, airframe, save, export, airspeed, gamma_deg, dt, dof):
             click.echo(f"wrote the {what} to {path}")
 
 
-def _model_sixdof(spec, as_json, save, export, airspeed, gamma_deg, dt):
+def _model_sixdof(spec, as_json, save, export, airspeed, gamma_deg, dt, suffix):
     """``ftc-mc model --dof 6``: the 6-DOF trim and named modes (its own import
     path, so a longitudinal ``model`` never loads the 6-DOF kernels)."""
     from .io.atomic import atomic_path
@@ -121,7 +123,7 @@ def _model_sixdof(spec, as_json, save, export, airspeed, gamma_deg, dt):
     source = str(PRESETS[spec].source) if spec in PRESETS else str(spec)
     if save is not None:
         with atomic_path(save) as tmp, open(tmp, "wb") as f:
-            save_sixdof_npz(plant, f, source)
+            save_sixdof_npz(plant, f, source, suffix)
     if export is not None:
         with atomic_path(export) as tmp:
             export_airframe(af, tmp, name=spec, source=source)

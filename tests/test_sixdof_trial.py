@@ -148,3 +148,28 @@ def test_sixdof_layout_maps_the_longitudinal_names():
     assert [LAYOUT.outputs[i] for i in lon_out] == [
         "Va" if n == "CAS" else n for n in LONGITUDINAL.outputs]
     assert [LAYOUT.outputs[i] for i in lat_out] == ["phi", "v", "p", "r", "psi"]
+
+
+@pytest.mark.parametrize("dof", ["3", "6"])
+def test_model_save_writes_matlab_files(tmp_path, dof):
+    """``ftc-mc model --save FILE.mat`` writes the same variables as the
+    ``.npz``, readable by scipy's MATLAB reader (and, longitudinal, flown back
+    by the package's own reader with equal arrays)."""
+    import scipy.io
+
+    npz, mat = tmp_path / "m.npz", tmp_path / "m.mat"
+    for path in (npz, mat):
+        res = CliRunner().invoke(cli, ["model", "--dof", dof, "--save", str(path)])
+        assert res.exit_code == 0, res.output
+    want = np.load(npz)
+    got = scipy.io.loadmat(mat)
+    for name in ("A", "B", "C", "Bw", "Dw", "x0", "u0", "y0"):
+        np.testing.assert_array_equal(np.squeeze(got[name]), np.squeeze(want[name]))
+    if dof == "6":
+        assert float(np.squeeze(got["airframe_Jxz"])) == float(want["airframe_Jxz"])
+    else:
+        from ftc_mc.model.airframe_files import load_linear_model
+
+        a, b = load_linear_model(mat), load_linear_model(npz)
+        np.testing.assert_array_equal(a.A, b.A)
+        np.testing.assert_array_equal(a.Dw, b.Dw)

@@ -588,8 +588,10 @@ these, ``airframe_<field>`` holds every field of the airframe
 meaning; the command ranges as two numbers), lateral-directional data included."""
 
 
-def save_sixdof_npz(plant: SixDofPlant, f, source: str = "") -> None:
-    """Write the 6-DOF linear model and its airframe to a ``.npz`` file.
+def save_sixdof_npz(plant: SixDofPlant, f, source: str = "", suffix: str = ".npz") -> None:
+    """Write the 6-DOF linear model and its airframe to a ``.npz`` file (or,
+    with ``suffix=".mat"``, a MATLAB ``.mat`` with the same variables; only the
+    ``.npz`` is read back by :func:`load_sixdof_model`).
 
     Variables: :data:`SIXDOF_MODEL_VARIABLES` and ``airframe_<field>`` for every
     airframe field (``docs/airframes.md``); :func:`load_sixdof_model` reads it
@@ -615,7 +617,9 @@ def save_sixdof_npz(plant: SixDofPlant, f, source: str = "") -> None:
     for field in dataclasses.fields(Airframe):
         data[f"airframe_{field.name}"] = np.array(getattr(plant.airframe, field.name),
                                                   dtype=np.float64)
-    np.savez(f, **data)
+    from .summary import save_model_file
+
+    save_model_file(data, f, suffix)
 
 
 def load_sixdof_model(path) -> tuple:

@@ -86,8 +86,9 @@ def format_summary(s: dict) -> str:
     return "\n".join(lines)
 
 
-def save_npz(plant: LinearPlant, f) -> None:
-    """Write everything a trial of the linear plant uses to a ``.npz`` file.
+def save_npz(plant: LinearPlant, f, suffix: str = ".npz") -> None:
+    """Write everything a trial of the linear plant uses to a ``.npz`` file (or,
+    with ``suffix=".mat"``, a MATLAB ``.mat`` with the same variables).
 
     :func:`ftc_mc.model.airframe_files.load_linear_model` reads it back to a
     :class:`LinearPlant` whose arrays equal these to the bit.  Variables (all
@@ -127,7 +128,32 @@ def save_npz(plant: LinearPlant, f) -> None:
 
     Bw, Dw = plant_wind_matrices(plant)
     tp = plant.trim
-    np.savez(f, A=plant.A, B=plant.B, C=plant.C, u0=plant.u0, u_lower=plant.u_lower,
-             u_upper=plant.u_upper, dt=np.float64(plant.dt), x0=tp.x0, y0=tp.y0,
-             alpha=np.float64(tp.alpha), V0=np.float64(tp.V0),
-             gamma0=np.float64(tp.gamma0), Bw=Bw, Dw=Dw)
+    save_model_file(model_variables(plant, Bw, Dw), f, suffix)
+
+
+def model_variables(plant: LinearPlant, Bw, Dw) -> dict:
+    """The variables of :func:`save_npz` (its table), by name."""
+    tp = plant.trim
+    return dict(A=plant.A, B=plant.B, C=plant.C, u0=plant.u0, u_lower=plant.u_lower,
+                u_upper=plant.u_upper, dt=np.float64(plant.dt), x0=tp.x0, y0=tp.y0,
+                alpha=np.float64(tp.alpha), V0=np.float64(tp.V0),
+                gamma0=np.float64(tp.gamma0), Bw=Bw, Dw=Dw)
+
+
+def save_model_file(variables: dict, f, suffix: str) -> None:
+    """Write a linear model's ``variables`` as ``.npz`` or as a MATLAB ``.mat``
+    (level 5, the variables under the same names; MATLAB and
+    :func:`ftc_mc.model.airframe_files.load_linear_model` read it).
+
+    Parameters
+    ----------
+    variables : dict of str to array_like
+    f : binary file
+    suffix : {".npz", ".mat"}
+    """
+    if suffix == ".mat":
+        import scipy.io
+
+        scipy.io.savemat(f, variables, format="5", oned_as="column")
+    else:
+        np.savez(f, **variables)
