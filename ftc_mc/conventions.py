@@ -83,6 +83,42 @@ ELEVON_BLOCK = (PARAM_NAMES.index("b0_elevons"), PARAM_NAMES.index("b1_left"),
 VARIANTS = ("paper", "swapped")
 """Table 1 as printed, and with its third clause's r_nz comparison swapped."""
 
+THRESHOLDED = ("r_q", "r_nx")
+"""Table 1's thresholded residual channels (``t_q``, ``t_nx``); the others
+(``r_nz``) are only compared with another channel."""
+
+NO_COMPARE = -1
+"""``cmp_a`` of a decision-table row that compares no channels."""
+
+
+def _table1(variant: str) -> tuple:
+    """Table 1 as a decision table (module docstring of
+    ``core/longitudinal/signature.py``): one row per hit pattern of the residual
+    channels (bit ``i`` set when channel ``i`` of :data:`RESIDUAL_NAMES` reaches its
+    threshold), each ``(block_if, block_else, cmp_a, cmp_b)``: ``block_if``
+    when ``cmp_a`` is :data:`NO_COMPARE` or ``r[cmp_a] >= r[cmp_b]``, else
+    ``block_else``."""
+    q, nx, nz = (RESIDUAL_NAMES.index(n) for n in ("r_q", "r_nx", "r_nz"))
+    both = ((RESET_THRUST, RESET_ELEVONS) if variant == "paper"
+            else (RESET_ELEVONS, RESET_THRUST))  # swapped: the r_nz test reversed
+    rows = []
+    for pattern in range(1 << len(RESIDUAL_NAMES)):
+        q_hit, nx_hit = bool(pattern >> q & 1), bool(pattern >> nx & 1)
+        if q_hit and nx_hit:
+            rows.append((*both, nz, nx))
+        elif q_hit:
+            rows.append((RESET_ELEVONS, RESET_ELEVONS, NO_COMPARE, NO_COMPARE))
+        elif nx_hit:
+            rows.append((RESET_THRUST, RESET_THRUST, NO_COMPARE, NO_COMPARE))
+        else:  # r_nz alone is never a hit of Table 1
+            rows.append((NO_RESET, NO_RESET, NO_COMPARE, NO_COMPARE))
+    return tuple(rows)
+
+
+TABLE1 = {v: _table1(v) for v in VARIANTS}
+"""Table 1's decision table of each variant (:func:`_table1`), the data the
+kernel reads (``Detection.table``)."""
+
 TEST_ONE_STEP, TEST_GLR = 0, 1
 """Residual tests of a design (``Detection.test``): the paper's one-step test of
 the normalised residuals (eqs. 9-11), or the GLR of a persistent change of their
@@ -180,6 +216,10 @@ class Layout:
     b0_index, b1_index : tuple of int
         Per actuator, the index of its lock offset and effectiveness in the
         augmented estimate ``[x, b]``.
+    thresholded : tuple of str
+        Table 1's residual channels that have a threshold.
+    decisions : tuple of (str, tuple)
+        Per Table 1 variant, its decision table (:data:`TABLE1`).
     """
 
     name: str
@@ -195,6 +235,8 @@ class Layout:
     actuator_block: tuple
     b0_index: tuple
     b1_index: tuple
+    thresholded: tuple = ()
+    decisions: tuple = ()
 
     @property
     def n_x(self) -> int:
@@ -237,6 +279,7 @@ LONGITUDINAL = Layout(
     block_params=((), THRUST_BLOCK, ELEVON_BLOCK),
     actuator_block=(RESET_THRUST, RESET_ELEVONS, RESET_ELEVONS),
     b0_index=(I_B0_THRUST, I_B0_ELEVONS, I_B0_ELEVONS),
-    b1_index=(I_B1_THRUST, I_B1_LEFT, I_B1_RIGHT))
+    b1_index=(I_B1_THRUST, I_B1_LEFT, I_B1_RIGHT), thresholded=THRESHOLDED,
+    decisions=tuple(TABLE1.items()))
 """The longitudinal family: the paper's plant, filter and Table 1 (the elevons'
 lock offsets enter as their sum, ``b0_elevons``)."""

@@ -383,7 +383,7 @@ def filter_step(xa, P, u, z, fm, det, phi, T, h, res, x_prev, P_prev):
             P_prev[i, j] = P[i, j]
     predict(xa, P, u, fm, phi, T)
     residuals(xa, P, z, fm, res)
-    block = signature(res[0], res[1], res[2], det.t_q, det.t_nx, det.swapped)
+    block = signature(res.reshape(-1, 1), 0, det.thresholds, det.table)
     if block != NO_RESET:
         reset_covariance(P_prev, block, det.reset_var)
         for i in range(n):

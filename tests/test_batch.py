@@ -17,7 +17,8 @@ import pytest
 from lane_workspace import LaneWorkspace, new_lane_workspace
 from ftc_mc.core.longitudinal import batch as kb
 import single_trajectory as kk
-from ftc_mc.core.longitudinal import signature as ks
+import naive
+from ftc_mc.conventions import TABLE1
 from single_trajectory import Workspace, filter_step
 from ftc_mc.sim.estimator import (EstimatorSettings, detection, filter_model,
                                   initial_covariance, unit_rows)
@@ -185,10 +186,14 @@ def test_signature_lanes(plant, swapped):
     res = np.ascontiguousarray(np.stack([rq.ravel(), rnx.ravel(), rnz.ravel()]))
     block = np.full(res.shape[1], -7, dtype=np.int64)
     kb.signature_lanes(res, det, block)
-    expect = [ks.signature(res[0, l], res[1, l], res[2, l], det.t_q, det.t_nx, swapped)
-              for l in range(res.shape[1])]
+    # Table 1 written clause by clause (tests/naive.py), not the decision table
+    variant = "swapped" if swapped else "paper"
+    expect = [naive.signature_ref(res[0, l], res[1, l], res[2, l], det.t_q, det.t_nx,
+                                  variant) for l in range(res.shape[1])]
     assert np.array_equal(block, expect)
     assert set(np.unique(block)) == {0, 1, 2}
+    # the decision table is the family's data: the variant's rows, nothing else
+    assert np.array_equal(det.table, np.array(TABLE1[variant])) and det.swapped == swapped
 
 
 def test_reset_lanes(plant):

@@ -37,6 +37,16 @@ thresholds = st.floats(min_value=0.5, max_value=100.0, allow_nan=False)
 
 
 # ------------------------------------------------------------------ helpers
+def table1(r_q, r_nx, r_nz, t_q, t_nx, swapped):
+    """The kernel's Table 1 (a decision table, ``conventions.TABLE1``) on one
+    lane: the paper's variant (``swapped`` 0) or the swapped one (1)."""
+    from ftc_mc.conventions import VARIANTS
+    from ftc_mc.core.longitudinal.settings import decision_table, thresholds_of
+
+    res = np.array([[r_q], [r_nx], [r_nz]], dtype=float)
+    return ks.signature(res, 0, thresholds_of(t_q, t_nx), decision_table(VARIANTS[swapped]))
+
+
 @pytest.fixture(scope="module")
 def plant():
     return build_plant()
@@ -265,7 +275,7 @@ def test_signature_grid(t_q, t_nx):
                 nz_values = _grid(t_nx) + _grid(t_q) + [r_nx, np.nextafter(r_nx, 0.0),
                                                         np.nextafter(r_nx, np.inf)]
                 for r_nz in nz_values:
-                    got = ks.signature(r_q, r_nx, r_nz, t_q, t_nx, swapped)
+                    got = table1(r_q, r_nx, r_nz, t_q, t_nx, swapped)
                     want = naive.signature_ref(r_q, r_nx, r_nz, t_q, t_nx, variant)
                     assert got == want, (variant, r_q, r_nx, r_nz, got, want)
                     n += 1
@@ -284,15 +294,15 @@ def test_signature_table_cases():
         (400.0, 26.0, 900.0, (1, 2)),     # elevon-lock-like pattern
     ]
     for r_q, r_nx, r_nz, (p, s) in cases:
-        assert ks.signature(r_q, r_nx, r_nz, t, t, 0) == p
-        assert ks.signature(r_q, r_nx, r_nz, t, t, 1) == s
+        assert table1(r_q, r_nx, r_nz, t, t, 0) == p
+        assert table1(r_q, r_nx, r_nz, t, t, 1) == s
 
 
 @settings(max_examples=300, deadline=None)
 @given(r_q=st.floats(0.0, 200.0), r_nx=st.floats(0.0, 200.0), r_nz=st.floats(0.0, 200.0),
        t_q=thresholds, t_nx=thresholds, swapped=st.booleans())
 def test_signature_random(r_q, r_nx, r_nz, t_q, t_nx, swapped):
-    got = ks.signature(r_q, r_nx, r_nz, t_q, t_nx, int(swapped))
+    got = table1(r_q, r_nx, r_nz, t_q, t_nx, int(swapped))
     assert got == naive.signature_ref(r_q, r_nx, r_nz, t_q, t_nx,
                                       "swapped" if swapped else "paper")
 

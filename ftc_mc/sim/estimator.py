@@ -20,7 +20,8 @@ import numpy as np
 
 from ..config.schema import EstimatorConfig
 from ..conventions import LONGITUDINAL, N_AUG, TEST_ONE_STEP, VARIANTS
-from ..core.longitudinal.settings import Belief, Detection, FilterModel
+from ..core.longitudinal.settings import (Belief, Detection, FilterModel, decision_table,
+                                          thresholds_of)
 from ..model.faults import bias_matrix, fault_bounds
 from ..model.linear import LinearPlant
 
@@ -147,8 +148,8 @@ def detection(plant: LinearPlant, s: EstimatorSettings) -> Detection:
     rng = plant.u_upper - plant.u_lower
     reset_var = np.array([(rng[0] / s.t_nx) ** 2, (rng[1] / s.t_q) ** 2,
                           1.0 / s.t_nx ** 2, 1.0 / s.t_q ** 2, 1.0 / s.t_q ** 2])
-    return Detection(t_q=float(s.t_q), t_nx=float(s.t_nx),
-                     swapped=1 if s.signature == "swapped" else 0, reset_var=reset_var,
+    return Detection(thresholds=thresholds_of(s.t_q, s.t_nx),
+                     table=decision_table(s.signature), reset_var=reset_var,
                      test=TEST_ONE_STEP, window=1, min_window=1, settle=0, startup=0)
 
 

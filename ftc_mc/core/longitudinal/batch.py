@@ -366,25 +366,22 @@ def innovations_lanes(xa, P, z, fm, innov):
 # ------------------------------------------------------------------ signature
 @kernel(inline="always")
 def signature_lanes(res, det, block):
-    """Table 1 on every lane, as :func:`ftc_mc.core.longitudinal.signature.signature`.
+    """Table 1 on every lane (:func:`ftc_mc.core.longitudinal.signature.signature`).
 
     Parameters
     ----------
     res : ndarray, shape (3, L)
         ``[r_q, r_nx, r_nz]`` of each lane (eqs. 9-11).
     det : Detection
-        Thresholds ``t_q``, ``t_nx`` and the variant (``swapped`` 0: Table 1 as
-        printed; 1: third clause's ``r_nz`` comparison swapped).
+        Table 1 as data: ``thresholds`` (3,) and the decision ``table`` (8, 4).
     block : ndarray of int64, shape (L,)
         Written with ``NO_RESET`` (0), ``RESET_THRUST`` (1) or
         ``RESET_ELEVONS`` (2) per lane.
     """
-    L = res.shape[1]
-    t_q = det.t_q
-    t_nx = det.t_nx
-    swapped = det.swapped
-    for l in range(L):
-        block[l] = signature(res[0, l], res[1, l], res[2, l], t_q, t_nx, swapped)
+    thresholds = det.thresholds
+    table = det.table
+    for l in range(res.shape[1]):
+        block[l] = signature(res, l, thresholds, table)
 
 
 @kernel

@@ -8,6 +8,10 @@ from __future__ import annotations
 
 from collections import namedtuple
 
+import numpy as np
+
+from ...conventions import RESIDUAL_NAMES, TABLE1, VARIANTS
+
 FilterModel = namedtuple("FilterModel", [
     "A",        # (9, 9)  discrete state matrix (eq. 1)
     "B",        # (9, 3)  discrete input matrix (eq. 1)
@@ -50,10 +54,11 @@ carries the ``ng = 4`` Dryden states of the longitudinal gusts
 (:mod:`ftc_mc.core.longitudinal.gustfilter`, issue 13); a sensor-aware design appends output
 biases after them (``Dz``, ``reset_g``; issue 14)."""
 
-Detection = namedtuple("Detection", [
-    "t_q",        # threshold on r_q (Table 1), > 0
-    "t_nx",       # threshold on r_nx (Table 1), > 0
-    "swapped",    # 0: Table 1 as printed; 1: third clause's r_nz test swapped
+_DetectionFields = namedtuple("Detection", [
+    "thresholds",  # (3,) threshold of each residual channel r_q, r_nx, r_nz (Table 1;
+                   #      inf: a channel that is only compared, r_nz)
+    "table",      # (8, 4) int64 Table 1's decision table: per hit pattern of the
+                  #      channels, (block_if, block_else, cmp_a, cmp_b) (conventions.TABLE1)
     "reset_var",  # (5,) variance of each fault parameter after its block's reset
     "test",       # conventions.TEST_ONE_STEP (eqs. 9-11) or TEST_GLR (core/shared/glr.py)
     "window",     # GLR window [steps] (1 with the one-step test)
@@ -62,7 +67,58 @@ Detection = namedtuple("Detection", [
     "startup",    # steps from the start before the test is armed: no reset, GLR window
                   # kept empty (0: armed at once; DesignConfig.startup_s, issue 25)
 ])
-"""Residual signature and covariance reset (paper section 3.2.2, Table 1)."""
+
+
+class Detection(_DetectionFields):
+    """Residual signature and covariance reset (paper section 3.2.2, Table 1).
+
+    Table 1 is data (``thresholds``, ``table``: ``conventions.TABLE1``); the
+    paper's names of its thresholds and variant are read-only views for the
+    code outside the kernels, and :meth:`_replace` also takes them.
+    """
+
+    __slots__ = ()
+
+    @property
+    def t_q(self) -> float:
+        """Threshold on ``r_q``."""
+        return float(self.thresholds[RESIDUAL_NAMES.index("r_q")])
+
+    @property
+    def t_nx(self) -> float:
+        """Threshold on ``r_nx``."""
+        return float(self.thresholds[RESIDUAL_NAMES.index("r_nx")])
+
+    @property
+    def swapped(self) -> int:
+        """1 when the table is the swapped variant's, 0 for Table 1 as printed."""
+        return int(np.array_equal(self.table, decision_table("swapped")))
+
+    def _replace(self, **kw):
+        """``namedtuple._replace``, also taking ``t_q``, ``t_nx`` and ``swapped``."""
+        if {"t_q", "t_nx"} & kw.keys():
+            thr = np.array(self.thresholds, dtype=float, copy=True)
+            for name in ("t_q", "t_nx"):
+                if name in kw:
+                    thr[RESIDUAL_NAMES.index("r_" + name[2:])] = float(kw.pop(name))
+            kw["thresholds"] = thr
+        if "swapped" in kw:
+            kw["table"] = decision_table(VARIANTS[int(bool(kw.pop("swapped")))])
+        return super()._replace(**kw)
+
+
+def thresholds_of(t_q: float, t_nx: float) -> np.ndarray:
+    """Table 1's thresholds vector (one per residual channel; ``inf`` on a
+    channel that has none)."""
+    thr = np.full(len(RESIDUAL_NAMES), np.inf)
+    thr[RESIDUAL_NAMES.index("r_q")] = float(t_q)
+    thr[RESIDUAL_NAMES.index("r_nx")] = float(t_nx)
+    return thr
+
+
+def decision_table(variant: str) -> np.ndarray:
+    """Table 1's decision table of ``variant`` as the kernels' array (8, 4)."""
+    return np.array(TABLE1[variant], dtype=np.int64)
 
 Belief = namedtuple("Belief", [
     "TM",  # (4, 4) column-stochastic mode transition matrix (eq. 13)

@@ -1,13 +1,19 @@
 """Residual signature (paper Table 1) and covariance reset (section 3.2.2).
 
-Table 1 as printed (``swapped = 0``)::
+Table 1 as printed (variant ``paper``)::
 
     thrust  : (r_nx >= t_nx and r_q <  t_q) or (r_nx >= t_nx and r_q >= t_q and r_nz >= r_nx)
     elevons : (r_nx <  t_nx and r_q >= t_q) or (r_nx >= t_nx and r_q >= t_q and r_nz <  r_nx)
 
-``swapped = 1`` exchanges the ``r_nz`` comparison of the third clause (an
+Variant ``swapped`` exchanges the ``r_nz`` comparison of the third clause (an
 elevon fault drives ``r_q`` and ``r_nz`` far above ``r_nx``, which the printed
 rule sends to the thrust block; see ``docs/paper-map.md``).
+
+The kernel reads Table 1 as data the family supplies (``conventions.TABLE1``,
+``Detection.thresholds`` and ``.table``): a threshold per residual channel and
+a decision table over the channels' hit patterns, whose rows may compare two
+channels (the third clause).  Another plant family (the 6-DOF one, with a roll
+channel and a block per elevon) brings its own channels, thresholds and table.
 """
 
 from __future__ import annotations
@@ -36,34 +42,34 @@ def in_block(j, block):
 
 
 @kernel
-def signature(r_q, r_nx, r_nz, t_q, t_nx, swapped):
-    """Which covariance block Table 1 resets.
+def signature(res, l, thresholds, table):
+    """Which covariance block Table 1 resets, from its decision table.
 
     Parameters
     ----------
-    r_q, r_nx, r_nz : float
-        Normalised residuals (eqs. 9-11).
-    t_q, t_nx : float
-        Thresholds (paper: 25).
-    swapped : int
-        0 for Table 1 as printed, 1 for the swapped third clause.
+    res : ndarray, shape (3, L)
+        Normalised residuals ``[r_q, r_nx, r_nz]`` of every lane (eqs. 9-11).
+    l : int
+        The lane.
+    thresholds : ndarray, shape (3,)
+        Threshold of each channel (paper: 25, 25; ``inf`` for ``r_nz``, which
+        is only compared).
+    table : ndarray of int64, shape (8, 4)
+        Per hit pattern (bit ``i``: channel ``i`` reached its threshold), the
+        row ``(block_if, block_else, cmp_a, cmp_b)``: ``block_if`` when
+        ``cmp_a < 0`` or ``r[cmp_a] >= r[cmp_b]``, else ``block_else``
+        (``conventions.TABLE1``: the module docstring's rules, per variant).
 
     Returns
     -------
     int
         ``NO_RESET``, ``RESET_THRUST`` or ``RESET_ELEVONS``.
     """
-    nx_hit = r_nx >= t_nx
-    q_hit = r_q >= t_q
-    if nx_hit and not q_hit:
-        return RESET_THRUST
-    if q_hit and not nx_hit:
-        return RESET_ELEVONS
-    if nx_hit and q_hit:
-        nz_big = r_nz >= r_nx
-        if swapped != 0:
-            nz_big = not nz_big
-        return RESET_THRUST if nz_big else RESET_ELEVONS
-    return NO_RESET
-
-
+    pattern = 0
+    for i in range(thresholds.shape[0]):
+        if res[i, l] >= thresholds[i]:
+            pattern |= 1 << i
+    a = table[pattern, 2]
+    if a < 0 or res[a, l] >= res[table[pattern, 3], l]:
+        return table[pattern, 0]
+    return table[pattern, 1]
