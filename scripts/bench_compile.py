@@ -39,6 +39,7 @@ PATHS = {
                   {"plant": {"kind": "nonlinear", "turbulence": "moderate"}}),
     "dense_glr": ("designs.yaml", "gust_glr", {}),
     "robust": ("robust_moderate.yaml", "robust", {}),
+    "sixdof": ("sixdof_tables.yaml", "paper", {}),  # issue 24: the 6-DOF plant's path
 }
 
 CHILD = r"""
