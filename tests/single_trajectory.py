@@ -63,7 +63,7 @@ from ftc_mc.conventions import N_FAULT as N_F
 from ftc_mc.core.jit import kernel
 from ftc_mc.core.longitudinal.control import controller_command
 from ftc_mc.core.longitudinal.signature import (NO_RESET, RESET_ELEVONS, RESET_THRUST,
-                                                in_block, signature)
+                                                in_block, signature_lanes)
 from ftc_mc.core.shared.belief import belief_update
 from ftc_mc.core.shared.excitation import saturate
 
@@ -383,7 +383,9 @@ def filter_step(xa, P, u, z, fm, det, phi, T, h, res, x_prev, P_prev):
             P_prev[i, j] = P[i, j]
     predict(xa, P, u, fm, phi, T)
     residuals(xa, P, z, fm, res)
-    block = signature(res.reshape(-1, 1), 0, det.thresholds, det.table)
+    one = np.zeros(1, dtype=np.int64)
+    signature_lanes(np.ascontiguousarray(res.reshape(-1, 1)), det, one)
+    block = one[0]
     if block != NO_RESET:
         reset_covariance(P_prev, block, det.reset_var)
         for i in range(n):

@@ -19,6 +19,7 @@ from ftc_mc.core.longitudinal import batch as kb
 import single_trajectory as kk
 import naive
 from ftc_mc.conventions import TABLE1
+from ftc_mc.core.longitudinal import signature as ks
 from single_trajectory import Workspace, filter_step
 from ftc_mc.sim.estimator import (EstimatorSettings, detection, filter_model,
                                   initial_covariance, unit_rows)
@@ -185,7 +186,7 @@ def test_signature_lanes(plant, swapped):
     rq, rnx, rnz = np.meshgrid(grid, grid, grid, indexing="ij")
     res = np.ascontiguousarray(np.stack([rq.ravel(), rnx.ravel(), rnz.ravel()]))
     block = np.full(res.shape[1], -7, dtype=np.int64)
-    kb.signature_lanes(res, det, block)
+    ks.signature_lanes(res, det, block)
     # Table 1 written clause by clause (tests/naive.py), not the decision table
     variant = "swapped" if swapped else "paper"
     expect = [naive.signature_ref(res[0, l], res[1, l], res[2, l], det.t_q, det.t_nx,

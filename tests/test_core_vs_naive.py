@@ -43,8 +43,14 @@ def table1(r_q, r_nx, r_nz, t_q, t_nx, swapped):
     from ftc_mc.conventions import VARIANTS
     from ftc_mc.core.longitudinal.settings import decision_table, thresholds_of
 
+    from ftc_mc.core.longitudinal.settings import Detection
+
     res = np.array([[r_q], [r_nx], [r_nz]], dtype=float)
-    return ks.signature(res, 0, thresholds_of(t_q, t_nx), decision_table(VARIANTS[swapped]))
+    det = Detection(thresholds=thresholds_of(t_q, t_nx), table=decision_table(VARIANTS[swapped]),
+                    reset_var=np.ones(5), test=0, window=1, min_window=1, settle=0, startup=0)
+    block = np.zeros(1, dtype=np.int64)
+    ks.signature_lanes(res, det, block)
+    return block[0]
 
 
 @pytest.fixture(scope="module")

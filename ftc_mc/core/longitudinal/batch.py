@@ -47,7 +47,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..jit import kernel
-from .signature import NO_RESET, in_block, signature
+from .signature import NO_RESET, in_block, signature_lanes
 
 from ...conventions import N_AUG, N_B0, N_B1, N_U, N_X, RESIDUAL_OUTPUTS
 from ...conventions import N_FAULT as N_F
@@ -364,26 +364,6 @@ def innovations_lanes(xa, P, z, fm, innov):
 
 
 # ------------------------------------------------------------------ signature
-@kernel(inline="always")
-def signature_lanes(res, det, block):
-    """Table 1 on every lane (:func:`ftc_mc.core.longitudinal.signature.signature`).
-
-    Parameters
-    ----------
-    res : ndarray, shape (3, L)
-        ``[r_q, r_nx, r_nz]`` of each lane (eqs. 9-11).
-    det : Detection
-        Table 1 as data: ``thresholds`` (3,) and the decision ``table`` (8, 4).
-    block : ndarray of int64, shape (L,)
-        Written with ``NO_RESET`` (0), ``RESET_THRUST`` (1) or
-        ``RESET_ELEVONS`` (2) per lane.
-    """
-    thresholds = det.thresholds
-    table = det.table
-    for l in range(res.shape[1]):
-        block[l] = signature(res, l, thresholds, table)
-
-
 @kernel
 def reset_lanes(P, block, reset_var):
     """Reset the suspected fault block of each lane (section 3.2.2).

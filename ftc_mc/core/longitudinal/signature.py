@@ -41,35 +41,46 @@ def in_block(j, block):
     return False
 
 
-@kernel
-def signature(res, l, thresholds, table):
-    """Which covariance block Table 1 resets, from its decision table.
+@kernel(inline="always")
+def signature_lanes(res, det, block):
+    """Which covariance block Table 1 resets, on every lane, from its data.
+
+    Each lane's hit pattern (bit ``i`` set when channel ``i`` reached its
+    threshold), computed a channel at a time so the loops vectorise over the
+    lanes; then its row ``(block_if, block_else, cmp_a, cmp_b)`` of the
+    decision table: ``block_if`` when ``cmp_a < 0`` or ``r[cmp_a] >=
+    r[cmp_b]``, else ``block_else`` (``conventions.TABLE1``: the module
+    docstring's rules, per variant).  The decision is written out here, not
+    called per lane: a call that passes arrays costs two reference-count
+    updates per lane, which made this stage 150 times slower
+    (``docs/performance.md``, lesson 12).
 
     Parameters
     ----------
     res : ndarray, shape (3, L)
         Normalised residuals ``[r_q, r_nx, r_nz]`` of every lane (eqs. 9-11).
-    l : int
-        The lane.
-    thresholds : ndarray, shape (3,)
-        Threshold of each channel (paper: 25, 25; ``inf`` for ``r_nz``, which
-        is only compared).
-    table : ndarray of int64, shape (8, 4)
-        Per hit pattern (bit ``i``: channel ``i`` reached its threshold), the
-        row ``(block_if, block_else, cmp_a, cmp_b)``: ``block_if`` when
-        ``cmp_a < 0`` or ``r[cmp_a] >= r[cmp_b]``, else ``block_else``
-        (``conventions.TABLE1``: the module docstring's rules, per variant).
-
-    Returns
-    -------
-    int
-        ``NO_RESET``, ``RESET_THRUST`` or ``RESET_ELEVONS``.
+    det : Detection
+        ``thresholds`` (3,): each channel's (paper: 25, 25; ``inf`` for
+        ``r_nz``, which is only compared); ``table`` (8, 4) int64: the
+        variant's decision table.
+    block : ndarray of int64, shape (L,)
+        Written with ``NO_RESET``, ``RESET_THRUST`` or ``RESET_ELEVONS``.
     """
-    pattern = 0
+    thresholds = det.thresholds
+    table = det.table
+    L = res.shape[1]
+    for l in range(L):
+        block[l] = 0
     for i in range(thresholds.shape[0]):
-        if res[i, l] >= thresholds[i]:
-            pattern |= 1 << i
-    a = table[pattern, 2]
-    if a < 0 or res[a, l] >= res[table[pattern, 3], l]:
-        return table[pattern, 0]
-    return table[pattern, 1]
+        t = thresholds[i]
+        bit = 1 << i
+        for l in range(L):
+            if res[i, l] >= t:
+                block[l] |= bit
+    for l in range(L):
+        p = block[l]
+        a = table[p, 2]
+        if a < 0 or res[a, l] >= res[table[p, 3], l]:
+            block[l] = table[p, 0]
+        else:
+            block[l] = table[p, 1]

@@ -37,7 +37,8 @@ import numpy as np
 from ...conventions import (C_ELEVON, I_B1_LEFT, I_B1_THRUST, N_AUG, N_FAULT, N_MODES, N_U, N_X,
                             NO_RESET, RESET_THRUST, STATUS_AIRSPEED, STATUS_ALPHA, STATUS_BANK,
                             STATUS_NONFINITE, STATUS_NOT_PSD, STATUS_OK)
-from .batch import (filter_correct_lanes, filter_predict_lanes, innovations_lanes, signature_lanes)
+from .batch import filter_correct_lanes, filter_predict_lanes, innovations_lanes
+from .signature import signature_lanes
 from ..shared.glr import glr_lanes, glr_restart
 from .gustfilter import gust_correct_lanes, gust_predict_lanes
 from ..shared.belief import belief_update
