@@ -282,7 +282,8 @@ def _finished(out_dir: Path, kind: str, files, identity: dict) -> bool:
 # -- the commands -----------------------------------------------------------------
 
 def run_campaign(config, *, trials=None, seed=None, signature=None, controller=None,
-                 plant=None, turbulence=None, dof=None, airframe=None, design=None, reset_log=None,
+                 plant=None, turbulence=None, dof=None, airframe=None, design=None,
+                 reset_log=None,
                  jobs: int = 1,
                  progress: bool = True,
                  backend: str = "threads", scheduler: str | None = None, out=None,
@@ -457,7 +458,8 @@ def run_sweep(config, thresholds=None, *, tq=None, tnx=None, transitions=None,
 
 
 def run_endurance(config, hours, *, flight_s: float | None = None, seed=None,
-                  signature=None, plant=None, turbulence=None, dof=None, airframe=None, design=None,
+                  signature=None, plant=None, turbulence=None, dof=None, airframe=None,
+                  design=None,
                   jobs: int = 1, progress: bool = True, backend: str = "threads",
                   scheduler: str | None = None, out=None, overwrite: bool = False,
                   resume: bool = False, command: str | None = None):
@@ -527,7 +529,8 @@ def run_endurance(config, hours, *, flight_s: float | None = None, seed=None,
 
 
 def run_scenario(config, *, seed: int | None = None, plant=None, turbulence=None, dof=None,
-                 airframe=None, design=None, out=None, overwrite: bool = False, command: str | None = None):
+                 airframe=None, design=None, out=None, overwrite: bool = False,
+                 command: str | None = None):
     """Fly one closed-loop scenario: the paper's Table 4 by default (``ftc-mc scenario``).
 
     Parameters

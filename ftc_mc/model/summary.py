@@ -127,7 +127,6 @@ def save_npz(plant: LinearPlant, f, suffix: str = ".npz") -> None:
     from .wind import plant_wind_matrices  # compiles the Numba dynamics: only here
 
     Bw, Dw = plant_wind_matrices(plant)
-    tp = plant.trim
     save_model_file(model_variables(plant, Bw, Dw), f, suffix)
 
 

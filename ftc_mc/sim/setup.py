@@ -199,7 +199,8 @@ def build_setup(cfg: Config | ScenarioConfig) -> SimSetup:
                      s3211_unit=cfg.steps(x.s3211_unit_s),
                      resend_delay=cfg.steps(x.resend_delay_s),
                      resend_b1=float(x.resend_b1_threshold))
-    val = Validity(va_trim=float(plant.trim.y0[LONGITUDINAL.output("Va")]), va_min=vc.airspeed_min_mps,
+    val = Validity(va_trim=float(plant.trim.y0[LONGITUDINAL.output("Va")]),
+                   va_min=vc.airspeed_min_mps,
                    va_max=vc.airspeed_max_mps, alpha_trim=plant.trim.alpha,
                    alpha_min=math.radians(vc.alpha_min_deg),
                    alpha_max=math.radians(vc.alpha_max_deg),
