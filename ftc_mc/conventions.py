@@ -125,6 +125,26 @@ the normalised residuals (eqs. 9-11), or the GLR of a persistent change of their
 mean over a sliding window (``ftc_mc/core/shared/glr.py``)."""
 TEST_NAMES = ("one_step", "glr")
 
+S3211_UNITS = (3, 2, 1, 1)
+"""Durations of the elevon 3211's alternating steps, in units (the paper's Fig. 4)."""
+
+EXCITATION_POLICIES = ("none", "periodic", "ambiguous")
+"""When a design sends excitation beyond the paper's requests on resets
+(``Excitation.policy``, issue 25): ``none`` only those (the paper); ``periodic``
+the doublet and the 3211 every period, staggered by half a period; ``ambiguous``
+one of them when the belief is unsure or a residual is high."""
+EXCITE_NONE, EXCITE_PERIODIC, EXCITE_AMBIGUOUS = range(len(EXCITATION_POLICIES))
+
+COST_NAMES = ("track_sq", "track_max") + tuple(f"u2_{n}" for n in INPUT_NAMES)
+"""Rows of ``TrialRecord.cost``, summed over the steps a trial flew (issue 25):
+the squared glide-path cross-track error [m^2], its largest magnitude [m], then
+each command's squared deviation from trim [throttle^2, rad^2]."""
+N_COST = len(COST_NAMES)
+COST_TRACK_SQ = COST_NAMES.index("track_sq")
+COST_TRACK_MAX = COST_NAMES.index("track_max")
+COST_U2 = COST_NAMES.index(f"u2_{INPUT_NAMES[0]}")
+"""First of the ``N_U`` command rows, in command order."""
+
 N_GUST_EST = 4
 """Gust states in a gust-aware filter (the Dryden shaping filter, ``core/shared/dryden.py``),
 appended after the fault parameters: ``[x (9), b (5), g (4)]``."""

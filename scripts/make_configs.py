@@ -38,6 +38,20 @@ filter and Table 1 (swapped) with the biases of the residuals' sensors; chosen
 from runs of the bias random walk and the settling time (docs/designs.md)."""
 
 
+EXCITATION_ROWS = ("elevon_loss", "engine_loss", "elevon_lock", "right_elevon_loss")
+"""The rows of ``configs/excitation.yaml`` (issue 25): the partial losses, and a lock."""
+
+
+def excitation_designs() -> dict:
+    """The periodic designs of ``configs/excitation.yaml``: ``per<P>_<phase>``, the
+    paper's filter and Table 1 (swapped) with the doublet every P s from ``phase``
+    s and the 3211 half a period later, P = 5 and 10 s at five phases each (the
+    faults come at 20 s: the phases spread the signals over the time after it)."""
+    return {f"per{P}_{ph}": {"signature": "swapped", "excitation_policy": "periodic",
+                             "excitation_period_s": float(P), "excitation_phase_s": float(ph)}
+            for P, phases in ((5, (0, 1, 2, 3, 4)), (10, (0, 2, 4, 6, 8))) for ph in phases}
+
+
 def campaign_configs() -> dict:
     """File name -> YAML text of every shipped campaign config."""
     files = {}
@@ -107,6 +121,17 @@ def campaign_configs() -> dict:
              "paper's Table 1 (paper, swapped) and the robust design side by side, with the "
              "lateral autopilot beside the paper's loop; add --turbulence moderate for "
              "gusts", omit=no_sensor)
+    designs = excitation_designs()
+    cfg = Config.model_validate({
+        "campaign": {"transitions": list(EXCITATION_ROWS), "signature": "swapped",
+                     "designs": list(designs)},
+        "designs": designs})
+    files["excitation.yaml"] = render_yaml(
+        cfg, "ftc-mc run configs/excitation.yaml -- excitation policies (issue 25): the "
+             "paper's design (swapped) beside the same design sending the doublet and the "
+             "3211 periodically (every 5 s and 10 s, five phases each), on the partial "
+             "losses and the elevon lock; linear plant, still air (docs/designs.md)",
+        omit=no_sensor)
     files["paper_scenario.yaml"] = render_yaml(
         ScenarioConfig(), "ftc-mc scenario configs/paper_scenario.yaml -- the paper's 100 s "
                           "landing approach (Table 4) with the full reconfiguring loop")

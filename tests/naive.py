@@ -12,8 +12,9 @@ one step), the belief, the excitation signals and saturation, the X8 equations
 and RK4, the controllers and their selection (``controller_command_ref``,
 ``horizon_cost_ref``, ``controller_objectives_ref``, ``select_controller_ref``),
 each stage of a trial step (``commands_ref``, ``truth_step_ref``,
-``filter_update_ref``, ``check_validity_ref``, ``handle_resets_ref``,
-``record_step_ref``, ``reconfigure_ref``) and the trial loop chaining them
+``filter_update_ref``, ``check_validity_ref``, ``handle_resets_ref`` with
+``policy_signals_ref``, ``record_cost_ref``, ``record_step_ref``,
+``reconfigure_ref``) and the trial loop chaining them
 (``advance_ref``).
 
 Paper: "Reconfiguration control method for non-redundant actuator faults on UAV"
@@ -893,7 +894,59 @@ def handle_resets_ref(exc, st, kn, block, res, reset_k, reset_block, reset_res, 
             if st.xa[B1_T, l] > exc.resend_b1 and not running_ref(kn, out["d_start"][l],
                                                                   d_len):
                 out["d_start"][l] = kn
+    if exc.policy != POLICY_NONE:
+        policy_signals_ref(exc, st, kn, res, out["d_start"], out["s_start"])
     return out
+
+
+POLICY_NONE, POLICY_PERIODIC, POLICY_AMBIGUOUS = 0, 1, 2
+"""``Excitation.policy`` codes (issue 25)."""
+
+
+def policy_signals_ref(exc, st, kn, res, d_start, s_start):
+    """The design's excitation policy at step ``kn``, in place on ``d_start`` and
+    ``s_start`` (those after the reset requests of the step).
+
+    On a live lane with no signal on: periodic, the doublet when ``kn`` is the
+    phase plus whole periods, the 3211 when it is half a period (rounded down)
+    after such a step; ambiguous, when the last start of either signal lies at
+    least a period back and the most probable mode is below ``belief_max`` or
+    ``r_q`` or ``r_nx`` is at least ``suspect``: the 3211 after a doublet, else
+    the doublet."""
+    d_len, s_len = 2 * exc.doublet_half, 7 * exc.s3211_unit
+    for l in range(len(d_start)):
+        on = running_ref(kn, d_start[l], d_len) or running_ref(kn, s_start[l], s_len)
+        if not st.alive[l] or on:
+            continue
+        if exc.policy == POLICY_PERIODIC:
+            since = kn - exc.phase
+            if since % exc.period == 0:
+                d_start[l] = kn
+            elif (since - exc.period // 2) % exc.period == 0:
+                s_start[l] = kn
+        elif exc.policy == POLICY_AMBIGUOUS:
+            last = max(d_start[l], s_start[l])
+            unsure = st.belief[:, l].max() < exc.belief_max
+            high = res[0, l] >= exc.suspect or res[1, l] >= exc.suspect
+            if kn - last >= exc.period and (unsure or high):
+                if d_start[l] > s_start[l]:
+                    s_start[l] = kn
+                else:
+                    d_start[l] = kn
+
+
+def record_cost_ref(track, x, u, alive, cost):
+    """The cost sums after a truth step (issue 25): for each live lane, the
+    glide path's cross-track error ``c = x sin(gamma0) + z cos(gamma0)`` of the
+    true state ``x`` adds ``c^2`` to row 0 and raises row 1 to ``|c|``; each
+    command adds its square to rows 2-4.  Returns the updated copy of ``cost``."""
+    cost = cost.copy()
+    c = x[track.ix] * track.sin_g + x[track.iz] * track.cos_g
+    live = np.asarray(alive, dtype=bool)
+    cost[0, live] += c[live] ** 2
+    cost[1, live] = np.maximum(cost[1, live], np.abs(c[live]))
+    cost[2:, live] += u[:, live] ** 2
+    return cost
 
 
 def record_step_ref(k, st, u, res, exc, wind, block, hist):
@@ -947,6 +1000,7 @@ def advance_ref(scheme, flight, inp, rec, st, k0, k1):
         u, exc = commands_ref(scheme, st, k)
         tr = truth_step_ref(scheme, flight, inp, k, st, u)
         st.x[:], st.gust[:], st.zhold[:] = tr["x"], tr["gust"], tr["zhold"]
+        rec.cost[:] = record_cost_ref(flight.track, st.x, u, st.alive, rec.cost)
         for f, J in lane_jacobians_ref(scheme, st, u, k).items():
             getattr(st, f)[:] = J
         xa, P, res, block, rmax, ebuf, ecount, last_k, last_block = filter_update_ref(

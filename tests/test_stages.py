@@ -34,8 +34,9 @@ import pytest
 import naive
 import single_trajectory
 from ftc_mc.sim.setup import build_setup
-from ftc_mc.conventions import (C_ELEVON, C_ENGINE, C_NOMINAL, I_B0_ELEVONS, I_B0_THRUST,
-                                I_B1_LEFT, I_B1_RIGHT, I_B1_THRUST, N_AUG, N_CONTROLLERS, N_X,
+from ftc_mc.conventions import (C_ELEVON, C_ENGINE, C_NOMINAL, EXCITE_AMBIGUOUS, EXCITE_NONE,
+                                EXCITE_PERIODIC, I_B0_ELEVONS, I_B0_THRUST, I_B1_LEFT,
+                                I_B1_RIGHT, I_B1_THRUST, N_AUG, N_CONTROLLERS, N_COST, N_X,
                                 RESET_ELEVONS, RESET_THRUST, STATUS_AIRSPEED, STATUS_ALPHA,
                                 STATUS_NONFINITE, STATUS_NOT_PSD, STATUS_OK)
 from ftc_mc.core.longitudinal import control
@@ -206,7 +207,7 @@ def new_rec(tim, L=L, max_resets=4, history=True):
         hist_pdiag=np.zeros((n_hist, 5, L)), hist_u=np.zeros((n_hist, 3, L)),
         hist_res=np.zeros((n_hist, 3, L)), hist_exc=np.zeros((n_hist, 4, L)),
         hist_block=np.zeros((n_hist, L), i8), hist_wind=np.zeros((n_hist, 3, L)),
-        sq_lat=np.zeros((2, L)))
+        sq_lat=np.zeros((2, L)), cost=np.zeros((N_COST, L)))
 
 
 # ------------------------------------------------------------------ comparisons
@@ -496,16 +497,43 @@ def test_check_validity(linear):
     assert seen == {STATUS_OK, STATUS_NONFINITE, STATUS_NOT_PSD, STATUS_AIRSPEED, STATUS_ALPHA}
 
 
-def test_handle_resets(linear):
+POLICIES = {
+    "none": {},
+    # short signals (doublet 4 steps, 3211 7) and period, so that the stage
+    # tests and the 25-step loop cross several starts
+    "periodic": {"policy": EXCITE_PERIODIC, "period": 16, "phase": 3, "doublet_half": 2,
+                 "s3211_unit": 1},
+    # a period longer than the doublet (20 steps), so the wait shows
+    "ambiguous": {"policy": EXCITE_AMBIGUOUS, "period": 30, "belief_max": 0.6,
+                  "suspect": 60.0},
+}
+"""Excitation policies of the stage tests (``Excitation`` fields over the
+config's, which have none)."""
+
+
+@pytest.mark.parametrize("policy", list(POLICIES))
+def test_handle_resets(linear, policy):
     """Reset records (including beyond capacity and on stopped lanes) and the
-    excitation they start, the doublet re-check above and below threshold."""
-    exc = linear.exc
+    excitation they start, the doublet re-check above and below threshold, and
+    the design's excitation policy (issue 25): periodic starts at their phase,
+    ambiguous on an unsure belief or a high residual, neither while a signal
+    runs nor on a stopped lane."""
+    exc = linear.exc._replace(**POLICIES[policy])
+    assert (exc.policy == EXCITE_NONE) == (policy == "none")
     rng = np.random.default_rng(80)
-    started = rechecked = truncated = 0
-    for kn in range(20, 32):
+    started = rechecked = truncated = by_policy = 0
+    for kn in range(20, 36):
         st = random_lanes(linear, rng, kn, L=12)
         st.recheck[:4] = kn  # pending re-checks now
         st.xa[I_B1_THRUST, :4] = [0.9, 0.1, 0.95, 0.2]
+        if policy != "none":  # some lanes with no signal on, recent or long ago
+            idle = rng.random(12) < 0.6
+            st.d_start[idle] = np.where(rng.random(idle.sum()) < 0.5, trial.NO_SIGNAL,
+                                        kn - 30 - rng.integers(0, 5, idle.sum()))
+            st.s_start[idle] = kn - 20 - rng.integers(0, 15, idle.sum())
+            sharp = rng.random(12) < 0.5  # confident beliefs on half the lanes
+            st.belief[:, sharp] = 0.01
+            st.belief[0, sharp] = 0.97
         block = rng.integers(0, 3, 12).astype(np.int64)
         res = rng.uniform(0.0, 100.0, (3, 12))
         rec = new_rec(linear.tim, L=12, max_resets=3)
@@ -515,6 +543,7 @@ def test_handle_resets(linear):
         work = new_trial_work(12, N_AUG)
         work.block[:], work.res[:] = block, res
         d0 = st.d_start.copy()
+        st0 = copy_nt(st)
         stages.handle_resets(exc, st, kn, work, rec)
         for f in ("d_start", "s_start", "recheck"):
             assert np.array_equal(getattr(st, f), want[f]), f
@@ -523,7 +552,82 @@ def test_handle_resets(linear):
         started += np.count_nonzero(st.d_start != d0)
         rechecked += np.count_nonzero((st.d_start[:4] == kn) & (block[:4] == 0))
         truncated += np.count_nonzero((block != 0) & st.alive & (rec.n_resets > 3))
+        # what the paper's rules alone start; the rest is the policy's
+        base = naive.handle_resets_ref(exc._replace(policy=EXCITE_NONE), st0, kn, block,
+                                       res, rec.reset_k,
+                                       rec.reset_block, rec.reset_res, rec.n_resets)
+        extra = (st.d_start != base["d_start"]) | (st.s_start != base["s_start"])
+        assert not extra[~st0.alive].any()
+        by_policy += np.count_nonzero(extra)
     assert started > 0 and rechecked > 0 and truncated > 0
+    assert (by_policy > 0) == (policy != "none"), by_policy
+
+
+def test_policy_signals_follow_the_schedule(linear):
+    """The periodic policy over two periods on idle lanes: a doublet at the phase
+    and every period, a 3211 half a period after each, nothing in between and
+    no overlap; the ambiguous policy alternates the signals, waits a period
+    after the latest start, and fires on an unsure belief or a high residual
+    only."""
+    exc = linear.exc._replace(**POLICIES["periodic"])
+    d_len, s_len = 2 * exc.doublet_half, 7 * exc.s3211_unit
+    assert max(d_len, s_len) <= exc.period // 2 <= exc.period - max(d_len, s_len)
+    rng = np.random.default_rng(81)
+    n = 4
+    st = random_lanes(linear, rng, 0, L=n)
+    st.alive[:] = True
+    st.d_start[:] = st.s_start[:] = trial.NO_SIGNAL
+    st.recheck[:] = -1
+    work = new_trial_work(n, N_AUG)
+    rec = new_rec(linear.tim, L=n)
+    starts = []
+    for kn in range(1, 2 * exc.period + exc.phase + 1):
+        stages.handle_resets(exc, st, kn, work, rec)
+        assert (st.d_start == st.d_start[0]).all() and (st.s_start == st.s_start[0]).all()
+        starts += [(kn, "d")] * int(st.d_start[0] == kn) + [(kn, "s")] * int(st.s_start[0] == kn)
+    p, ph = exc.period, exc.phase
+    assert starts == [(ph, "d"), (ph + p // 2, "s"), (ph + p, "d"), (ph + p + p // 2, "s"),
+                      (ph + 2 * p, "d")]
+    amb = linear.exc._replace(**POLICIES["ambiguous"])
+    d_len = 2 * amb.doublet_half
+    none = trial.NO_SIGNAL
+    st.d_start[:] = st.s_start[:] = none
+    st.belief[:] = 0.0
+    st.belief[0] = 1.0                      # sure: nothing
+    work.res[:] = 1.0
+    stages.handle_resets(amb, st, 50, work, rec)
+    assert (st.d_start == none).all() and (st.s_start == none).all()
+    st.belief[:, 0] = [0.5, 0.3, 0.1, 0.1]  # lane 0: unsure
+    work.res[1, 1] = amb.suspect            # lane 1: a high r_nx
+    work.res[0, 2] = amb.suspect            # lane 2: a high r_q; lane 3: neither
+    stages.handle_resets(amb, st, 51, work, rec)
+    assert list(st.d_start) == [51, 51, 51, none]  # the doublet first
+    stages.handle_resets(amb, st, 51 + d_len, work, rec)  # doublet over, too soon
+    assert (st.s_start == none).all()
+    kn = 51 + max(d_len, amb.period)
+    stages.handle_resets(amb, st, kn, work, rec)
+    assert list(st.s_start) == [kn, kn, kn, none]  # then the 3211
+
+
+def test_record_cost(linear, nonlinear_gusts):
+    """The cost sums (issue 25) against their twin, exactly: live lanes only, the
+    largest cross-track error kept, on the longitudinal plant's track."""
+    rng = np.random.default_rng(82)
+    for setup in (linear, nonlinear_gusts):
+        track = setup.flight.track
+        assert (track.ix, track.iz) == (3, 4) and track.sin_g < 0  # descending
+        st = random_lanes(setup, rng, 5)
+        work = new_trial_work(L, N_AUG)
+        work.u[:] = 0.1 * rng.standard_normal((3, L))
+        rec = new_rec(setup.tim)
+        rec.cost[:] = rng.uniform(0.0, 10.0, rec.cost.shape)
+        rec.cost[1, :2] = 1e-3  # below |c|: raised
+        want = naive.record_cost_ref(track, st.x, work.u, st.alive, rec.cost)
+        before = rec.cost.copy()
+        stages.record_cost(track, st, work, rec)
+        assert np.array_equal(rec.cost, want)
+        assert np.array_equal(rec.cost[:, ~st.alive], before[:, ~st.alive])
+        assert (rec.cost[1, :2] > 1e-3).all()
 
 
 def test_record_step(linear):
@@ -587,15 +691,20 @@ def test_reconfigure(fixture, request):
 
 # ================================================================== the whole loop
 @pytest.mark.usefixtures("trial_kernel")
-@pytest.mark.parametrize("fixture", ["linear", "nonlinear_gusts"])
-def test_advance_matches_the_chained_twins(fixture, request):
+@pytest.mark.parametrize("fixture,policy", [("linear", "none"), ("nonlinear_gusts", "none"),
+                                            ("linear", "periodic"), ("linear", "ambiguous")])
+def test_advance_matches_the_chained_twins(fixture, policy, request):
     """The trial loop against the twins chained in NumPy over 25 steps (two
     reconfiguration periods, resets firing with low thresholds, the schedule
     switching): every record field, discrete ones exactly, continuous ones to
     1e-11 (per-step differences of 1e-16 grow along the trajectory: measured
-    up to 7e-13 on the nonlinear plant in gusts)."""
+    up to 7e-13 on the nonlinear plant in gusts); with each excitation policy
+    (issue 25), whose signals then start beside those of the resets."""
     setup = request.getfixturevalue(fixture)
     scheme = scheme_of(setup, t_q=8.0, t_nx=8.0)
+    # the ambiguous policy also on residuals below the thresholds, so it fires
+    extra = {"suspect": 3.0} if policy == "ambiguous" else {}
+    scheme = scheme._replace(excitation=scheme.excitation._replace(**{**POLICIES[policy], **extra}))
     flight = setup.flight._replace(timing=setup.tim._replace(n_steps=25))
     rng = np.random.default_rng(110)
     inp = random_inputs(setup, rng, 25)
@@ -605,6 +714,15 @@ def test_advance_matches_the_chained_twins(fixture, request):
     inp = inp._replace(xa0=xa0, g0=g0)
     rec, _ = assert_loop_matches(scheme, flight, inp, 25, 1e-11)
     assert rec.n_resets.sum() > 0 and np.any(rec.hist_exc[:, 2:])
+    assert (rec.cost[0] > 0).all() and (rec.cost[2:] > 0).all()
+    if policy != "none":  # the policy started signals the resets alone did not
+        plain = scheme._replace(excitation=scheme.excitation._replace(policy=EXCITE_NONE))
+        rec0 = new_rec(flight.timing, max_resets=16)
+        st0 = trial.new_state(L, inp.xa0.shape[0], plain.detection.window, N_X, 0, 0)
+        trial.init_state(inp, st0, rec0)
+        trial.init_jacobians(plain.filter, st0)
+        rec0, _ = naive.advance_ref(plain, flight, inp, rec0, st0, 0, 25)
+        assert not np.array_equal(rec.hist_exc[:, 2:], rec0.hist_exc[:, 2:])
 
 
 def assert_loop_matches(scheme, flight, inp, n_steps, tol):

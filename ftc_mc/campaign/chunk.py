@@ -18,9 +18,9 @@ import numpy as np
 import pandas as pd
 
 from ..config.schema import Config
-from ..conventions import (BLOCK_NAMES, C_NOMINAL, LONGITUDINAL, MODE_NAMES, MODE_NOMINAL,
-                           STATUS_AIRSPEED, STATUS_ALPHA, STATUS_NAMES, STATUS_NONFINITE,
-                           STATUS_NOT_PSD)
+from ..conventions import (BLOCK_NAMES, C_NOMINAL, COST_TRACK_MAX, COST_TRACK_SQ, COST_U2,
+                           LONGITUDINAL, MODE_NAMES, MODE_NOMINAL, STATUS_AIRSPEED,
+                           STATUS_ALPHA, STATUS_NAMES, STATUS_NONFINITE, STATUS_NOT_PSD)
 from ..core.longitudinal.settings import TrialInputs, TrialRecord
 from ..core.longitudinal.trial import advance
 from ..sim.compiling import compiled_once
@@ -526,6 +526,27 @@ def lateral_columns(rec: TrialRecord, n_steps: int) -> dict:
             "heading_rms_deg": np.degrees(np.sqrt(rec.sq_lat[1] / flown))}
 
 
+COST_COLUMNS = ("track_rms_m", "track_max_m") + tuple(
+    f"control_energy_{n}" for n in LONGITUDINAL.inputs)
+"""The trial columns of :func:`cost_columns`."""
+
+
+def cost_columns(rec: TrialRecord, n_steps: int, dt: float) -> dict:
+    """What flying a trial cost (issue 25), over the steps it flew (to its end,
+    or to its exit from the validity envelope; ``TrialRecord.cost``):
+    ``track_rms_m`` and ``track_max_m``, the RMS and the largest magnitude of the
+    glide path's cross-track error ``x sin(gamma0) + z cos(gamma0)`` [m] of the
+    true state after each step; ``control_energy_<command>``, the sum of the
+    command's squared deviation from trim times ``dt`` (throttle: [s], elevons:
+    [rad^2 s]), excitation included."""
+    flown = np.maximum(np.where(rec.stop_k >= 0, rec.stop_k, n_steps), 1)
+    out = {"track_rms_m": np.sqrt(rec.cost[COST_TRACK_SQ] / flown),
+           "track_max_m": rec.cost[COST_TRACK_MAX].copy()}
+    for i, name in enumerate(LONGITUDINAL.inputs):
+        out[f"control_energy_{name}"] = rec.cost[COST_U2 + i] * dt
+    return out
+
+
 def _runs(spec: ChunkSpec):
     """``(t_q, t_nx, variant, Detection)`` of every run of a chunk, point-major."""
     setup = spec.setup
@@ -603,6 +624,7 @@ def run_chunk(spec: ChunkSpec, name: str, trial_ids) -> dict:
         t, r = classify(spec, name, v, trial_ids, values, inp, rec)
         if setup.dof == 6:
             t.update(lateral_columns(rec, n))
+        t.update(cost_columns(rec, n, setup.plant.dt))
         if spec.points is not None:
             t["t_q"] = np.full(L, tq)
             t["t_nx"] = np.full(L, tnx)

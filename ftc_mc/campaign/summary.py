@@ -16,6 +16,7 @@ import pandas as pd
 
 from ..core.longitudinal.trial import STATUS_NAMES
 from ..stats import median_p95, wilson
+from .chunk import COST_COLUMNS
 from .scoring import real_flight_scores
 from .transitions import TRANSITION_TABLE, is_sensor, paper_counts, transition_of
 
@@ -101,7 +102,7 @@ SUMMARY_COLUMNS = ("transition", "variant", "judged", "no_reset", "small_b1",
                    "wrong_mode", "controller_switch", "envelope_exit", "actuator_reset_s",
                    "wrong_mode_s", "controller_switch_s", "first_action_s",
                    "sensor_bias_hat_end", "isolated", "first_reset_block", "correct_side",
-                   "bank_rms_deg", "heading_rms_deg")
+                   "bank_rms_deg", "heading_rms_deg") + COST_COLUMNS
 """The ``trials.parquet`` columns :func:`summary_row` reads: a chunked scan reads
 only these (``campaign/assemble.py``)."""
 
@@ -148,7 +149,30 @@ def summary_row(name: str, variant: str, g: pd.DataFrame) -> dict:
     row["correct_side_trials"] = int(applies.sum())
     row.update(_rate("correct_side", int((side[applies] == 1.0).sum()), int(applies.sum())))
     row.update(lateral_summary(g))
+    row.update(cost_summary(ok))
     return row
+
+
+def cost_summary(ok: pd.DataFrame) -> dict:
+    """What flying cost over the judged trials ``ok`` (issue 25; the trial columns
+    of :func:`ftc_mc.campaign.chunk.cost_columns`): ``track_rms_m``, the RMS of
+    the glide path's cross-track error (``sqrt`` of the mean of the trials'
+    squares, each trial weighted equally) [m]; ``track_max_m_mean`` and
+    ``track_max_m``, the mean and the largest of the trials' largest
+    cross-track errors [m]; ``control_energy_<command>``, the mean of the
+    trials' control energies.  ``{}`` for a table written before those
+    columns."""
+    if "track_rms_m" not in ok:
+        return {}
+    n = len(ok)
+    rms = ok["track_rms_m"].to_numpy(dtype=float)
+    mx = ok["track_max_m"].to_numpy(dtype=float)
+    out = {"track_rms_m": float(np.sqrt(np.mean(rms ** 2))) if n else np.nan,
+           "track_max_m_mean": float(mx.mean()) if n else np.nan,
+           "track_max_m": float(mx.max()) if n else np.nan}
+    for col in COST_COLUMNS[2:]:
+        out[col] = float(ok[col].to_numpy(dtype=float).mean()) if n else np.nan
+    return out
 
 
 def lateral_summary(g: pd.DataFrame) -> dict:
@@ -220,6 +244,7 @@ def sensor_row(name: str, variant: str, g: pd.DataFrame) -> dict:
         row.update(_quantiles(key, ok[f"{key}_s"].to_numpy(dtype=float)))
     row.update(_quantiles("first_action", ok["first_action_s"].to_numpy(dtype=float)))
     row["false_resets"] = int(ok["false_resets"].sum())
+    row.update(cost_summary(ok))
     if (tr.kind == "bias" and "sensor_bias_hat_end" in ok
             and ok["sensor_bias_hat_end"].notna().any()):  # the design estimates it
         row.update(_rate("isolated", int(ok["isolated"].astype(bool).sum()), n))

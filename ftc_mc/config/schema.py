@@ -17,9 +17,9 @@ from typing import Annotated, Literal
 from pydantic import (AfterValidator, BaseModel, BeforeValidator, ConfigDict, Field,
                       field_validator, model_validator)
 
-from ..conventions import (ACTUATOR_NAMES, BIASED_OUTPUTS, OUTPUT_NAMES, PLANT_KINDS,
-                           SENSOR_FAULT_KINDS, SENSOR_PREFIX, STATE_NAMES, TRANSITIONS,
-                           TURBULENCE_LEVELS)
+from ..conventions import (ACTUATOR_NAMES, BIASED_OUTPUTS, EXCITATION_POLICIES, OUTPUT_NAMES,
+                           PLANT_KINDS, S3211_UNITS, SENSOR_FAULT_KINDS, SENSOR_PREFIX,
+                           STATE_NAMES, TRANSITIONS, TURBULENCE_LEVELS)
 from ..errors import UserError
 from ..model.source import (DEFAULT_AIRFRAME, check_airframe, check_condition,
                             is_linear_model)
@@ -441,6 +441,16 @@ class DesignConfig(_Strict):
     """Standard deviation a bias takes when its hypothesis opens, per output [rad/s, g]; outputs left out take the largest bias of a typical small-UAV sensor (q 5 deg/s, n_x and n_z 80 mg: the upper ends of sensor_draws' defaults)."""
     sensor_bias_walk: dict[Literal[BIASED_OUTPUTS], NonNeg] = Field(default_factory=dict)
     """Random-walk density of each estimated bias per sqrt(s), as a fraction of the output's measurement-noise standard deviation; outputs left out take q 0.3, n_z 0.3 (a bias too small for Table 1 is still learnt in the 30 s after it), n_x 0.05 (faster, it would hide small thrust losses); issue 14's note. The biases start at 0 with that standard deviation (a calibrated sensor)."""
+    excitation_policy: Literal[EXCITATION_POLICIES] = "none"
+    """Excitation beyond the paper's requests on resets (issue 25; docs/designs.md): none, the paper's (a doublet on a thrust reset, a 3211 on an elevon reset, the doublet re-check); periodic: also the engine doublet every excitation_period_s and the elevon 3211 half a period after each; ambiguous: also one of them (the other than the last sent) when the belief's most probable mode is below excitation_belief or r_q or r_nx reach excitation_residual, at most once per excitation_period_s. A signal is only sent while none runs; the excitation section sets both signals."""
+    excitation_period_s: Pos = 5.0
+    """periodic: time between two doublets [s] (a multiple of model.dt_s, at least twice the longer signal, so they never overlap); ambiguous: the shortest time from a signal's start to the next one sent."""
+    excitation_phase_s: NonNeg = 0.0
+    """periodic: the doublets start at this time plus whole periods [s] (a multiple of model.dt_s, below excitation_period_s); the 3211s half a period later."""
+    excitation_belief: Annotated[float, NoBool, Field(ge=0, le=1, allow_inf_nan=False)] = 0.9
+    """ambiguous: send while the belief's most probable mode has a probability below this (0: never on the belief)."""
+    excitation_residual: Pos | None = None
+    """ambiguous: send when r_q or r_nx (the design's decision statistics: one-step residuals or GLR) reach this; null: never on the residuals. Below Table 1's thresholds it excites a suspected change before it is decided."""
 
     @model_validator(mode="after")
     def _biases(self):
@@ -488,6 +498,26 @@ def _check_designs(cfg, listed, where: str, duration: tuple) -> None:
     _check_periods(cfg.model.dt_s, [(f"designs.{n}.relinearise_s", d.relinearise_s)
                                     for n, d in cfg.designs.items()
                                     if d.relinearise_s is not None])
+    _check_periods(cfg.model.dt_s, [(f"designs.{n}.excitation_period_s", d.excitation_period_s)
+                                    for n, d in cfg.designs.items()
+                                    if d.excitation_policy != "none"])
+    _check_periods(cfg.model.dt_s, [(f"designs.{n}.excitation_phase_s", d.excitation_phase_s)
+                                    for n, d in cfg.designs.items()
+                                    if d.excitation_policy == "periodic"
+                                    and d.excitation_phase_s > 0])
+    e = cfg.excitation
+    longest = max(2 * e.doublet_half_period_s, sum(S3211_UNITS) * e.s3211_unit_s)
+    for n, d in cfg.designs.items():
+        if d.excitation_policy != "periodic":
+            continue
+        if d.excitation_period_s < 2 * longest - 1e-9:
+            raise ValueError(f"designs.{n}.excitation_period_s: must be at least twice the "
+                             f"longer excitation signal ({2 * longest:g} s), so the doublet "
+                             f"and the 3211 never overlap; got {d.excitation_period_s:g}")
+        if d.excitation_phase_s >= d.excitation_period_s:
+            raise ValueError(f"designs.{n}.excitation_phase_s: must be below "
+                             f"excitation_period_s ({d.excitation_period_s:g} s), got "
+                             f"{d.excitation_phase_s:g}")
     for n, d in cfg.designs.items():
         if d.relinearise_s is not None and d.prediction != "nonlinear":
             raise ValueError(f"designs.{n}.relinearise_s: only with prediction: nonlinear "

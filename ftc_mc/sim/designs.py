@@ -28,6 +28,12 @@ the biases of the sensors sharing its residual (:data:`BIAS_BLOCK`), so the
 filter, with the excitation the reset sends, sorts the change into an actuator
 fault or an output bias (:func:`_with_sensor_biases`).
 
+A design may also send excitation beyond the paper's requests on resets
+(``excitation_policy``, issue 25): its :attr:`Design.excitation` fills the
+policy fields of the kernels' :class:`~ftc_mc.core.longitudinal.settings.Excitation`
+(:data:`NO_POLICY` for the paper's, which leaves the kernels as before).  A
+policy changes the flight before any reset, so it is part of the design key.
+
 A design changes only what the filter assumes: the truth noise of every trial
 comes from the config's ``estimator`` and ``noise`` sections, so all designs fly
 the same trials (common random numbers).
@@ -42,13 +48,32 @@ import numpy as np
 import scipy.linalg
 
 from ..config.schema import BUILTIN_DESIGNS, DesignConfig, EstimatorConfig
-from ..conventions import (OUTPUT_NAMES, RESET_ELEVONS, RESET_THRUST, STATE_NAMES, TEST_GLR,
-                           TEST_NAMES, TEST_ONE_STEP)
+from ..conventions import (EXCITATION_POLICIES, EXCITE_NONE, OUTPUT_NAMES, RESET_ELEVONS,
+                           RESET_THRUST, STATE_NAMES, TEST_GLR, TEST_NAMES, TEST_ONE_STEP)
 from ..core.longitudinal.settings import Detection, FilterModel
 from ..model.linear import LinearPlant
 from ..model.turbulence import dryden_model
 from ..model.wind import plant_wind_matrices
 from .estimator import EstimatorSettings, detection, filter_model, initial_covariance
+
+
+NO_POLICY = {"policy": EXCITE_NONE, "period": 1, "phase": 0, "belief_max": 0.0,
+             "suspect": math.inf}
+"""The policy fields of :class:`~ftc_mc.core.longitudinal.settings.Excitation` of a
+design without an excitation policy (the paper's: signals on resets only)."""
+
+
+def excitation_policy(dc: DesignConfig, dt: float) -> dict:
+    """The policy fields of the kernels' ``Excitation`` for the design ``dc``
+    (``dt``: the control period [s]); :data:`NO_POLICY` for ``none``."""
+    if dc.excitation_policy == "none":
+        return dict(NO_POLICY)
+    return {"policy": EXCITATION_POLICIES.index(dc.excitation_policy),
+            "period": int(round(dc.excitation_period_s / dt)),
+            "phase": int(round(dc.excitation_phase_s / dt)),
+            "belief_max": float(dc.excitation_belief),
+            "suspect": (math.inf if dc.excitation_residual is None
+                        else float(dc.excitation_residual))}
 
 
 @dataclasses.dataclass(frozen=True)
@@ -77,6 +102,8 @@ class Design:
     biases : tuple of str
         Outputs whose sensor bias the design estimates, in the order of their
         states (the last ``len(biases)`` of the estimate).
+    excitation : dict
+        The policy fields of the kernels' ``Excitation`` (:func:`excitation_policy`).
     """
 
     name: str
@@ -88,6 +115,7 @@ class Design:
     window: int
     key: str
     biases: tuple = ()
+    excitation: dict = dataclasses.field(default_factory=lambda: dict(NO_POLICY))
 
     @property
     def n_aug(self) -> int:
@@ -187,10 +215,11 @@ def build_design(name: str, dc: DesignConfig, plant: LinearPlant, est: Estimator
     det = _with_test(detection(plant, s), test, window, min_window)._replace(
         settle=int(round(dc.settle_s / plant.dt)), startup=int(round(dc.startup_s / plant.dt)))
     # every field but those Table 1 reads only when it decides (a shared start runs
-    # with resets disabled)
+    # with resets disabled); the excitation policy's are in: it flies before any reset
     key = dc.model_dump_json(exclude={"signature", "t_q", "t_nx"})
     return Design(name=name, est=s, fm=fm, det=det, P0=_c(P0), test=test, window=window,
-                  key=key, biases=tuple(dc.sensor_biases))
+                  key=key, biases=tuple(dc.sensor_biases),
+                  excitation=excitation_policy(dc, plant.dt))
 
 
 SENSOR_BIAS_SD = {"q": 5.0 * math.pi / 180.0, "n_x": 0.08, "n_z": 0.08}

@@ -26,7 +26,7 @@ import math
 import numpy as np
 
 from ..conventions import LONGITUDINAL as LAY
-from ..conventions import N_MODES
+from ..conventions import N_COST, N_MODES
 from ..core.longitudinal.gustfilter import N_WIND
 from ..core.longitudinal.settings import TrialInputs, TrialRecord
 from ..core.longitudinal.workspace import N_EXC
@@ -98,7 +98,8 @@ def new_record(setup, L: int, max_resets: int, history: bool = False,
         hist_res=np.zeros((n_hist, n_res, L)), hist_exc=np.zeros((n_hist, N_EXC, L)),
         hist_block=np.zeros((n_hist, L), dtype=np.int64),
         hist_wind=np.zeros((n_hist, N_WIND, L)),
-        xa_end=np.zeros((n_est, L)), sq_lat=np.zeros((N_SQ_LAT, L)))
+        xa_end=np.zeros((n_est, L)), sq_lat=np.zeros((N_SQ_LAT, L)),
+        cost=np.zeros((N_COST, L)))
 
 
 def run_alone(setup, name: str, det, inp: TrialInputs, max_resets: int,

@@ -24,14 +24,15 @@ from ..config.schema import Config, ScenarioConfig
 from ..conventions import LONGITUDINAL, VARIANTS
 from ..core.shared.interp import EngineTables
 from ..core.longitudinal.settings import (Belief, Controller, Detection, Excitation, FilterModel,
-                                          Flight, Reconfig, Scheme, Timing, TruthPlant, Validity)
+                                          Flight, Reconfig, Scheme, Timing, Track, TruthPlant,
+                                          Validity)
 from ..design.lqr import discounted_lqr, paper_q_lqr
 from ..design.terminal import terminal_costs
 from ..design.theorem41 import cached_engine_tables
 from ..model.linear import LinearPlant
 from ..model.source import load_plant
 from ..model.turbulence import DrydenModel
-from .designs import Design, build_designs
+from .designs import NO_POLICY, Design, build_designs
 from .estimator import (EstimatorSettings, belief_settings, detection, filter_model,
                         initial_covariance)
 from .truth import lateral_noise, sixdof_truth_plant, truth_plant
@@ -81,6 +82,9 @@ class SimSetup:
     gust_lat_chol : ndarray or None
         6-DOF in turbulence: Cholesky factor of the lateral gust states' stationary
         covariance.
+    track : Track or None
+        The glide path's cross-track error of the truth state (None: built from
+        ``plant`` and ``truth`` when read, :attr:`flight`).
     """
 
     plant: LinearPlant
@@ -105,19 +109,24 @@ class SimSetup:
     dof: int = 3
     lat_std: np.ndarray | None = None
     gust_lat_chol: np.ndarray | None = None
+    track: Track | None = None
 
     def scheme(self, name: str, detection: Detection | None = None) -> Scheme:
-        """The kernels' :class:`Scheme` of the design ``name``: its filter, and its
-        detection (or ``detection``)."""
+        """The kernels' :class:`Scheme` of the design ``name``: its filter, its
+        detection (or ``detection``) and its excitation policy."""
         d: Design = self.designs[name]
         return Scheme(filter=d.fm, detection=d.det if detection is None else detection,
-                      belief=self.bs, controller=self.ctl, excitation=self.exc,
+                      belief=self.bs, controller=self.ctl,
+                      excitation=self.exc._replace(**d.excitation),
                       reconfig=self.rc, engine=self.eng)
 
     @property
     def flight(self) -> Flight:
-        """The kernels' :class:`Flight`: timing, validity and truth plant."""
-        return Flight(timing=self.tim, validity=self.val, plant=self.truth)
+        """The kernels' :class:`Flight`: timing, validity, truth plant and the
+        glide path's cross-track error."""
+        return Flight(timing=self.tim, validity=self.val, plant=self.truth,
+                      track=self.track if self.track is not None else
+                      track_of(self.plant, self.truth, self.dof))
 
     def detection(self, name: str, t_q: float, t_nx: float) -> Detection:
         """Table 1 settings of the design ``name`` at the thresholds ``(t_q, t_nx)``
@@ -127,6 +136,17 @@ class SimSetup:
         of the design's thresholds, and never used).
         """
         return self.designs[name].detection(self.plant, t_q, t_nx)
+
+
+def track_of(plant: LinearPlant, truth, dof: int) -> Track:
+    """The :class:`Track` of a truth plant: the rows of ``x`` and ``z`` in its
+    state (the 6-DOF state's of the same names on the 6-DOF plant) and the trim
+    flight-path angle's sine and cosine."""
+    ix, iz = LONGITUDINAL.state("x"), LONGITUDINAL.state("z")
+    if dof == 6:
+        ix, iz = int(truth.lon_state[ix]), int(truth.lon_state[iz])
+    g = float(plant.trim.gamma0)
+    return Track(ix=ix, iz=iz, sin_g=math.sin(g), cos_g=math.cos(g))
 
 
 def runs_of(cfg: Config | ScenarioConfig) -> tuple:
@@ -198,7 +218,8 @@ def build_setup(cfg: Config | ScenarioConfig) -> SimSetup:
                      s3211_amp=float(x.s3211_amplitude_rad),
                      s3211_unit=cfg.steps(x.s3211_unit_s),
                      resend_delay=cfg.steps(x.resend_delay_s),
-                     resend_b1=float(x.resend_b1_threshold))
+                     resend_b1=float(x.resend_b1_threshold),
+                     **NO_POLICY)
     val = Validity(va_trim=float(plant.trim.y0[LONGITUDINAL.output("Va")]),
                    va_min=vc.airspeed_min_mps,
                    va_max=vc.airspeed_max_mps, alpha_trim=plant.trim.alpha,
@@ -227,4 +248,5 @@ def build_setup(cfg: Config | ScenarioConfig) -> SimSetup:
         r_std=r_std,
         beta=(cfg.estimator.beta_engine, cfg.estimator.beta_elevon),
         truth=truth, gust=gust, gust_chol=None if gust is None else gust.P0_chol,
-        dof=pc.dof, lat_std=lat_std, gust_lat_chol=gust_lat_chol)
+        dof=pc.dof, lat_std=lat_std, gust_lat_chol=gust_lat_chol,
+        track=track_of(plant, truth, pc.dof))

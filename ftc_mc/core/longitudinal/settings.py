@@ -141,8 +141,19 @@ Excitation = namedtuple("Excitation", [
     "s3211_unit",       # steps of one unit of the 3211
     "resend_delay",     # steps after a thrust reset before the doublet re-check (3 s)
     "resend_b1",        # re-send the doublet if b1_thrust estimate exceeds this (0.7)
+    # the design's excitation policy beyond the requests on resets (issue 25)
+    "policy",           # conventions.EXCITE_NONE (the paper), EXCITE_PERIODIC or
+                        #    EXCITE_AMBIGUOUS (stages.policy_signals)
+    "period",           # periodic: steps between two doublets (the 3211 half-way);
+                        #    ambiguous: fewest steps from a signal's start to a sent one
+    "phase",            # periodic: the doublets start at steps phase + n period
+    "belief_max",       # ambiguous: send while the most probable mode's probability
+                        #    is below this (0: never)
+    "suspect",          # ambiguous: send when r_q or r_nx (the decision statistics)
+                        #    reach this (inf: never)
 ])
-"""Excitation on reset requests (paper sections 3.2.3 and 4.1.1)."""
+"""Excitation on reset requests (paper sections 3.2.3 and 4.1.1), and the
+design's policy of sending more (issue 25)."""
 
 Timing = namedtuple("Timing", [
     "n_steps",        # steps simulated
@@ -203,6 +214,9 @@ TrialRecord = namedtuple("TrialRecord", [
     "hist_wind",    # (n_hist, 3, L) gust u_g, w_g [m/s], q_g [rad/s] held over each step
     "sq_lat",       # (2, L) sums over the valid steps of the squared bank and heading
                     #      deviations [rad^2] (6-DOF plant; zeros otherwise)
+    "cost",         # (N_COST, L) over the valid steps (conventions.COST_NAMES): sum of
+                    #      the squared cross-track error [m^2], its largest magnitude [m],
+                    #      sums of each squared command deviation (stages.record_cost)
 ])
 """Per-lane outputs of :func:`ftc_mc.sim.lanes.run_trials`."""
 
@@ -241,10 +255,20 @@ Scheme = namedtuple("Scheme", [
 """The fault-tolerant control scheme under test: estimator, detector, belief,
 controllers and their selection.  A threshold sweep varies only ``detection``."""
 
+Track = namedtuple("Track", [
+    "ix",     # row of the along-path position deviation x [m] in the truth state
+    "iz",     # row of the vertical deviation z [m] (down) in the truth state
+    "sin_g",  # sin of the trim flight-path angle gamma0
+    "cos_g",  # cos of gamma0
+])
+"""The glide path's cross-track error ``x sin(gamma0) + z cos(gamma0)`` [m] of the
+truth state (as ``scenario/run.py`` computes ``cross_track_error_m``)."""
+
 Flight = namedtuple("Flight", [
     "timing",    # Timing: steps, fault step, reconfiguration period
     "validity",  # Validity: where a trial stops being trusted
     "plant",     # TruthPlant: the simulated aircraft and air
+    "track",     # Track: the glide path's cross-track error (TrialRecord.cost)
 ])
 """What the scheme flies: the truth plant, how long, and its validity envelope."""
 

@@ -4,12 +4,12 @@
 
 1. :func:`commands` -- controller, saturation and excitation (eqs. 15-25, 44);
 2. :func:`ftc_mc.core.longitudinal.plant.truth_step` -- effect (eq. 2), gusts, plant,
-   measurement;
+   measurement; then :func:`record_cost` -- the tracking error and command sums;
 3. :func:`filter_update` -- the augmented filter with Table 1 and resets
    (eqs. 5-11, :func:`ftc_mc.core.longitudinal.batch.filter_step_lanes`);
 4. :func:`check_validity` -- where a trial stops being trusted;
 5. :func:`handle_resets` -- reset records and excitation requests (sections
-   3.2.3 and 4.1.1);
+   3.2.3 and 4.1.1), and the design's excitation policy (:func:`policy_signals`);
 6. :func:`record_step` -- the per-step history (scenarios);
 7. :func:`reconfigure` -- every reconfiguration period, the belief (eqs. 12-14)
    and the controller selection (eqs. 45-47);
@@ -34,9 +34,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...conventions import (C_ELEVON, I_B1_LEFT, I_B1_THRUST, N_AUG, N_FAULT, N_MODES, N_U, N_X,
-                            NO_RESET, RESET_THRUST, STATUS_AIRSPEED, STATUS_ALPHA, STATUS_BANK,
-                            STATUS_NONFINITE, STATUS_NOT_PSD, STATUS_OK)
+from ...conventions import (C_ELEVON, COST_TRACK_MAX, COST_TRACK_SQ, COST_U2, EXCITE_NONE,
+                            EXCITE_PERIODIC, I_B1_LEFT, I_B1_THRUST, N_AUG, N_FAULT, N_MODES,
+                            N_U, N_X, NO_RESET, RESET_THRUST, STATUS_AIRSPEED, STATUS_ALPHA,
+                            STATUS_BANK, STATUS_NONFINITE, STATUS_NOT_PSD, STATUS_OK)
 from .batch import filter_correct_lanes, filter_predict_lanes, innovations_lanes
 from .signature import signature_lanes
 from ..shared.glr import glr_lanes, glr_restart
@@ -148,6 +149,43 @@ def commands(path, scheme, st, k, work):
         out[EXC_3211_START, l] = 1.0 if ks == 0 else 0.0
         u[U_LEFT, l] = saturate(u[U_LEFT, l], s, a, lo[U_LEFT], hi[U_LEFT])
         u[U_RIGHT, l] = saturate(u[U_RIGHT, l], -s, a, lo[U_RIGHT], hi[U_RIGHT])
+
+
+# ------------------------------------------------------------------ 2b. cost
+@kernel(inline="always")
+def record_cost(track, st, work, rec):
+    """After the truth step: the costs of flying the step (issue 25).
+
+    For every live lane (its steps until it stops, the step that takes it out
+    of the envelope included, as ``TrialRecord.sq_lat``): the cross-track error
+    of the glide path ``c = x sin(gamma0) + z cos(gamma0)`` of the true state
+    after the step (``scenario/run.py``'s ``cross_track_error_m``) adds ``c^2``
+    to ``cost[COST_TRACK_SQ]`` and raises ``cost[COST_TRACK_MAX]`` to ``|c|``;
+    each command ``u_i`` applied during the step (deviation from trim, the
+    excitation included) adds ``u_i^2`` to ``cost[COST_U2 + i]``.
+
+    Parameters
+    ----------
+    track : Track
+        Rows of ``x`` and ``z`` in the truth state, ``sin`` and ``cos`` of gamma0.
+    st : LaneState
+        Reads ``x`` (the true state after the step) and ``alive``.
+    work : TrialWork
+        Reads ``u``.
+    rec : TrialRecord
+        ``cost`` updated.
+    """
+    x = st.x
+    u = work.u
+    cost = rec.cost
+    for l in range(x.shape[1]):
+        if not st.alive[l]:
+            continue
+        c = x[track.ix, l] * track.sin_g + x[track.iz, l] * track.cos_g
+        cost[COST_TRACK_SQ, l] += c * c
+        cost[COST_TRACK_MAX, l] = max(cost[COST_TRACK_MAX, l], abs(c))
+        for i in range(N_U):
+            cost[COST_U2 + i, l] += u[i, l] * u[i, l]
 
 
 # ------------------------------------------------------------------ 3. filter
@@ -421,7 +459,8 @@ def handle_resets(excitation, st, kn, work, rec):
     re-check ``resend_delay`` steps later; an elevon reset starts the 3211
     unless one is running (section 3.2.3).  At a pending re-check the doublet
     is sent again if ``b1_thrust`` is estimated above ``resend_b1`` and none is
-    running (section 4.1.1).  Resets of a lane that stopped are ignored.
+    running (section 4.1.1).  Resets of a lane that stopped are ignored.  Then
+    the design's excitation policy, if it has one (:func:`policy_signals`).
 
     Parameters
     ----------
@@ -460,6 +499,70 @@ def handle_resets(excitation, st, kn, work, rec):
             if (st.xa[I_B1_THRUST, l] > excitation.resend_b1
                     and not running(kn, d_start[l], d_len)):
                 d_start[l] = kn
+    if excitation.policy != EXCITE_NONE:
+        policy_signals(excitation, st, kn, work)
+
+
+@kernel(inline="always")
+def policy_signals(excitation, st, kn, work):
+    """The design's excitation beyond the requests on resets (issue 25).
+
+    A live lane on which neither signal runs at step ``kn`` (after the
+    requests of this step, :func:`handle_resets`) starts one:
+
+    * ``EXCITE_PERIODIC``: the doublet at the steps ``phase + n period`` and the
+      3211 at ``phase + period // 2 + n period`` (``n`` any integer), so the two
+      alternate and, when each lasts at most half a period, never overlap;
+    * ``EXCITE_AMBIGUOUS``: at least ``period`` steps after the latest start of
+      either signal, when the belief's most probable mode has a probability
+      below ``belief_max`` or ``r_q`` or ``r_nx`` (this step's decision
+      statistics, ``work.res``: the one-step residuals or the GLR's) reach
+      ``suspect``: the 3211 if the doublet was the latest sent, else the doublet.
+
+    Neither depends on Table 1's thresholds, so a lane with no reset flies the
+    same under every threshold (a sweep shares its start, ``sim/lanes.py``).
+
+    Parameters
+    ----------
+    excitation : Excitation
+        ``policy`` (not ``EXCITE_NONE``), ``period``, ``phase``, ``belief_max``,
+        ``suspect``, and the signals' lengths.
+    st : LaneState
+        Reads ``alive``, ``belief``; ``d_start``, ``s_start`` updated.
+    kn : int
+        Step reached (``k + 1``).
+    work : TrialWork
+        Reads ``res``.
+    """
+    d_len = doublet_length(excitation.doublet_half)
+    s_len = signal_3211_length(excitation.s3211_unit)
+    period = excitation.period
+    d_start = st.d_start
+    s_start = st.s_start
+    for l in range(st.xa.shape[1]):
+        if (not st.alive[l] or running(kn, d_start[l], d_len)
+                or running(kn, s_start[l], s_len)):
+            continue
+        if excitation.policy == EXCITE_PERIODIC:
+            ph = (kn - excitation.phase) % period
+            if ph < 0:
+                ph += period
+            if ph == 0:
+                d_start[l] = kn
+            elif ph == period // 2:
+                s_start[l] = kn
+        else:  # EXCITE_AMBIGUOUS
+            if kn - max(d_start[l], s_start[l]) < period:
+                continue
+            pmax = 0.0
+            for m in range(st.belief.shape[0]):
+                pmax = max(pmax, st.belief[m, l])
+            if (pmax < excitation.belief_max or work.res[R_Q, l] >= excitation.suspect
+                    or work.res[R_NX, l] >= excitation.suspect):
+                if d_start[l] > s_start[l]:
+                    s_start[l] = kn
+                else:
+                    d_start[l] = kn
 
 
 # ------------------------------------------------------------------ 6. history

@@ -18,10 +18,12 @@ described where it is defined:
 1. :func:`ftc_mc.core.longitudinal.stages.commands` -- ``u_k = f(U(x_hat_k), s_k, A_k)``;
 2. :func:`ftc_mc.core.longitudinal.plant.truth` -- effect, gusts, plant, ``z_{k+1}``
    (the longitudinal :func:`~ftc_mc.core.longitudinal.plant.truth_step`, or the
-   6-DOF family's :func:`ftc_mc.core.sixdof.truth.sixdof_truth`);
+   6-DOF family's :func:`ftc_mc.core.sixdof.truth.sixdof_truth`), then
+   :func:`ftc_mc.core.longitudinal.stages.record_cost` -- tracking and command costs;
 3. :func:`ftc_mc.core.longitudinal.stages.filter_update` -- the filter with ``u_k``, ``z_{k+1}``;
 4. :func:`ftc_mc.core.longitudinal.stages.check_validity`;
-5. :func:`ftc_mc.core.longitudinal.stages.handle_resets` -- resets and excitation requests;
+5. :func:`ftc_mc.core.longitudinal.stages.handle_resets` -- resets, excitation requests
+   and the design's excitation policy;
 6. :func:`ftc_mc.core.longitudinal.stages.record_step` -- history;
 7. :func:`ftc_mc.core.longitudinal.stages.reconfigure` -- belief and controller, every
    ``reconf_every`` steps.
@@ -40,7 +42,7 @@ from ..jit import kernel
 from .plant import truth
 from .settings import LaneState
 from .stages import (check_validity, commands, filter_update, handle_resets,  # noqa: F401
-                     is_psd, reconfigure, record_end, record_step)
+                     is_psd, reconfigure, record_cost, record_end, record_step)
 from .workspace import new_trial_work
 
 NO_SIGNAL = -(1 << 40)
@@ -71,8 +73,9 @@ def advance(path, scheme, flight, inp, rec, st, k0, k1):
         c2) and ``engine`` (EngineTables of c1).
     flight : Flight
         ``timing`` (Timing), ``validity`` (Validity: where a lane stops being
-        recorded, :func:`ftc_mc.core.longitudinal.stages.check_validity`) and ``plant``
-        (TruthPlant: linear or nonlinear, still air or Dryden gusts).
+        recorded, :func:`ftc_mc.core.longitudinal.stages.check_validity`), ``plant``
+        (TruthPlant: linear or nonlinear, still air or Dryden gusts) and
+        ``track`` (Track: the glide path's cross-track error).
     inp : TrialInputs
         Per-lane fault schedule, initial estimates and noise.
     rec : TrialRecord
@@ -91,6 +94,7 @@ def advance(path, scheme, flight, inp, rec, st, k0, k1):
         kn = k + 1
         commands(path, scheme, st, k, work)
         truth(path, scheme, flight, inp, k, st, work, rec)
+        record_cost(flight.track, st, work, rec)
         filter_update(path, scheme, st, k, work)
         check_validity(flight.validity, st, kn, work, rec)
         handle_resets(scheme.excitation, st, kn, work, rec)
@@ -137,6 +141,8 @@ def init_state(inp, st, rec):
             st.lat[i, l] = 0.0
         for i in range(rec.sq_lat.shape[0]):
             rec.sq_lat[i, l] = 0.0
+        for i in range(rec.cost.shape[0]):
+            rec.cost[i, l] = 0.0
         st.ecount[l] = 0
         st.last_k[l] = NO_SIGNAL
         st.last_block[l] = 0

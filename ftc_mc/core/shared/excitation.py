@@ -6,11 +6,8 @@ first step of the signal); outside their support they are zero.
 
 from __future__ import annotations
 
+from ...conventions import S3211_UNITS  # noqa: F401  (3, 2, 1, 1): Fig. 4
 from ..jit import kernel
-
-
-S3211_UNITS = (3, 2, 1, 1)
-"""Durations of the 3211's alternating steps, in units (Fig. 4)."""
 
 
 @kernel

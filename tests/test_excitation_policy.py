@@ -1,0 +1,155 @@
+"""A design's excitation policy and the cost of flying (issue 25): validation,
+the kernels' settings, the design key that keeps a sweep's shared starts
+apart, the cost columns against the trial's own history, and a policy's
+effect on a small campaign."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from ftc_mc import api
+from ftc_mc.campaign.chunk import COST_COLUMNS, chunk_spec, trial_inputs
+from ftc_mc.campaign.sweep import run_sweep, threshold_points
+from ftc_mc.config import Config
+from ftc_mc.config.load import validate_model
+from ftc_mc.conventions import (COST_TRACK_MAX, COST_TRACK_SQ, COST_U2, EXCITE_AMBIGUOUS,
+                                EXCITE_NONE, EXCITE_PERIODIC, LONGITUDINAL)
+from ftc_mc.errors import UserError
+from ftc_mc.sim.designs import NO_POLICY
+from ftc_mc.sim.lanes import run_alone, simulate
+
+PERIODIC = {"excitation_policy": "periodic", "excitation_period_s": 4.0,
+            "excitation_phase_s": 1.0}
+AMBIGUOUS = {"excitation_policy": "ambiguous", "excitation_period_s": 3.0,
+             "excitation_belief": 0.9, "excitation_residual": 6.0}
+SHORT = {"fault_time_s": 5.0, "window_s": 5.0, "duration_s": 12.0}
+
+
+def config(transitions=("elevon_loss",), trials=8, **over):
+    data = {"designs": {"per": PERIODIC, "amb": AMBIGUOUS},
+            "campaign": {"transitions": list(transitions), "trials": trials, "chunk_size": 8,
+                         "signature": "swapped", "designs": ["per", "amb"]},
+            "controller": {"kind": "nominal"}, "timing": SHORT,
+            "model": {"airframe": "x8-gryte2018"}}
+    data.update(over)
+    return validate_model(Config, data, "test.yaml")
+
+
+@pytest.mark.parametrize("design, needle", [
+    ({"excitation_policy": "always"}, "designs.x.excitation_policy"),
+    ({"excitation_policy": "periodic", "excitation_period_s": 3.0},
+     "designs.x.excitation_period_s: must be at least twice the longer excitation signal (4 s)"),
+    ({"excitation_policy": "periodic", "excitation_period_s": 4.05},
+     "designs.x.excitation_period_s: must be a positive multiple of model.dt_s"),
+    ({"excitation_policy": "periodic", "excitation_phase_s": 0.25},
+     "designs.x.excitation_phase_s: must be a positive multiple of model.dt_s"),
+    ({"excitation_policy": "periodic", "excitation_phase_s": 5.0},
+     "designs.x.excitation_phase_s: must be below excitation_period_s (5 s)"),
+    ({"excitation_policy": "ambiguous", "excitation_belief": 1.5}, "designs.x.excitation_belief"),
+    ({"excitation_policy": "ambiguous", "excitation_residual": 0.0},
+     "designs.x.excitation_residual"),
+])
+def test_bad_policies_are_one_line(design, needle):
+    with pytest.raises(UserError) as exc:
+        validate_model(Config, {"designs": {"x": design}}, "test.yaml")
+    msg = str(exc.value)
+    assert needle in msg and "\n" not in msg, msg
+
+
+def test_policy_reaches_the_kernels_as_data():
+    """The design's policy fills ``Excitation``'s policy fields (steps); the
+    paper's designs keep :data:`NO_POLICY`; the policy is part of the design key,
+    so a sweep never shares a start between designs that fly differently before
+    any reset; every field has the same type (one compile path for all)."""
+    setup = chunk_spec(config()).setup
+    per, amb, sw = (setup.scheme(n).excitation for n in ("per", "amb", "swapped"))
+    assert (per.policy, per.period, per.phase) == (EXCITE_PERIODIC, 40, 10)
+    assert (amb.policy, amb.period, amb.belief_max, amb.suspect) == (EXCITE_AMBIGUOUS, 30,
+                                                                     0.9, 6.0)
+    assert sw._asdict() == {**setup.exc._asdict(), **NO_POLICY} and sw.policy == EXCITE_NONE
+    assert math.isinf(sw.suspect)
+    assert [type(v) for v in per] == [type(v) for v in sw] == [type(v) for v in amb]
+    keys = {n: setup.designs[n].key for n in ("per", "amb", "swapped")}
+    assert len(set(keys.values())) == 3
+
+
+def test_shared_start_with_a_policy_equals_running_alone():
+    """A sweep's shared start (resets disabled up to the switch) with a policy
+    gives every design, at every threshold, the records it gives alone: the
+    policy does not read the thresholds.  The policies do start signals
+    before the switch, so the designs' pre-fault flights differ."""
+    cfg = config(transitions=("engine_loss",))
+    spec = chunk_spec(cfg)
+    setup = spec.setup
+    inp, _ = trial_inputs(spec, "engine_loss", np.arange(8))
+    runs = [(n, setup.detection(n, t, t)) for t in (8.0, 25.0) for n in setup.designs]
+    shared, _ = simulate(setup, inp, runs, 64, setup.tim.k_fault)
+    alone, _ = simulate(setup, inp, runs, 64)
+    for (name, det), a, b in zip(runs, shared, alone):
+        for f in a._fields:
+            np.testing.assert_array_equal(getattr(a, f), getattr(b, f),
+                                          err_msg=f"{name} {det.t_q} {f}")
+    energy = {name: rec.cost[COST_U2].sum() for (name, det), rec in zip(runs, alone)
+              if det.t_q == 25.0}
+    assert energy["per"] > energy["swapped"] and energy["amb"] > energy["swapped"]
+
+
+def test_cost_sums_match_the_history():
+    """``TrialRecord.cost`` equals the sums over the trial's own history: the
+    cross-track error of ``scenario/run.py`` and the commands, over the steps
+    flown; the trial columns are their RMS, maximum and energies."""
+    spec = chunk_spec(config())
+    setup = spec.setup
+    inp, _ = trial_inputs(spec, "elevon_loss", np.arange(4))
+    rec = run_alone(setup, "per", setup.det["per"], inp, 64, history=True)
+    g = setup.plant.trim.gamma0
+    x = rec.hist_x[:, LONGITUDINAL.state("x")]
+    z = rec.hist_x[:, LONGITUDINAL.state("z")]
+    cross = x * math.sin(g) + z * math.cos(g)
+    assert (rec.status == 0).all()
+    np.testing.assert_allclose(rec.cost[COST_TRACK_SQ], (cross ** 2).sum(axis=0), rtol=1e-12)
+    np.testing.assert_array_equal(rec.cost[COST_TRACK_MAX], np.abs(cross).max(axis=0))
+    np.testing.assert_allclose(rec.cost[COST_U2:], (rec.hist_u ** 2).sum(axis=0), rtol=1e-12)
+    assert np.any(rec.hist_exc[:, 2] == 1.0) and np.any(rec.hist_exc[:, 3] == 1.0)
+
+
+def test_campaign_columns_and_summary():
+    """Every trial row carries the cost columns; the summary their RMS, maxima
+    and mean energies; a periodic policy spends more control energy than the
+    same design without it, on the same trials; results do not depend on the
+    chunking."""
+    res = api.run_campaign(config(), jobs=1, progress=False)
+    t = res.trials
+    assert set(COST_COLUMNS) <= set(t.columns)
+    assert list(t.columns[-len(COST_COLUMNS):]) == list(COST_COLUMNS)
+    assert (t["track_rms_m"] > 0).all() and (t["track_max_m"] >= t["track_rms_m"]).all()
+    s = res.summary.set_index("variant")
+    for col in ("track_rms_m", "track_max_m_mean", "track_max_m", *COST_COLUMNS[2:]):
+        assert np.isfinite(s[col]).all(), col
+    for col in COST_COLUMNS[2:]:
+        assert s.loc["per", col] > s.loc["swapped", col], col
+    again = api.run_campaign(config(campaign={"transitions": ["elevon_loss"], "trials": 8,
+                                              "chunk_size": 3, "signature": "swapped",
+                                              "designs": ["per", "amb"]}),
+                             jobs=1, progress=False)
+    pd.testing.assert_frame_equal(t, again.trials, check_exact=True)
+
+
+def test_sweep_runs_a_policy_like_any_design():
+    """``ftc-mc sweep`` with a policy design: each point's trials equal a
+    campaign at that point (the shared start is the design's own)."""
+    cfg = config(transitions=("engine_loss",), trials=6)
+    points = threshold_points("8,25")
+    res = run_sweep(cfg, points, flights=4, jobs=1, progress=False)
+    assert set(res.table["variant"]) == {"swapped", "per", "amb"}
+    for t, _ in points:
+        est = cfg.estimator.model_copy(update={"t_q": t, "t_nx": t})
+        designs = {n: d.model_copy(update={"t_q": t, "t_nx": t}) for n, d in cfg.designs.items()}
+        alone = api.run_campaign(cfg.model_copy(update={"estimator": est, "designs": designs}),
+                                 jobs=1, progress=False).trials
+        shared = res.trials[res.trials.t_q == t].drop(columns=["t_q", "t_nx"])
+        pd.testing.assert_frame_equal(alone, shared.reset_index(drop=True), check_exact=True)
