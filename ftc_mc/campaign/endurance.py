@@ -287,4 +287,7 @@ def endurance_markdown(summary: pd.DataFrame) -> str:
                    for s, h, t, k in zip(summary["target_shown"], summary["hours_to_show"],
                                          summary["target_per_h"], summary["false_resets"])],
     })
+    if "bank_rms_deg" in summary:  # the 6-DOF plant
+        view["bank / heading RMS [deg]"] = [f"{b:.2f} / {h:.2f}" for b, h in zip(
+            summary["bank_rms_deg"], summary["heading_rms_deg"])]
     return view.to_markdown(index=False)

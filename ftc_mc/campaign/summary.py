@@ -330,6 +330,19 @@ def side_text(r, intervals: bool = True) -> str:
             f"{100 * r['correct_side_ci_low']:.1f}-{100 * r['correct_side_ci_high']:.1f})")
 
 
+def extra_columns(r) -> dict:
+    """The columns of a summary row that only some runs have: the 6-DOF plant's
+    bank and heading RMS [deg], and the glide-path tracking RMS [m] with the
+    control energy of the commands (issue 25)."""
+    out = {}
+    if "bank_rms_deg" in r and np.isfinite(r["bank_rms_deg"]):
+        out["bank / heading RMS [deg]"] = (f"{r['bank_rms_deg']:.2f} / "
+                                           f"{r['heading_rms_deg']:.2f}")
+    if "track_rms_m" in r and np.isfinite(r["track_rms_m"]):
+        out["track RMS [m]"] = f"{r['track_rms_m']:.3g}"
+    return out
+
+
 def markdown_table(summary: pd.DataFrame) -> str:
     """The summary as the paper's columns plus ours, in Markdown.
 
@@ -364,6 +377,7 @@ def markdown_table(summary: pd.DataFrame) -> str:
             "detection median [s]": num(r["detection_median_s"]),
             "correct side (%, 95% CI)": side_text(r),
             "paper: inappropriate / no reset": paper_text(r),
+            **extra_columns(r),
         })
     table = pd.DataFrame(rows).to_markdown(index=False)
     return table + ("\n\n" + sensor if sensor else "")
