@@ -1,0 +1,181 @@
+"""Steady flight of the flying wing with one elevon locked (issue 26, item 5).
+
+The X8 has no rudder: with one elevon locked, pitch and roll share the healthy
+elevon, and the throttle is the only other control.  A lock offset is
+*trimmable* when some steady flight exists with it -- straight or turning, at
+any airspeed and flight path inside the validity envelope -- with the healthy
+elevon and the throttle within their limits.
+
+Steady flight (no wind) means constant body velocities and rates: a level or
+climbing/descending turn at the turn rate ``Omega`` about the vertical, body
+rates ``(p, q, r) = Omega (-sin theta, sin phi cos theta, cos phi cos theta)``,
+and the six body accelerations of the authors' equations
+(:func:`ftc_mc.model.sixdof.derivatives`) zero.  The unknowns are airspeed,
+angle of attack, sideslip, bank, pitch, turn rate, throttle and the healthy
+elevon: eight unknowns for six conditions, so a lock is trimmable when the
+least-squares residual over the envelope's box reaches zero
+(``scipy.optimize.least_squares`` with bounds, from the trim and from
+``starts`` random points of the box).  With ``V0`` and ``gamma0`` given, the
+airspeed is fixed and the air-path angle is a seventh condition.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+import scipy.optimize
+
+from ..core.sixdof.layout import COMMAND, LAYOUT, N_COMMAND, N_STATE, OUTPUT, STATE
+from .airframe import Airframe
+from .sixdof import derivatives, outputs, pack_parameters, trim6
+
+UNKNOWNS = ("airspeed", "alpha", "beta", "phi", "theta", "turn_rate", "throttle",
+            "free_elevon")
+"""The unknowns of a steady flight, in order (SI units, rad, rad/s)."""
+
+RESIDUAL_TOL = 1e-9
+"""Largest scaled acceleration residual [m/s^2; rad/s^2 / 10] of a steady flight."""
+
+
+@dataclasses.dataclass(frozen=True)
+class Envelope:
+    """The box the search stays in.
+
+    Attributes
+    ----------
+    airspeed : (float, float)
+        [m/s] (``validity.airspeed_*_mps``).
+    alpha : (float, float)
+        Angle of attack [rad] (``validity.alpha_*_deg``).
+    bank : float
+        Largest bank [rad] (``validity.bank_max_deg``).
+    """
+
+    airspeed: tuple = (12.0, 30.0)
+    alpha: tuple = (math.radians(-8.0), math.radians(12.0))
+    bank: float = math.radians(60.0)
+
+
+@dataclasses.dataclass(frozen=True)
+class SteadyFlight:
+    """The best steady flight found with one elevon locked.
+
+    Attributes
+    ----------
+    side : str
+        ``"left"`` or ``"right"``: the locked elevon.
+    lock : float
+        Its absolute position [rad].
+    offset : float
+        ``lock`` less the trim's position of that elevon [rad].
+    residual : float
+        Largest scaled acceleration left (:data:`RESIDUAL_TOL` or less: steady).
+    values : dict
+        :data:`UNKNOWNS` -> value at the best point; ``gamma`` the air-path angle.
+    """
+
+    side: str
+    lock: float
+    offset: float
+    residual: float
+    values: dict
+
+    @property
+    def steady(self) -> bool:
+        """Whether a steady flight exists (the residual reached zero)."""
+        return self.residual <= RESIDUAL_TOL
+
+
+def _state(w, side, pos):
+    V, alpha, beta, phi, theta, om, thr, e = w
+    x = np.zeros(N_STATE)
+    x[STATE["phi"]], x[STATE["theta"]] = phi, theta
+    x[STATE["u"]] = V * math.cos(alpha) * math.cos(beta)
+    x[STATE["v"]] = V * math.sin(beta)
+    x[STATE["w"]] = V * math.sin(alpha) * math.cos(beta)
+    x[STATE["p"]] = -om * math.sin(theta)
+    x[STATE["q"]] = om * math.sin(phi) * math.cos(theta)
+    x[STATE["r"]] = om * math.cos(phi) * math.cos(theta)
+    cmd = np.zeros(N_COMMAND)
+    cmd[COMMAND["throttle"]] = thr
+    cmd[COMMAND[side]] = pos
+    cmd[COMMAND["right" if side == "left" else "left"]] = e
+    for name in LAYOUT.actuators:
+        x[STATE[name]] = cmd[COMMAND[name]]
+    return x, cmd
+
+
+def steady_flight(airframe: Airframe, side: str, lock: float, envelope: Envelope = Envelope(),
+                  V0: float | None = None, gamma0_deg: float | None = None, starts: int = 12,
+                  seed: int = 0) -> SteadyFlight:
+    """The best steady flight with the ``side`` elevon locked at ``lock`` [rad].
+
+    Parameters
+    ----------
+    airframe : Airframe
+        With lateral-directional data.
+    side : {"left", "right"}
+    lock : float
+        Absolute position of the locked elevon [rad].
+    envelope : Envelope
+    V0, gamma0_deg : float, optional
+        Fix the airspeed [m/s] and the air-path angle [deg]; free by default.
+    starts : int
+        Random starting points tried after the trim (the search stops at the
+        first steady one).
+    seed : int
+        Their generator's seed.
+    """
+    tr = trim6(airframe)
+    p = pack_parameters(airframe, tr.V0, tr.gamma0)
+    rows = [STATE[n] for n in ("u", "v", "w", "p", "q", "r")]
+    scale = np.array([1.0, 1.0, 1.0, 10.0, 10.0, 10.0])
+    lo_e, hi_e = airframe.elevon_limits
+    lo_t, hi_t = airframe.throttle_limits
+    lo = np.array([envelope.airspeed[0], envelope.alpha[0], -0.5, -envelope.bank, -1.2,
+                   -2.0, lo_t, lo_e])
+    hi = np.array([envelope.airspeed[1], envelope.alpha[1], 0.5, envelope.bank, 1.2, 2.0,
+                   hi_t, hi_e])
+    free = slice(0 if V0 is None else 1, None)  # a fixed airspeed is no unknown
+    lo, hi = lo[free], hi[free]
+
+    def full(w):
+        return w if V0 is None else np.concatenate(([V0], w))
+
+    def residual(w):
+        x, cmd = _state(full(w), side, lock)
+        out = derivatives(x, cmd, p)[rows] / scale
+        if gamma0_deg is not None:
+            out = np.append(out, outputs(x, p)[OUTPUT["gamma"]] - math.radians(gamma0_deg))
+        return out
+
+    other = "right" if side == "left" else "left"
+    first = np.array([tr.V0, tr.alpha, 0.0, 0.0, tr.x0[STATE["theta"]], 0.0,
+                      tr.u0[COMMAND["throttle"]], tr.u0[COMMAND[other]]])
+    first = first[free]
+    rng = np.random.default_rng(seed)
+    best = None
+    for s in range(starts + 1):
+        w0 = np.clip(first, lo, hi) if s == 0 else rng.uniform(lo, hi)
+        sol = scipy.optimize.least_squares(residual, w0, bounds=(lo, hi), xtol=1e-15,
+                                           ftol=1e-15, gtol=1e-15)
+        if best is None or sol.cost < best.cost:
+            best = sol
+        if np.max(np.abs(best.fun)) <= RESIDUAL_TOL:
+            break
+    w = full(best.x)
+    x, _ = _state(w, side, lock)
+    values = dict(zip(UNKNOWNS, (float(v) for v in w)))
+    values["gamma"] = float(outputs(x, p)[OUTPUT["gamma"]])
+    return SteadyFlight(side=side, lock=float(lock),
+                        offset=float(lock - tr.u0[COMMAND[side]]),
+                        residual=float(np.max(np.abs(best.fun))), values=values)
+
+
+def trimmable_set(airframe: Airframe, side: str, offsets_deg, **kw) -> list:
+    """:func:`steady_flight` at each lock offset from trim [deg] of ``side``."""
+    tr = trim6(airframe)
+    return [steady_flight(airframe, side, tr.u0[COMMAND[side]] + math.radians(o), **kw)
+            for o in offsets_deg]
