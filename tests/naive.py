@@ -731,6 +731,17 @@ def commands_ref(scheme, st, k):
     return u, out
 
 
+def dryden_ref(turb, Ad, Bd, Cd, state, eta):
+    """One step of a discrete Dryden shaping filter on every lane: the gust held
+    over the step ``Cd s_k``, the next state ``Ad s_k + Bd eta_k`` and the gust at
+    the next sample; in still air (``turb`` 0) zero gusts and the state kept."""
+    if not turb:
+        L = state.shape[1]
+        return np.zeros((Cd.shape[0], L)), state.copy(), np.zeros((Cd.shape[0], L))
+    nxt = Ad @ state + Bd @ eta
+    return Cd @ state, nxt, Cd @ nxt
+
+
 def truth_step_ref(scheme, flight, inp, k, st, u):
     """The truth over step ``k``: effect (eq. 2), Dryden gust, linear (eq. 1) or
     nonlinear (RK4) plant, measurement and air data.  Returns a dict with ``x``,
@@ -742,13 +753,8 @@ def truth_step_ref(scheme, flight, inp, k, st, u):
     ev = int(np.searchsorted(inp.k_switch, k, side="right")) - 1
     e = np.column_stack([effect(u[:, l], fm.u0, inp.b0[ev][:, l], inp.b1[ev][:, l])
                          for l in range(L)])
-    gust = st.gust.copy()
-    wind = np.zeros((3, L))
-    wind_next = np.zeros((3, L))
-    if pl.turb:
-        wind = pl.Cd @ st.gust
-        gust = pl.Ad @ st.gust + pl.Bd @ inp.eta[k]
-        wind_next = pl.Cd @ gust
+    wind, gust, wind_next = dryden_ref(pl.turb, pl.Ad, pl.Bd, pl.Cd, st.gust,
+                                       inp.eta[k] if pl.turb else None)
     if pl.kind == 0:
         x = fm.A @ st.x + fm.B @ e + pl.Bw @ wind + inp.w[k]
         z = fm.C @ x + pl.Dw @ wind_next + inp.v[k]

@@ -178,7 +178,7 @@ def sixdof_truth_ref(scheme, flight, inp, k, st, rec, u):
     """
     from ftc_mc.conventions import LONGITUDINAL
     from ftc_mc.model.faults import effect
-    from naive import sensor_fault_ref
+    from naive import dryden_ref, sensor_fault_ref
 
     fm, ctl, pl = scheme.filter, scheme.controller, flight.plant
     L = st.x.shape[1]
@@ -196,18 +196,9 @@ def sixdof_truth_ref(scheme, flight, inp, k, st, rec, u):
     ev = int(np.searchsorted(inp.k_switch, k, side="right")) - 1
     e = np.column_stack([effect(u[:, l], fm.u0, inp.b0[ev][:, l], inp.b1[ev][:, l])
                          for l in range(L)])
-    gust, glat = st.gust.copy(), st.glat.copy()
-    lon_w = np.zeros((3, L))
-    lon_wn = np.zeros((3, L))
-    lat_w = np.zeros((3, L))
-    lat_wn = np.zeros((3, L))
-    if pl.turb:
-        lon_w = pl.Cd @ st.gust
-        gust = pl.Ad @ st.gust + pl.Bd @ inp.eta[k]
-        lon_wn = pl.Cd @ gust
-        lat_w = pl.Cdl @ st.glat
-        glat = pl.Adl @ st.glat + pl.Bdl @ inp.eta_lat[k]
-        lat_wn = pl.Cdl @ glat
+    eta, eta_lat = (inp.eta[k], inp.eta_lat[k]) if pl.turb else (None, None)
+    lon_w, gust, lon_wn = dryden_ref(pl.turb, pl.Ad, pl.Bd, pl.Cd, st.gust, eta)
+    lat_w, glat, lat_wn = dryden_ref(pl.turb, pl.Adl, pl.Bdl, pl.Cdl, st.glat, eta_lat)
 
     def wind(lon, latw, l):
         w = np.zeros(len(LAYOUT.wind))

@@ -288,7 +288,6 @@ def test_other_design_set_is_never_resumed_or_overwritten(tmp_path):
 def test_shared_start_per_design_equals_running_alone():
     """Sweep sharing groups runs by design key; each gives the records it gives alone."""
     from ftc_mc.campaign.chunk import chunk_spec, trial_inputs
-    from ftc_mc.sim.lanes import simulate
 
     cfg = config(plant={"turbulence": "light"}, campaign={"trials": 4, "designs": [
         "gust_glr", "tight"], "transitions": ["elevon_lock"]})
@@ -296,10 +295,20 @@ def test_shared_start_per_design_equals_running_alone():
     setup = spec.setup
     inp, _ = trial_inputs(spec, "elevon_lock", np.arange(4))
     runs = [(n, setup.detection(n, t, t)) for t in (10.0, 40.0) for n in setup.designs]
+    sim, (alone, sim_alone) = assert_shared_start_exact(setup, inp, runs)
+    assert sim_alone == 4 * setup.tim.n_steps * len(runs)
+
+
+def assert_shared_start_exact(setup, inp, runs):
+    """Every run's records with a shared start up to the switch equal its
+    records alone (``sim.lanes.simulate``); returns the shared run's lane
+    steps and the alone ``(records, lane steps)``."""
+    from ftc_mc.sim.lanes import simulate
+
     shared, sim = simulate(setup, inp, runs, 64, setup.tim.k_fault)
     alone, sim_alone = simulate(setup, inp, runs, 64)
     for (name, det), a, b in zip(runs, shared, alone):
         for f in a._fields:
             np.testing.assert_array_equal(getattr(a, f), getattr(b, f),
                                           err_msg=f"{name} {det.t_q} {f}")
-    assert sim_alone == 4 * setup.tim.n_steps * len(runs)
+    return sim, (alone, sim_alone)

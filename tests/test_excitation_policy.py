@@ -20,7 +20,8 @@ from ftc_mc.conventions import (COST_TRACK_MAX, COST_TRACK_SQ, COST_U2, EXCITE_A
                                 EXCITE_NONE, EXCITE_PERIODIC, LONGITUDINAL)
 from ftc_mc.errors import UserError
 from ftc_mc.sim.designs import NO_POLICY
-from ftc_mc.sim.lanes import run_alone, simulate
+from ftc_mc.sim.lanes import run_alone
+from test_designs import assert_shared_start_exact
 
 PERIODIC = {"excitation_policy": "periodic", "excitation_period_s": 4.0,
             "excitation_phase_s": 1.0}
@@ -87,12 +88,7 @@ def test_shared_start_with_a_policy_equals_running_alone():
     setup = spec.setup
     inp, _ = trial_inputs(spec, "engine_loss", np.arange(8))
     runs = [(n, setup.detection(n, t, t)) for t in (8.0, 25.0) for n in setup.designs]
-    shared, _ = simulate(setup, inp, runs, 64, setup.tim.k_fault)
-    alone, _ = simulate(setup, inp, runs, 64)
-    for (name, det), a, b in zip(runs, shared, alone):
-        for f in a._fields:
-            np.testing.assert_array_equal(getattr(a, f), getattr(b, f),
-                                          err_msg=f"{name} {det.t_q} {f}")
+    _, (alone, _) = assert_shared_start_exact(setup, inp, runs)
     energy = {name: rec.cost[COST_U2].sum() for (name, det), rec in zip(runs, alone)
               if det.t_q == 25.0}
     assert energy["per"] > energy["swapped"] and energy["amb"] > energy["swapped"]

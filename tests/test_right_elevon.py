@@ -18,16 +18,10 @@ from ftc_mc.conventions import (ACTUATOR_NAMES, MODE_LEFT_ELEVON, MODE_NOMINAL,
                                 RIGHT_ELEVON_TRANSITIONS, STATUS_AIRSPEED, TRANSITIONS)
 from ftc_mc.sim.lanes import new_record
 from ftc_mc.stats import wilson
+from test_campaign import small_config
 
 LEFT = ACTUATOR_NAMES.index("left_elevon")
 RIGHT = ACTUATOR_NAMES.index("right_elevon")
-SMALL = {"timing": {"fault_time_s": 5.0, "window_s": 5.0, "duration_s": 15.0}}
-
-
-def small_config(transitions, trials=8, **campaign):
-    return Config.model_validate({"campaign": {"transitions": list(transitions),
-                                               "trials": trials, "chunk_size": 4,
-                                               **campaign}, **SMALL})
 
 
 @pytest.fixture(scope="module")

@@ -123,17 +123,13 @@ TRANSITION_TABLE = {
                    "Engine nominal → Engine less efficient"),
         Transition("engine_loss_recover", ENGINE, "loss", False,
                    "Engine less efficient → Engine nominal"),
-        # issue 24: the elevon rows on the right elevon (not in the paper)
-        Transition("right_elevon_lock", RIGHT, "lock", True,
-                   "Right elevon nominal → Right elevon locked"),
-        Transition("right_elevon_unlock", RIGHT, "lock", False,
-                   "Right elevon locked → Right elevon nominal"),
-        Transition("right_elevon_loss", RIGHT, "loss", True,
-                   "Right elevon nominal → Right elevon less efficient"),
-        Transition("right_elevon_loss_recover", RIGHT, "loss", False,
-                   "Right elevon less efficient → Right elevon nominal"),
     ]
 }
+# issue 24: the elevon rows again on the right elevon (not in the paper)
+TRANSITION_TABLE.update(
+    (f"right_{t.name}", dataclasses.replace(t, name=f"right_{t.name}", actuator=RIGHT,
+                                            label=t.label.replace("Elevon", "Right elevon")))
+    for t in list(TRANSITION_TABLE.values()) if t.actuator == LEFT)
 """Every actuator transition by name, the paper's eight rows first (their order in
 tables), then the right elevon's (:data:`~ftc_mc.conventions.TRANSITIONS`)."""
 assert tuple(TRANSITION_TABLE) == TRANSITIONS

@@ -129,7 +129,7 @@ def lateral_arrays(setup, n: int, L: int):
     """Zeroed ``(v_lat, eta_lat, g0_lat)`` of ``L`` lanes: sized for the 6-DOF
     family's lateral loop and gusts (:mod:`ftc_mc.core.sixdof.truth`, imported
     only then), empty on the longitudinal plants."""
-    if getattr(setup, "dof", 3) != 6:
+    if setup.dof != 6:
         return np.zeros((0, 0, L)), np.zeros((0, 0, L)), np.zeros((0, L))
     from ..core.sixdof.truth import N_LAT_GUST_NOISE, N_LAT_GUST_STATE
 
@@ -189,7 +189,7 @@ def draw_lanes(setup, trial_ids, seed: int, fault_range=None) -> LaneDraws:
     turbulent = setup.gust_chol is not None
     eta = np.zeros((n if turbulent else 0, 4, L))
     g0 = np.zeros((4, L))
-    six = getattr(setup, "dof", 3) == 6
+    six = setup.dof == 6
     v_lat, eta_lat, g0_lat = lateral_arrays(setup, n, L)
     for l, tid in enumerate(trial_ids):
         fault[l], w[:, :, l], v[:, :, l], gust = draw_lane(
