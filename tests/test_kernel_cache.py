@@ -163,3 +163,58 @@ def test_the_digest_reads_core_recursively_and_what_it_imports(tmp_path):
     assert with_import != digest
     (root / "ftc_mc" / "layouts.py").write_text("N = 4\n")
     assert jit.source_digest(core) != with_import
+
+
+LATE = '''"""A kernel module imported after an edit, for tests/test_kernel_cache.py."""
+from .jit import kernel
+from .probe_parts.scale import scaled
+
+
+@kernel
+def late(x):
+    return scaled(x) - 1.0
+'''
+
+RACE = '''
+import json, sys
+from pathlib import Path
+from ftc_mc.core import jit
+from ftc_mc.core.probe_parts import scale   # imported with FACTOR = 2
+Path(scale.__file__).write_text(sys.argv[1])   # then edited: FACTOR = 3
+from ftc_mc.core.late import late            # imported after the edit
+value = late(1.5)                            # inlines the scale it imported: 2
+print(json.dumps({"value": value, "digest": jit.source_digest(),
+                  "unchanged": jit.sources_unchanged(),
+                  "files": [p.name for p in Path(late._cache.cache_path).glob("late.*")]}))
+'''
+
+
+@pytest.mark.skipif(not jit.CACHE, reason="FTC_MC_NUMBA_CACHE=0")
+def test_sources_edited_while_a_process_runs_never_leave_a_stale_kernel(tmp_path):
+    """A process that imported a kernel source before an edit and another after
+    it compiles a kernel of old and new code.  Its folder and stamp are the new
+    digest's, so saved, it would be loaded stale by every later process of the
+    new sources.  It is not saved, and the next process compiles the new value."""
+    root = _copy(tmp_path / "a")
+    (root / "ftc_mc" / "core" / "late.py").write_text(LATE)
+    cache = tmp_path / "cache"
+    env = {k: v for k, v in os.environ.items()
+           if k not in ("NUMBA_CACHE_DIR", "FTC_MC_NUMBA_CACHE", "PYTHONPATH")}
+    env.update(PYTHONPATH=str(root), FTC_MC_CACHE_DIR=str(cache))
+    out = subprocess.run([sys.executable, "-c", RACE, SCALE.format(factor=3.0)], cwd=root,
+                         env=env, capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr
+    race = json.loads(out.stdout.splitlines()[-1])
+    assert race["value"] == 2.0 * 1.5 - 1.0 and race["unchanged"] is False
+    assert race["files"] == [] and "not cached" in out.stderr
+    after = subprocess.run(
+        [sys.executable, "-c", "import json; from ftc_mc.core import jit; "
+         "from ftc_mc.core.late import late; "
+         "print(json.dumps({'value': late(1.5), 'digest': jit.source_digest(), "
+         "'hits': sum(late.stats.cache_hits.values())}))"],
+        cwd=root, env=env, capture_output=True, text=True, timeout=300)
+    assert after.returncode == 0, after.stderr
+    res = json.loads(after.stdout.splitlines()[-1])
+    assert res["digest"] == race["digest"] and res["hits"] == 0
+    assert res["value"] == 3.0 * 1.5 - 1.0
+    assert "not cached" not in after.stderr

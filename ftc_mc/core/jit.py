@@ -5,15 +5,16 @@ on the content of every kernel source.  Numba on its own keys a cached kernel on
 its own file only (its folder on the file's absolute path, its stamp on that
 file alone), so a kernel that inlines others would be loaded stale after an edit of
 theirs, and a second clone of the same sources would compile everything again.
-Here instead (:class:`ContentCacheLocator`, placed first in Numba's list of cache
-locators), a kernel defined under ``ftc_mc/core/`` is cached in a folder named
+Here instead (:class:`ContentCacheLocator`, the first locator of each kernel's
+cache, :class:`ContentFunctionCache`), a kernel defined under ``ftc_mc/core/`` is cached in a folder named
 after a digest of the kernel sources (:func:`source_digest`: every ``.py`` file
 under ``core/``, read recursively, and the modules outside it that they import,
 such as ``conventions.py``), and its index is stamped with that digest:
 ``$FTC_MC_CACHE_DIR/numba/<digest>/core/`` (``~/.cache/ftc-mc/numba/<digest>``
 by default).  No path of the clone enters the folder or the stamp, so another
 clone or install of identical sources loads the kernels, while any edit of a
-kernel source starts a new folder.  ``NUMBA_CACHE_DIR`` in the environment takes
+kernel source starts a new folder.  A process whose kernel sources change while
+it runs saves no kernel (:func:`sources_unchanged`).  ``NUMBA_CACHE_DIR`` in the environment takes
 precedence over ``$FTC_MC_CACHE_DIR/numba`` (``$NUMBA_CACHE_DIR/<digest>``; the
 benchmarks point it at an empty folder), and ``FTC_MC_NUMBA_CACHE=0`` turns caching off.  ``fastmath`` stays
 off: it was no faster here (``scripts/bench_core.py``) and breaks bit-for-bit
@@ -107,23 +108,48 @@ def kernel_sources(core: Path | None = None) -> list[Path]:
 
 _DIGESTS: dict = {}
 
+_FIRST_STATS: dict = {}
+"""Per kernel folder, the stamps of its sources when this process first read
+them (:func:`sources_unchanged`)."""
+
+
+def _source_stats(core: Path) -> tuple:
+    """(path, size, modification time) of every file of :func:`kernel_sources`."""
+    return tuple((str(p), st.st_size, st.st_mtime_ns)
+                 for p in kernel_sources(core) for st in [p.stat()])
+
 
 def full_source_digest(core: Path | None = None) -> str:
     """SHA-256 (hex) of the relative path and content of every file of
     :func:`kernel_sources`.  Read again only when a file's stamp (size,
     modification time) or the list of files changes."""
     core = CORE if core is None else Path(core).resolve()
-    files = kernel_sources(core)
-    stats = tuple((str(p), st.st_size, st.st_mtime_ns) for p in files for st in [p.stat()])
+    stats = _source_stats(core)
+    _FIRST_STATS.setdefault(str(core), stats)
     key = (str(core), stats)
     if key not in _DIGESTS:
         h = hashlib.sha256()
-        for path in files:
+        for path in (Path(name) for name, _, _ in stats):
             h.update(path.relative_to(core.parent).as_posix().encode() + b"\0")
             data = path.read_bytes()
             h.update(len(data).to_bytes(8, "little") + data)
         _DIGESTS[key] = h.hexdigest()
     return _DIGESTS[key]
+
+
+def sources_unchanged(core: Path | None = None) -> bool:
+    """Whether the kernel sources still have the stamps (size, modification
+    time) they had when this process first read them, and no file came or went.
+
+    A process that imports some kernel modules, and others after an edit (a
+    lazily imported module, a ``git checkout`` during a test run), compiles
+    kernels that mix old and new code.  Their folder and stamp are those of one
+    digest or the other, so a later process of either sources would load them:
+    :class:`ContentFunctionCache` does not save a kernel once this is false.
+    """
+    core = CORE if core is None else Path(core).resolve()
+    first = _FIRST_STATS.get(str(core))
+    return first is None or _source_stats(core) == first
 
 
 def source_digest(core: Path | None = None) -> str:
@@ -189,18 +215,36 @@ class ContentCacheLocator(caching._CacheLocator):
         return self
 
 
-def _register_locator() -> None:
-    """Put :class:`ContentCacheLocator` first in Numba's list of cache
-    locators (``numba.core.caching.CacheImpl``; ``_CacheImpl`` before Numba
-    0.61), once per process and package."""
-    impl = getattr(caching, "CacheImpl", None) or getattr(caching, "_CacheImpl")
-    classes = impl._locator_classes
-    if ContentCacheLocator not in classes:
-        classes.insert(0, ContentCacheLocator)
+class ContentCacheImpl(caching.FunctionCache._impl_class):
+    """The cache implementation of Numba's ``FunctionCache``, with
+    :class:`ContentCacheLocator` tried before Numba's own locators."""
+
+    _locator_classes = [ContentCacheLocator,
+                        *caching.FunctionCache._impl_class._locator_classes]
+
+
+class ContentFunctionCache(caching.FunctionCache):
+    """The on-disk cache of one kernel (:func:`kernel`): Numba's, located by
+    :class:`ContentCacheImpl`, that saves nothing once the kernel sources have
+    changed while this process ran (:func:`sources_unchanged`), and says so once
+    on stderr."""
+
+    _impl_class = ContentCacheImpl
+    _warned = False
+
+    def _save_overload(self, sig, data):
+        if not sources_unchanged():
+            if not ContentFunctionCache._warned:
+                import sys
+                print("ftc-mc: the kernel sources changed while this process ran; "
+                      "its compiled kernels are not cached", file=sys.stderr, flush=True)
+                ContentFunctionCache._warned = True
+            return
+        super()._save_overload(sig, data)
 
 
 if CACHE:
-    _register_locator()
+    full_source_digest()  # the stamps every later save is checked against
     if not os.environ.get("NUMBA_CACHE_DIR"):
         # kernels compiled with cache=True outside core/ (tests, benchmarks)
         # and the compile lock (sim.compiling) use Numba's own setting
@@ -221,8 +265,18 @@ def kernel(func=None, **overrides):
     """
     opts = dict(OPTIONS, **overrides)
     if func is None:
-        return lambda f: numba.njit(**opts)(f)
-    return numba.njit(**opts)(func)
+        return lambda f: _njit(f, opts)
+    return _njit(func, opts)
+
+
+def _njit(func, opts):
+    """``numba.njit(**opts)(func)``, its disk cache a :class:`ContentFunctionCache`."""
+    opts = dict(opts)
+    cache = opts.pop("cache")
+    dispatcher = numba.njit(**opts)(func)
+    if cache:
+        dispatcher._cache = ContentFunctionCache(func)  # Dispatcher.enable_caching
+    return dispatcher
 
 
 COMPILE_NOTICE = ("ftc-mc: compiling the simulation kernels of this path once: {} "
