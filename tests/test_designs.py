@@ -312,3 +312,29 @@ def assert_shared_start_exact(setup, inp, runs):
             np.testing.assert_array_equal(getattr(a, f), getattr(b, f),
                                           err_msg=f"{name} {det.t_q} {f}")
     return sim, (alone, sim_alone)
+
+
+def test_a_design_flies_its_own_controller_on_the_same_trials():
+    """``controller`` of a design: a nominal-controller design run beside the
+    reconfiguring paper flies c0 throughout and equals the paper's own run with
+    ``controller.kind: nominal``, trial by trial; null keeps the section's kind."""
+    data = {"designs": {"paper_c0": {"signature": "paper", "controller": "nominal"}},
+            "campaign": {"designs": ["paper_c0"], "trials": 4, "signature": "paper",
+                         "transitions": ["engine_lock"]},
+            "timing": {"fault_time_s": 2.0, "window_s": 3.0, "duration_s": 6.0},
+            "controller": {"kind": "reconfiguring"}}
+    cfg = validate_model(Config, data, "test.yaml")
+    assert cfg.controller_of("paper_c0") == "nominal"
+    assert cfg.controller_of("paper") == "reconfiguring"
+    both = api.run_campaign(cfg, progress=False, jobs=1).trials
+    nominal = validate_model(Config, {**data, "controller": {"kind": "nominal"},
+                                      "campaign": {**data["campaign"], "designs": []}},
+                             "test.yaml")
+    alone = api.run_campaign(nominal, progress=False, jobs=1).trials
+    c0 = both[both.variant == "paper_c0"].reset_index(drop=True)
+    ref = alone.reset_index(drop=True)
+    for col in ref.columns.drop("variant"):
+        np.testing.assert_array_equal(c0[col].to_numpy(), ref[col].to_numpy(), err_msg=col)
+    rc = both[both.variant == "paper"].reset_index(drop=True)
+    # the reconfiguring paper flies otherwise after the switch (c1 chosen in some trial)
+    assert not np.array_equal(rc["b1_hat_end"].to_numpy(), c0["b1_hat_end"].to_numpy())

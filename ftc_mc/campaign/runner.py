@@ -107,7 +107,7 @@ def auto_jobs(cfg: Config, n_variants: int, backend: str = "threads") -> int:
     on the nonlinear plant about four (``scripts/bench_truth.py``).
     """
     c = cfg.campaign
-    weight = 6 if cfg.controller.kind == "reconfiguring" else 1
+    weight = 6 if any(cfg.controller_of(d) == "reconfiguring" for d in c.runs()) else 1
     weight *= 4 if cfg.plant.kind == "nonlinear" else 1
     steps = c.trials * len(c.transitions) * n_variants * cfg.steps(cfg.timing.duration_s)
     if backend != "threads" and steps * weight < SMALL_RUN_STEPS:

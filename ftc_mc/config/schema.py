@@ -109,6 +109,12 @@ class _Sampled(_Strict):
         """Number of sampling periods in ``seconds``."""
         return int(round(seconds / self.model.dt_s))
 
+    def controller_of(self, design: str) -> str:
+        """The controller kind the design ``design`` flies: its own
+        ``controller``, else the ``controller`` section's ``kind``."""
+        dc = self.designs.get(design)
+        return dc.controller if dc is not None and dc.controller else self.controller.kind
+
 
 class ModelConfig(_Strict):
     """Airframe, trim point and sampling (paper section 5.1)."""
@@ -451,6 +457,9 @@ class DesignConfig(_Strict):
     """ambiguous: send while the belief's most probable mode has a probability below this (0: never on the belief)."""
     excitation_residual: Pos | None = None
     """ambiguous: send when r_q or r_nx (the design's decision statistics: one-step residuals or GLR) reach this; null: never on the residuals. Below Table 1's thresholds it excites a suspected change before it is decided."""
+
+    controller: Literal["nominal", "reconfiguring"] | None = None
+    """Controller of this design's flights: nominal (c0 throughout) or reconfiguring (c0/c1/c2 chosen by eqs. 45-47), so one campaign compares both on the same trials; null: the controller section's kind."""
 
     @model_validator(mode="after")
     def _biases(self):

@@ -14,9 +14,10 @@ def summary_markdown(res: ScenarioResult) -> str:
     """Our timeline beside the paper's, event by event."""
     seg = res.segments.copy()
     ev = res.events
+    design = res.config.scenario.design or res.config.scenario.signature
     lines = ["# ftc-mc scenario", "",
-             f"Design: `{res.config.scenario.design or res.config.scenario.signature}`; controller: "
-             f"`{res.config.controller.kind}`; seed {res.config.scenario.seed}; "
+             f"Design: `{design}`; controller: "
+             f"`{res.config.controller_of(design)}`; seed {res.config.scenario.seed}; "
              f"truth plant `{res.config.plant.kind}`, turbulence "
              f"`{res.config.plant.turbulence}`; run status: `{res.status}`.", "",
              "## Detection of each schedule entry", ""]

@@ -104,6 +104,9 @@ class Design:
         states (the last ``len(biases)`` of the estimate).
     excitation : dict
         The policy fields of the kernels' ``Excitation`` (:func:`excitation_policy`).
+    controller : str or None
+        ``nominal`` or ``reconfiguring``: the design's own controller kind;
+        None: the config's ``controller.kind``.
     """
 
     name: str
@@ -116,6 +119,7 @@ class Design:
     key: str
     biases: tuple = ()
     excitation: dict = dataclasses.field(default_factory=lambda: dict(NO_POLICY))
+    controller: str | None = None
 
     @property
     def n_aug(self) -> int:
@@ -219,7 +223,7 @@ def build_design(name: str, dc: DesignConfig, plant: LinearPlant, est: Estimator
     key = dc.model_dump_json(exclude={"signature", "t_q", "t_nx"})
     return Design(name=name, est=s, fm=fm, det=det, P0=_c(P0), test=test, window=window,
                   key=key, biases=tuple(dc.sensor_biases),
-                  excitation=excitation_policy(dc, plant.dt))
+                  excitation=excitation_policy(dc, plant.dt), controller=dc.controller)
 
 
 SENSOR_BIAS_SD = {"q": 5.0 * math.pi / 180.0, "n_x": 0.08, "n_z": 0.08}

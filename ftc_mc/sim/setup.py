@@ -37,6 +37,10 @@ from .estimator import (EstimatorSettings, belief_settings, detection, filter_mo
                         initial_covariance)
 from .truth import lateral_noise, sixdof_truth_plant, truth_plant
 
+CONTROLLER_KINDS = {"nominal": 0, "reconfiguring": 1}
+"""``Reconfig.kind`` of each controller kind (``controller.kind``, a design's
+``controller``)."""
+
 
 @dataclasses.dataclass(frozen=True)
 class SimSetup:
@@ -113,12 +117,19 @@ class SimSetup:
 
     def scheme(self, name: str, detection: Detection | None = None) -> Scheme:
         """The kernels' :class:`Scheme` of the design ``name``: its filter, its
-        detection (or ``detection``) and its excitation policy."""
+        detection (or ``detection``), its excitation policy and its controller
+        kind (:meth:`reconfig_of`)."""
         d: Design = self.designs[name]
         return Scheme(filter=d.fm, detection=d.det if detection is None else detection,
                       belief=self.bs, controller=self.ctl,
                       excitation=self.exc._replace(**d.excitation),
-                      reconfig=self.rc, engine=self.eng)
+                      reconfig=self.reconfig_of(name), engine=self.eng)
+
+    def reconfig_of(self, name: str) -> Reconfig:
+        """The kernels' :class:`Reconfig` of the design ``name``: the config's,
+        with the design's own controller kind when it sets one."""
+        kind = self.designs[name].controller
+        return self.rc if kind is None else self.rc._replace(kind=CONTROLLER_KINDS[kind])
 
     @property
     def flight(self) -> Flight:
@@ -209,7 +220,7 @@ def build_setup(cfg: Config | ScenarioConfig) -> SimSetup:
     q_diag, r_diag = np.ascontiguousarray(np.diag(Q)), np.ascontiguousarray(np.diag(R))
     JN = terminal_costs(fm, ctl.K, eng, ctl.lo_dev, ctl.hi_dev, c.discount, q_diag,
                         r_diag, cfg.steps(c.terminal_horizon_s))
-    rc = Reconfig(kind=0 if c.kind == "nominal" else 1, horizon=cfg.steps(c.horizon_s),
+    rc = Reconfig(kind=CONTROLLER_KINDS[c.kind], horizon=cfg.steps(c.horizon_s),
                   alpha=float(c.discount), q_lqr=q_diag, r_lqr=r_diag, JN=JN,
                   penalty=c.switch_penalty * (1.0 - np.eye(3)))
     x = cfg.excitation
