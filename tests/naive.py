@@ -941,18 +941,25 @@ def policy_signals_ref(exc, st, kn, res, d_start, s_start):
                     d_start[l] = kn
 
 
-def record_cost_ref(track, x, u, alive, cost):
+def record_cost_ref(track, k_switch, kn, x, u, alive, cost, marks):
     """The cost sums after a truth step (issue 25): for each live lane, the
     glide path's cross-track error ``c = x sin(gamma0) + z cos(gamma0)`` of the
     true state ``x`` adds ``c^2`` to row 0 and raises row 1 to ``|c|``; each
-    command adds its square to rows 2-4.  Returns the updated copy of ``cost``."""
+    command adds its square to rows 2-4.  The height marks (issue 26): a live
+    lane's ``z`` goes to ``marks[1]``, and to ``marks[0]`` when the step reached
+    ``kn`` is the switch ``k_switch``.  Returns updated copies of ``cost`` and
+    ``marks``."""
     cost = cost.copy()
-    c = x[track.ix] * track.sin_g + x[track.iz] * track.cos_g
+    marks = marks.copy()
     live = np.asarray(alive, dtype=bool)
+    marks[1, live] = x[track.iz, live]
+    if kn == k_switch:
+        marks[0, live] = x[track.iz, live]
+    c = x[track.ix] * track.sin_g + x[track.iz] * track.cos_g
     cost[0, live] += c[live] ** 2
     cost[1, live] = np.maximum(cost[1, live], np.abs(c[live]))
     cost[2:, live] += u[:, live] ** 2
-    return cost
+    return cost, marks
 
 
 def record_step_ref(k, st, u, res, exc, wind, block, hist):
@@ -1006,7 +1013,9 @@ def advance_ref(scheme, flight, inp, rec, st, k0, k1):
         u, exc = commands_ref(scheme, st, k)
         tr = truth_step_ref(scheme, flight, inp, k, st, u)
         st.x[:], st.gust[:], st.zhold[:] = tr["x"], tr["gust"], tr["zhold"]
-        rec.cost[:] = record_cost_ref(flight.track, st.x, u, st.alive, rec.cost)
+        rec.cost[:], rec.z_switch_last[:] = record_cost_ref(
+            flight.track, flight.timing.k_fault, kn, st.x, u, st.alive, rec.cost,
+            rec.z_switch_last)
         for f, J in lane_jacobians_ref(scheme, st, u, k).items():
             getattr(st, f)[:] = J
         xa, P, res, block, rmax, ebuf, ecount, last_k, last_block = filter_update_ref(

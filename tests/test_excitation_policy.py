@@ -12,7 +12,7 @@ import pandas as pd
 import pytest
 
 from ftc_mc import api
-from ftc_mc.campaign.chunk import COST_COLUMNS, chunk_spec, trial_inputs
+from ftc_mc.campaign.chunk import COST_COLUMNS, chunk_spec, height_columns, trial_inputs
 from ftc_mc.campaign.sweep import run_sweep, threshold_points
 from ftc_mc.config import Config
 from ftc_mc.config.load import validate_model
@@ -111,6 +111,15 @@ def test_cost_sums_match_the_history():
     np.testing.assert_array_equal(rec.cost[COST_TRACK_MAX], np.abs(cross).max(axis=0))
     np.testing.assert_allclose(rec.cost[COST_U2:], (rec.hist_u ** 2).sum(axis=0), rtol=1e-12)
     assert np.any(rec.hist_exc[:, 2] == 1.0) and np.any(rec.hist_exc[:, 3] == 1.0)
+    # the height marks (issue 26): z after the switch step and after the last step,
+    # and the height lost between them, the glide path's descent included
+    kf, n = setup.tim.k_fault, setup.tim.n_steps
+    np.testing.assert_array_equal(rec.z_switch_last[0], z[kf - 1])
+    np.testing.assert_array_equal(rec.z_switch_last[1], z[n - 1])
+    dt, V0 = setup.plant.dt, setup.plant.trim.V0
+    height = V0 * math.sin(g) * dt * np.arange(1, n + 1)[:, None] - z  # above the start
+    lost = height_columns(rec, setup)["height_lost_m"]
+    np.testing.assert_allclose(lost, height[kf - 1] - height[n - 1], rtol=1e-12, atol=1e-12)
 
 
 def test_campaign_columns_and_summary():
@@ -121,7 +130,7 @@ def test_campaign_columns_and_summary():
     res = api.run_campaign(config(), jobs=1, progress=False)
     t = res.trials
     assert set(COST_COLUMNS) <= set(t.columns)
-    assert list(t.columns[-len(COST_COLUMNS):]) == list(COST_COLUMNS)
+    assert list(t.columns[-len(COST_COLUMNS) - 1:]) == [*COST_COLUMNS, "height_lost_m"]
     assert (t["track_rms_m"] > 0).all() and (t["track_max_m"] >= t["track_rms_m"]).all()
     s = res.summary.set_index("variant")
     for col in ("track_rms_m", "track_max_m_mean", "track_max_m", *COST_COLUMNS[2:]):

@@ -207,7 +207,7 @@ def new_rec(tim, L=L, max_resets=4, history=True):
         hist_pdiag=np.zeros((n_hist, 5, L)), hist_u=np.zeros((n_hist, 3, L)),
         hist_res=np.zeros((n_hist, 3, L)), hist_exc=np.zeros((n_hist, 4, L)),
         hist_block=np.zeros((n_hist, L), i8), hist_wind=np.zeros((n_hist, 3, L)),
-        sq_lat=np.zeros((2, L)), cost=np.zeros((N_COST, L)))
+        sq_lat=np.zeros((2, L)), cost=np.zeros((N_COST, L)), z_switch_last=np.zeros((2, L)))
 
 
 # ------------------------------------------------------------------ comparisons
@@ -622,11 +622,21 @@ def test_record_cost(linear, nonlinear_gusts):
         rec = new_rec(setup.tim)
         rec.cost[:] = rng.uniform(0.0, 10.0, rec.cost.shape)
         rec.cost[1, :2] = 1e-3  # below |c|: raised
-        want = naive.record_cost_ref(track, st.x, work.u, st.alive, rec.cost)
-        before = rec.cost.copy()
-        stages.record_cost(track, st, work, rec)
-        assert np.array_equal(rec.cost, want)
-        assert np.array_equal(rec.cost[:, ~st.alive], before[:, ~st.alive])
+        rec.z_switch_last[:] = rng.standard_normal(rec.z_switch_last.shape)
+        for kn in (setup.tim.k_fault - 1, setup.tim.k_fault):
+            want, marks = naive.record_cost_ref(track, setup.tim.k_fault, kn, st.x, work.u,
+                                                st.alive, rec.cost, rec.z_switch_last)
+            before, before_marks = rec.cost.copy(), rec.z_switch_last.copy()
+            stages.record_cost(track, setup.tim.k_fault, st, kn, work, rec)
+            assert np.array_equal(rec.cost, want)
+            assert np.array_equal(rec.z_switch_last, marks)
+            assert np.array_equal(rec.cost[:, ~st.alive], before[:, ~st.alive])
+            assert np.array_equal(rec.z_switch_last[:, ~st.alive], before_marks[:, ~st.alive])
+            live = st.alive
+            assert np.array_equal(rec.z_switch_last[1, live], st.x[track.iz, live])
+            # the switch mark only at the switch
+            assert np.array_equal(rec.z_switch_last[0, live] == st.x[track.iz, live],
+                                  np.full(live.sum(), kn == setup.tim.k_fault))
         assert (rec.cost[1, :2] > 1e-3).all()
 
 

@@ -225,6 +225,7 @@ def classify(spec: ChunkSpec, tr_name: str, variant: str, trial_ids, values,
         "variant": np.full(L, variant, dtype=object),
         "trial_id": np.asarray(trial_ids, dtype=np.int64),
         "lock_position": values if is_lock else np.full(L, np.nan),
+        "lock_offset": values - u0 if is_lock else np.full(L, np.nan),
         "loss_b1": np.full(L, np.nan) if is_lock else values,
         "mode_pre": np.array([MODE_NAMES[m] for m in inp.mode_pre], dtype=object),
         "mode_post": np.array([MODE_NAMES[m] for m in inp.mode_post], dtype=object),
@@ -399,6 +400,7 @@ def classify_sensor(spec: ChunkSpec, tr_name: str, variant: str, trial_ids, size
         "variant": np.full(L, variant, dtype=object),
         "trial_id": np.asarray(trial_ids, dtype=np.int64),
         "lock_position": np.full(L, np.nan),
+        "lock_offset": np.full(L, np.nan),
         "loss_b1": np.full(L, np.nan),
         "mode_pre": np.array([MODE_NAMES[m] for m in inp.mode_pre], dtype=object),
         "mode_post": np.array([MODE_NAMES[m] for m in inp.mode_post], dtype=object),
@@ -547,6 +549,20 @@ def cost_columns(rec: TrialRecord, n_steps: int, dt: float) -> dict:
     return out
 
 
+def height_columns(rec: TrialRecord, setup) -> dict:
+    """``height_lost_m``: the height the aircraft lost from the switch to the last
+    step it flew (its exit from the validity envelope, or the trial's end) [m],
+    the glide path's own descent ``V0 |sin gamma0| t`` included; NaN for a trial
+    that stopped before the switch (``TrialRecord.z_switch_last``; the height is
+    ``V0 t sin(gamma0) - z`` above the start, ``z`` the vertical deviation, down,
+    from the reference point flying the glide path)."""
+    dt = setup.plant.dt
+    last = np.where(rec.stop_k >= 0, rec.stop_k, setup.tim.n_steps) * dt
+    climb = setup.plant.trim.V0 * np.sin(setup.plant.trim.gamma0)
+    z_switch, z_last = rec.z_switch_last
+    return {"height_lost_m": climb * (setup.tim.k_fault * dt - last) + z_last - z_switch}
+
+
 def _runs(spec: ChunkSpec):
     """``(t_q, t_nx, variant, Detection)`` of every run of a chunk, point-major."""
     setup = spec.setup
@@ -625,6 +641,7 @@ def run_chunk(spec: ChunkSpec, name: str, trial_ids) -> dict:
         if setup.dof == 6:
             t.update(lateral_columns(rec, n))
         t.update(cost_columns(rec, n, setup.plant.dt))
+        t.update(height_columns(rec, setup))
         if spec.points is not None:
             t["t_q"] = np.full(L, tq)
             t["t_nx"] = np.full(L, tnx)

@@ -23,6 +23,7 @@ from .assemble import write_run_tables
 from .chunk import chunk_spec
 from .parallel import run_chunks
 from .summary import markdown_table, summarize
+from .survival import survival_markdown, survival_table
 
 
 class CampaignResult:
@@ -62,9 +63,25 @@ class CampaignResult:
             return pd.read_parquet(self.out / "resets.parquet")
         return self._resets
 
+    def survival(self) -> pd.DataFrame:
+        """Survival after an elevon lock by lock offset
+        (:func:`~.survival.survival_table`; empty without elevon-lock rows)."""
+        cols = ["transition", "variant", "lock_offset", "status", "stop_s", "height_lost_m"]
+        if self._trials is None and self.out is not None:
+            import pyarrow.parquet as pq
+            names = pq.read_schema(self.out / "trials.parquet").names
+            trials = pd.read_parquet(self.out / "trials.parquet",
+                                     columns=[c for c in cols if c in names])
+        else:
+            trials = self.trials
+        t = self.config.timing
+        return survival_table(trials, t.fault_time_s, t.duration_s)
+
     def markdown(self) -> str:
-        """The summary table in Markdown."""
-        return markdown_table(self.summary)
+        """The summary table in Markdown, and the survival after an elevon lock
+        when the run has elevon-lock rows."""
+        survival = survival_markdown(self.survival()) if self.config is not None else ""
+        return markdown_table(self.summary) + ("\n\n" + survival if survival else "")
 
 
 def resolve_config(config, trials=None, seed=None, signature=None) -> Config:

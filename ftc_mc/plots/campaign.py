@@ -2,7 +2,9 @@
 
 * :func:`delay_figure`: reset-delay and detection-time box plots of one run;
 * :func:`sweep_figure`: rates against the threshold of one sweep;
-* :func:`plant_figure`: rates of runs flown on different truth plants.
+* :func:`plant_figure`: rates of runs flown on different truth plants;
+* :func:`survival_figure`: share staying in the envelope after an elevon lock,
+  by lock offset.
 
 They read the tables the report builds from Parquet files
 (``ftc_mc/report/``); transition names are shown through the ``labels``
@@ -115,6 +117,53 @@ def delay_figure(trials: pd.DataFrame, path: Path, labels=None) -> Path:
     axs[0].invert_yaxis()
     axs[1].legend(loc="best", fontsize=8)
     fig.suptitle("Reset delay and detection time (judged trials; whiskers 5-95 %)")
+    return save(fig, path)
+
+
+def survival_figure(table: pd.DataFrame, path: Path, labels=None) -> Path:
+    """Share of trials staying inside the envelope after an elevon lock, against
+    the lock offset from trim, one panel per elevon-lock row and one line per
+    design (95 % Wilson intervals as bars).
+
+    Parameters
+    ----------
+    table : DataFrame
+        :func:`ftc_mc.campaign.survival.survival_table` of a run.
+    path : Path
+        PNG file, written atomically.
+    labels : mapping of str to str, optional
+        Display label of each transition name.
+
+    Returns
+    -------
+    Path
+    """
+    label = _namer(labels)
+    names = list(dict.fromkeys(table["transition"]))
+    bins = (table[["offset_lo_deg", "offset_hi_deg", "bin"]].drop_duplicates()
+            .sort_values("offset_lo_deg"))
+    pos = {b: i for i, b in enumerate(bins["bin"])}
+    styles = design_styles(list(dict.fromkeys(table["variant"])))
+    fig, axs = plt.subplots(1, len(names), figsize=(5.5 * len(names), 3.8), sharey=True,
+                            layout="constrained", squeeze=False)
+    for ax, name in zip(axs[0], names):
+        for variant, g in table[table["transition"] == name].groupby("variant", sort=False):
+            g = g[g["flying"] > 0]
+            x = np.array([pos[b] for b in g["bin"]])
+            y = g["survived_rate"].to_numpy()
+            err = np.vstack([y - g["survived_ci_low"].to_numpy(),
+                             g["survived_ci_high"].to_numpy() - y])
+            ax.errorbar(x, 100 * y, yerr=100 * err, capsize=2, label=variant,
+                        **styles[variant])
+        ax.set_xticks(range(len(pos)), list(pos), rotation=45, ha="right", fontsize=7)
+        ax.set_xlabel("lock offset from trim [deg]")
+        ax.set_title(label(name), fontsize=9)
+        ax.set_ylim(-3, 103)
+        ax.grid(alpha=0.3)
+    horizon = table["horizon_s"].iloc[0]
+    axs[0][0].set_ylabel(f"stay in the envelope {horizon:g} s [%]")
+    axs[0][-1].legend(loc="best", fontsize=8)
+    fig.suptitle("Survival after an elevon lock")
     return save(fig, path)
 
 

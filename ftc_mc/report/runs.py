@@ -397,4 +397,23 @@ def run_section(r: ResultDir, fig_dir: Path, slug: str, report: Path) -> list:
             + ["### Excluded trials", ""] + exclusion_table(summary, trials, cfg)
             + [_comparison_heading(trials), ""] + variant_comparison(trials)
             + ["### Delay distributions", "", f"![delays of {slug}]({rel_link(fig, report)})",
-               ""] + real_flight_lines(trials) + sensor)
+               ""] + real_flight_lines(trials)
+            + survival_lines(trials, cfg, fig_dir / f"{slug}_survival.png", report) + sensor)
+
+
+def survival_lines(trials: pd.DataFrame, cfg: dict, fig_path: Path, report: Path) -> list:
+    """The survival after an elevon lock (:mod:`ftc_mc.campaign.survival`) with its
+    figure; nothing for a run without elevon-lock rows."""
+    from ..campaign.survival import survival_markdown, survival_table
+    from ..plots.campaign import survival_figure
+
+    timing = cfg.get("timing", {})
+    if "fault_time_s" not in timing:
+        return []
+    table = survival_table(trials, timing["fault_time_s"], timing["duration_s"])
+    if not len(table):
+        return []
+    fig = survival_figure(table, fig_path, LABELS)
+    text = survival_markdown(table).replace("## Survival", "### Survival", 1)
+    text = text.replace("\n### `", "\n#### `")
+    return [text, "", f"![survival of {fig_path.stem}]({rel_link(fig, report)})", ""]

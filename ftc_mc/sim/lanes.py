@@ -99,7 +99,7 @@ def new_record(setup, L: int, max_resets: int, history: bool = False,
         hist_block=np.zeros((n_hist, L), dtype=np.int64),
         hist_wind=np.zeros((n_hist, N_WIND, L)),
         xa_end=np.zeros((n_est, L)), sq_lat=np.zeros((N_SQ_LAT, L)),
-        cost=np.zeros((N_COST, L)))
+        cost=np.zeros((N_COST, L)), z_switch_last=np.zeros((2, L)))
 
 
 def run_alone(setup, name: str, det, inp: TrialInputs, max_resets: int,

@@ -217,6 +217,10 @@ TrialRecord = namedtuple("TrialRecord", [
     "cost",         # (N_COST, L) over the valid steps (conventions.COST_NAMES): sum of
                     #      the squared cross-track error [m^2], its largest magnitude [m],
                     #      sums of each squared command deviation (stages.record_cost)
+    "z_switch_last",  # (2, L) the truth's vertical deviation z [m] (down) from the glide
+                      #   path's reference point after the step reaching the switch
+                      #   (timing.k_fault; NaN if the lane stopped before) and after
+                      #   the last step flown (stages.record_cost)
 ])
 """Per-lane outputs of :func:`ftc_mc.sim.lanes.run_trials`."""
 

@@ -153,8 +153,9 @@ def commands(path, scheme, st, k, work):
 
 # ------------------------------------------------------------------ 2b. cost
 @kernel(inline="always")
-def record_cost(track, st, work, rec):
-    """After the truth step: the costs of flying the step (issue 25).
+def record_cost(track, k_switch, st, kn, work, rec):
+    """After the truth step: the costs of flying the step (issue 25), and the
+    height marks of the survivability study (issue 26).
 
     For every live lane (its steps until it stops, the step that takes it out
     of the envelope included, as ``TrialRecord.sq_lat``): the cross-track error
@@ -162,26 +163,37 @@ def record_cost(track, st, work, rec):
     after the step (``scenario/run.py``'s ``cross_track_error_m``) adds ``c^2``
     to ``cost[COST_TRACK_SQ]`` and raises ``cost[COST_TRACK_MAX]`` to ``|c|``;
     each command ``u_i`` applied during the step (deviation from trim, the
-    excitation included) adds ``u_i^2`` to ``cost[COST_U2 + i]``.
+    excitation included) adds ``u_i^2`` to ``cost[COST_U2 + i]``.  The vertical
+    deviation ``z`` of the true state is written to ``z_switch_last[1]`` (so it
+    holds the last step flown), and to ``z_switch_last[0]`` at the switch.
 
     Parameters
     ----------
     track : Track
         Rows of ``x`` and ``z`` in the truth state, ``sin`` and ``cos`` of gamma0.
+    k_switch : int
+        Step of the switch to the final mode (``Timing.k_fault``).
     st : LaneState
         Reads ``x`` (the true state after the step) and ``alive``.
+    kn : int
+        Step reached (``k + 1``).
     work : TrialWork
         Reads ``u``.
     rec : TrialRecord
-        ``cost`` updated.
+        ``cost`` and ``z_switch_last`` updated.
     """
     x = st.x
     u = work.u
     cost = rec.cost
+    marks = rec.z_switch_last
     for l in range(x.shape[1]):
         if not st.alive[l]:
             continue
-        c = x[track.ix, l] * track.sin_g + x[track.iz, l] * track.cos_g
+        z = x[track.iz, l]
+        marks[1, l] = z
+        if kn == k_switch:
+            marks[0, l] = z
+        c = x[track.ix, l] * track.sin_g + z * track.cos_g
         cost[COST_TRACK_SQ, l] += c * c
         cost[COST_TRACK_MAX, l] = max(cost[COST_TRACK_MAX, l], abs(c))
         for i in range(N_U):

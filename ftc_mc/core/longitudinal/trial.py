@@ -94,7 +94,7 @@ def advance(path, scheme, flight, inp, rec, st, k0, k1):
         kn = k + 1
         commands(path, scheme, st, k, work)
         truth(path, scheme, flight, inp, k, st, work, rec)
-        record_cost(flight.track, st, work, rec)
+        record_cost(flight.track, flight.timing.k_fault, st, kn, work, rec)
         filter_update(path, scheme, st, k, work)
         check_validity(flight.validity, st, kn, work, rec)
         handle_resets(scheme.excitation, st, kn, work, rec)
@@ -143,6 +143,8 @@ def init_state(inp, st, rec):
             rec.sq_lat[i, l] = 0.0
         for i in range(rec.cost.shape[0]):
             rec.cost[i, l] = 0.0
+        rec.z_switch_last[0, l] = np.nan
+        rec.z_switch_last[1, l] = 0.0
         st.ecount[l] = 0
         st.last_k[l] = NO_SIGNAL
         st.last_block[l] = 0

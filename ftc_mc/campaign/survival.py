@@ -1,0 +1,172 @@
+"""Survivability after an elevon lock (issue 26, item 5): does the aircraft stay
+inside the validity envelope, and for how long, by how far the elevon locked
+from trim?
+
+From the trials of a run's elevon-lock rows (``elevon_lock``,
+``right_elevon_lock``), per row, design and bin of lock offset from the trim
+command (``lock_offset``, [deg]):
+
+* ``flying``: trials still flying at the switch whose fate over the horizon is
+  known: a trial that stopped numerically (``nonfinite``, ``not_psd``) within
+  the horizon is left out and counted in ``unknown``; one that left the
+  envelope before the switch is no lock trial and is left out;
+* ``left``: those that left the envelope (airspeed, angle of attack, bank)
+  within ``horizon_s`` of the lock; ``survived_rate`` the others' share, with
+  its 95 % Wilson interval;
+* ``median_leave_s``: the median time from the lock to the exit over all
+  ``flying`` trials, a survivor counting as never leaving; NaN (shown ``>H``)
+  when at least half survive the horizon;
+* ``height_lost_median_m``: the median height lost from the lock to the exit of
+  those that left (``height_lost_m``: the glide path's own descent, 1.05 m/s at
+  20 m/s and -3 deg, included).
+
+The horizon is 60 s after the lock, or the time a trial flies after it
+(``timing.duration_s - timing.fault_time_s``) when that is shorter.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+
+from ..conventions import (STATUS_AIRSPEED, STATUS_ALPHA, STATUS_BANK, STATUS_NAMES,
+                           STATUS_NONFINITE, STATUS_NOT_PSD)
+from ..stats import wilson
+from .transitions import transition_of
+
+HORIZON_S = 60.0
+"""Time after the lock over which survival is judged [s] (issue 26)."""
+
+OFFSET_EDGES_DEG = (-math.inf, -20.0, -10.0, -5.0, -2.0, -0.5, 0.5, 2.0, 5.0, 10.0, math.inf)
+"""Bins of lock offset from trim [deg]: the finer the nearer trim, where the
+trimmable set's edges lie (``docs/airframes.md``)."""
+
+EXITS = tuple(STATUS_NAMES[s] for s in (STATUS_AIRSPEED, STATUS_ALPHA, STATUS_BANK))
+"""Statuses of a trial that left the validity envelope."""
+
+NUMERIC = tuple(STATUS_NAMES[s] for s in (STATUS_NONFINITE, STATUS_NOT_PSD))
+"""Statuses of a trial that stopped numerically (the aircraft's fate unknown)."""
+
+
+def horizon_of(fault_time_s: float, duration_s: float) -> float:
+    """The survival horizon [s] of a run: :data:`HORIZON_S`, or the time its
+    trials fly after the switch when shorter."""
+    return min(HORIZON_S, duration_s - fault_time_s)
+
+
+def _is_elevon_lock(name: str) -> bool:
+    """Whether ``name`` locks an elevon from nominal (not an unlock, not a sensor)."""
+    tr = transition_of(name)
+    return (getattr(tr, "kind", None) == "lock" and getattr(tr, "onset", False)
+            and tr.is_elevon)
+
+
+def bin_label(lo: float, hi: float) -> str:
+    """Text of the offset bin ``[lo, hi)`` [deg]."""
+    if math.isinf(lo):
+        return f"below {hi:g}"
+    if math.isinf(hi):
+        return f"{lo:g} and above"
+    return f"{lo:g} to {hi:g}"
+
+
+def survival_table(trials: pd.DataFrame, fault_time_s: float, duration_s: float,
+                   edges=OFFSET_EDGES_DEG) -> pd.DataFrame:
+    """Survival by lock offset bin (module docstring).
+
+    Parameters
+    ----------
+    trials : DataFrame
+        A run's trials (``transition``, ``variant``, ``lock_offset`` [rad],
+        ``status``, ``stop_s``, ``height_lost_m``).
+    fault_time_s, duration_s : float
+        The run's ``timing`` [s].
+    edges : sequence of float
+        Bin edges of the lock offset [deg], increasing.
+
+    Returns
+    -------
+    DataFrame
+        One row per elevon-lock row, design and non-empty bin: ``transition``,
+        ``variant``, ``offset_lo_deg``, ``offset_hi_deg``, ``bin``, ``flying``,
+        ``left``, ``survived_rate``, ``survived_ci_low``, ``survived_ci_high``,
+        ``median_leave_s``, ``height_lost_median_m``, ``unknown``,
+        ``horizon_s``; empty when the run has no elevon-lock row or its trials
+        lack the columns (a run written before them).
+    """
+    need = {"lock_offset", "height_lost_m", "status", "stop_s"}
+    rows = []
+    if not need <= set(trials.columns):
+        return pd.DataFrame(rows)
+    horizon = horizon_of(fault_time_s, duration_s)
+    locks = trials[trials["transition"].map(_is_elevon_lock)]
+    edges = np.asarray(edges, dtype=float)
+    for (name, variant), g in locks.groupby(["transition", "variant"], sort=False):
+        off = np.degrees(g["lock_offset"].to_numpy(dtype=float))
+        status = g["status"].to_numpy()
+        after = g["stop_s"].to_numpy(dtype=float) - fault_time_s
+        stopped = np.isfinite(after)
+        before_switch = stopped & (after <= 0.0)
+        within = stopped & (after <= horizon) & ~before_switch
+        numeric = within & np.isin(status, NUMERIC)
+        left = within & np.isin(status, EXITS)
+        keep = ~before_switch & ~numeric
+        which = np.digitize(off, edges[1:-1])
+        for b in range(len(edges) - 1):
+            in_bin = which == b
+            n = int((in_bin & keep).sum())
+            if not n and not (in_bin & numeric).any():
+                continue
+            k_left = int((in_bin & left).sum())
+            lo, hi = wilson(n - k_left, n) if n else (math.nan, math.nan)
+            leave = np.where(left, after, math.inf)[in_bin & keep]
+            median = float(np.median(leave)) if n and k_left * 2 > n else math.nan
+            lost = g["height_lost_m"].to_numpy(dtype=float)[in_bin & left]
+            rows.append({
+                "transition": name, "variant": variant,
+                "offset_lo_deg": edges[b], "offset_hi_deg": edges[b + 1],
+                "bin": bin_label(edges[b], edges[b + 1]), "flying": n, "left": k_left,
+                "survived_rate": (n - k_left) / n if n else math.nan,
+                "survived_ci_low": lo, "survived_ci_high": hi,
+                "median_leave_s": median,
+                "height_lost_median_m": float(np.median(lost)) if len(lost) else math.nan,
+                "unknown": int((in_bin & numeric).sum()), "horizon_s": horizon})
+    return pd.DataFrame(rows)
+
+
+def survival_markdown(table: pd.DataFrame) -> str:
+    """The survival table in Markdown, one block per elevon-lock row: a line per
+    offset bin, a column group per design."""
+    if not len(table):
+        return ""
+    horizon = table["horizon_s"].iloc[0]
+    out = [f"## Survival after an elevon lock ({horizon:g} s horizon)", "",
+           "Share of the trials flying at the lock that stay inside the validity envelope "
+           f"for {horizon:g} s after it (95 % Wilson interval), median time from the lock "
+           "to the exit (`>H`: at least half stay in), median height lost until the exit "
+           "(the glide path's own descent included), by lock offset from the trim "
+           "command. Trials that stopped numerically within the horizon are left out "
+           "(`unknown`).", ""]
+    for name, g in table.groupby("transition", sort=False):
+        out += [f"### `{name}`", ""]
+        rows = []
+        for b, gb in g.groupby("bin", sort=False):
+            row = {"lock offset [deg]": b}
+            for _, r in gb.iterrows():
+                v = r["variant"]
+                row[f"{v}: stay in"] = (f"{r['flying'] - r['left']}/{r['flying']} "
+                                        f"({100 * r['survived_rate']:.0f} %, "
+                                        f"{100 * r['survived_ci_low']:.0f}-"
+                                        f"{100 * r['survived_ci_high']:.0f})"
+                                        if r["flying"] else "-")
+                row[f"{v}: median exit [s]"] = (f">{horizon:g}" if not np.isfinite(
+                    r["median_leave_s"]) else f"{r['median_leave_s']:.1f}")
+                row[f"{v}: height lost [m]"] = ("-" if not np.isfinite(
+                    r["height_lost_median_m"]) else f"{r['height_lost_median_m']:.1f}")
+                if r["unknown"]:
+                    row[f"{v}: stay in"] += f", {r['unknown']} unknown"
+            rows.append(row)
+        out += [pd.DataFrame(rows).fillna("-").to_markdown(index=False), ""]
+    return "\n".join(out)

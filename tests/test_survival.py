@@ -1,0 +1,88 @@
+"""Survival after an elevon lock (issue 26, item 5; ftc_mc/campaign/survival.py):
+the table's counts, censored medians and exclusions against a hand-made trials
+table, its Markdown and figure, and the columns it reads on a real run."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+
+from ftc_mc.campaign.survival import (OFFSET_EDGES_DEG, horizon_of, survival_markdown,
+                                      survival_table)
+
+
+def _trials():
+    """Ten left-elevon locks 3 deg above trim (bin 2 to 5) and three 1 deg below
+    (-2 to -0.5), switch at 20 s, 80 s flights, and one engine lock."""
+    rows = []
+    # bin 2..5: four leave (at 21, 22, 23 s and at 85 s: after the horizon), one
+    # stops numerically at 30 s, one left before the switch, four fly to the end
+    for i, (status, stop, lost) in enumerate(
+            [("bank_out_of_bounds", 21.0, 5.0), ("airspeed_out_of_bounds", 22.0, 7.0),
+             ("alpha_out_of_bounds", 23.0, 9.0), ("bank_out_of_bounds", 85.0, 99.0),
+             ("nonfinite", 30.0, 1.0), ("airspeed_out_of_bounds", 10.0, math.nan),
+             ("ok", math.nan, 60.0), ("ok", math.nan, 61.0), ("ok", math.nan, 62.0),
+             ("ok", math.nan, 63.0)]):
+        rows.append(("elevon_lock", "paper", math.radians(3.0), status, stop, lost))
+    for status, stop in (("ok", math.nan), ("bank_out_of_bounds", 50.0), ("ok", math.nan)):
+        rows.append(("elevon_lock", "paper", math.radians(-1.0), status, stop, 30.0))
+    rows.append(("engine_lock", "paper", 0.3, "airspeed_out_of_bounds", 25.0, 3.0))
+    rows.append(("elevon_unlock", "paper", math.nan, "ok", math.nan, 0.0))
+    return pd.DataFrame(rows, columns=["transition", "variant", "lock_offset", "status",
+                                       "stop_s", "height_lost_m"])
+
+
+def test_counts_medians_and_exclusions():
+    tab = survival_table(_trials(), fault_time_s=20.0, duration_s=100.0)
+    assert set(tab["transition"]) == {"elevon_lock"}  # no engine, no unlock rows
+    assert (tab["horizon_s"] == 60.0).all()
+    up = tab[tab["offset_lo_deg"] == 2.0].iloc[0]
+    # 10 trials: 1 left before the switch and 1 numerical within the horizon are out
+    assert (up["flying"], up["left"], up["unknown"]) == (8, 3, 1)
+    assert up["survived_rate"] == 5 / 8
+    assert up["survived_ci_low"] < 5 / 8 < up["survived_ci_high"]
+    # at least half stay in: no median exit; heights of the three that left
+    assert math.isnan(up["median_leave_s"]) and up["height_lost_median_m"] == 7.0
+    down = tab[tab["offset_lo_deg"] == -2.0].iloc[0]
+    assert (down["flying"], down["left"]) == (3, 1) and math.isnan(down["median_leave_s"])
+    assert len(tab) == 2  # empty bins are left out
+
+
+def test_censored_median_and_a_short_horizon():
+    t = _trials()
+    t = t[t["lock_offset"] > 0].copy()
+    t.loc[t.index[6:9], ["status", "stop_s"]] = ["bank_out_of_bounds", 24.0]
+    tab = survival_table(t, 20.0, 100.0)
+    # leave times 1, 2, 3, 4, 4, 4 s and 2 survivors (inf): median of 8 = 4 s
+    assert tab.iloc[0]["left"] == 6 and tab.iloc[0]["median_leave_s"] == 4.0
+    # flights shorter than 60 s after the lock: the horizon is what they fly
+    assert horizon_of(20.0, 50.0) == 30.0
+    short = survival_table(t, 20.0, 50.0)
+    assert short.iloc[0]["horizon_s"] == 30.0 and short.iloc[0]["left"] == 6
+
+
+def test_markdown_and_figure(tmp_path):
+    from ftc_mc.plots.campaign import survival_figure
+
+    t = _trials()
+    both = pd.concat([t, t.assign(variant="robust")])
+    tab = survival_table(both, 20.0, 100.0)
+    md = survival_markdown(tab)
+    assert "## Survival after an elevon lock (60 s horizon)" in md
+    assert "5/8 (62 %" in md and ", 1 unknown" in md and ">60" in md
+    assert "paper: stay in" in md and "robust: stay in" in md
+    png = survival_figure(tab, tmp_path / "s.png")
+    assert png.stat().st_size > 1000
+    assert survival_markdown(survival_table(t[t.transition == "engine_lock"], 20, 100)) == ""
+
+
+def test_old_runs_without_the_columns_give_no_table():
+    t = _trials().drop(columns=["height_lost_m"])
+    assert survival_table(t, 20.0, 100.0).empty
+
+
+def test_bins_cover_every_offset():
+    assert OFFSET_EDGES_DEG[0] == -math.inf and OFFSET_EDGES_DEG[-1] == math.inf
+    assert np.all(np.diff(OFFSET_EDGES_DEG) > 0)
