@@ -121,6 +121,19 @@ def campaign_configs() -> dict:
              "paper's Table 1 (paper, swapped) and the robust design side by side, with the "
              "lateral autopilot beside the paper's loop; add --turbulence moderate for "
              "gusts", omit=no_sensor)
+    cfg = Config.model_validate({
+        "campaign": {"transitions": ["elevon_lock", "right_elevon_lock"],
+                     "signature": "paper", "designs": ["paper_nominal"]},
+        "plant": {"kind": "nonlinear", "dof": 6},
+        "timing": {"duration_s": 80.0},
+        "designs": {"paper_nominal": {"signature": "paper", "controller": "nominal"}}})
+    files["sixdof_survival.yaml"] = render_yaml(
+        cfg, "ftc-mc run configs/sixdof_survival.yaml -- survival after an elevon lock "
+             "(issue 26): the share of trials inside the envelope 60 s after the lock, the "
+             "median time to leave it and the height lost, by lock offset, on the 6-DOF "
+             "flying wing under the paper's reconfiguring scheme (paper) and the nominal "
+             "controller alone (paper_nominal), on the same trials; --dof 3 for the "
+             "longitudinal plant", omit=no_sensor)
     designs = excitation_designs()
     cfg = Config.model_validate({
         "campaign": {"transitions": list(EXCITATION_ROWS), "signature": "swapped",
