@@ -366,9 +366,9 @@ def announce_compile(dispatcher, what="", duration="1-1.5 min", stream=None,
     compiled (:func:`needs_compile`, or ``needed`` when the caller has just
     asked it); return whether it was printed.
 
-    ``what`` names the path compiled, ``duration`` the time it takes: 52-92 s
-    for the paths of ``scripts/bench_compile.py`` on an empty cache, less when
-    the kernels they share are cached (``docs/performance.md`` lesson 11).
+    ``what`` names the path compiled, ``duration`` the time it takes (the
+    measured figures per path, and why they are less when the kernels they
+    share are cached: ``docs/performance.md``, lesson 11).
     """
     import sys
     if (needs_compile(dispatcher) if needed is None else needed) is not True:

@@ -35,8 +35,7 @@ differs is only the order in which *independent* results are produced:
 Measured on the paper's problem, one core (``scripts/bench_core.py``): about
 1.6-1.7 M filter steps/s at 64-192 lanes, about 4x ``step.filter_step``.  The
 lane rows should start on 64-byte boundaries (``tests/lane_workspace.py::lane_zeros``,
-``L`` a multiple of 8): NumPy's default placement cost 20 % here.  A cold
-compile of :func:`filter_step_lanes` takes about 30 s (then cached).
+``L`` a multiple of 8): NumPy's default placement cost 20 % here.
 
 Work arrays are passed in (``tests/lane_workspace.py::new_lane_workspace`` in the tests and the benchmark),
 so no kernel allocates.
