@@ -20,8 +20,9 @@ controller that flies such a turn:
    deg), minimised by SLSQP with the six accelerations as equality
    constraints, inside a *design box* smaller than the validity envelope
    (:class:`DesignBox`: airspeed 14-28 m/s, angle of attack -6 to 10 deg,
-   bank 45 deg, throttle 0.05-0.95, healthy elevon within 25 deg), so that the
-   controller has room around its design point.  Starts: the solution of
+   bank 45 deg, throttle 0.05-0.95, healthy elevon within 25 deg, air-path
+   angle -15 to +10 deg), so that the controller has room around its design
+   point.  Starts: the solution of
    :func:`ftc_mc.model.trimmable.steady_flight`, the nominal trim, and any
    points given.
 2. **A lock with no steady flight in the design box** (beyond about -24/+2
@@ -108,6 +109,10 @@ class DesignBox:
         Largest healthy elevon deflection [rad].
     sideslip : float
         Largest sideslip [rad] (the bound of :mod:`ftc_mc.model.trimmable`).
+    gamma : (float, float)
+        Air-path angle [rad]: the validity envelope has no bound, but the
+        family holds steep steady climbs (``x8-gryte2018``, 5 deg above trim:
+        +60 deg at full throttle) that a glide cannot reach.
     """
 
     airspeed: tuple = (14.0, 28.0)
@@ -116,6 +121,7 @@ class DesignBox:
     throttle: tuple = (0.05, 0.95)
     elevon: float = math.radians(25.0)
     sideslip: float = 0.5
+    gamma: tuple = (math.radians(-15.0), math.radians(10.0))
 
     def bounds(self):
         """Lower and upper bounds of the :data:`~ftc_mc.model.trimmable.UNKNOWNS`."""
@@ -237,6 +243,10 @@ def _closest(p, side, lock, box, weights, V0, gamma0, starts):
         x, _ = _state(w, side, lock)
         return outputs(x, p)[OUTPUT["gamma"]]
 
+    def room(w):
+        g = gamma(w)
+        return np.array([g - box.gamma[0], box.gamma[1] - g])
+
     def cost(w):
         return (((w[0] - V0) / weights.airspeed) ** 2
                 + ((gamma(w) - gamma0) / weights.gamma) ** 2
@@ -246,11 +256,12 @@ def _closest(p, side, lock, box, weights, V0, gamma0, starts):
     for w0 in starts:
         sol = scipy.optimize.minimize(cost, np.clip(w0, lo, hi), method="SLSQP",
                                       bounds=list(zip(lo, hi)),
-                                      constraints=[{"type": "eq", "fun": acc}],
+                                      constraints=[{"type": "eq", "fun": acc},
+                                                   {"type": "ineq", "fun": room}],
                                       options={"maxiter": 500, "ftol": 1e-14})
         w = np.clip(sol.x, lo, hi)
         res = float(np.max(np.abs(acc(w))))
-        if res <= 1e-8 and (best is None or cost(w) < best[0]):
+        if res <= 1e-8 and np.min(room(w)) >= -1e-9 and (best is None or cost(w) < best[0]):
             best = (float(cost(w)), w, res)
     return best
 
