@@ -26,7 +26,8 @@ survived 60 s, the time it left and by which bound, the height lost [m]
 Usage::
 
     PYTHONPATH=. python scripts/study_lock_turn.py [--airframe x8-pyfly]
-        [--offsets -30,-20,...] [--turbulence]   # one moderate-turbulence pass too
+        [--offsets -30,-20,...] [--turbulence [--seeds N]]  # moderate turbulence,
+                                            # N records: nominal and lock-turn (1 s)
         [--json out.json]
 """
 
@@ -146,11 +147,20 @@ def fmt_run(r):
     return f"{r['t_leave']:4.1f}s {r['why'][:8]:8s}"
 
 
+def fmt_turb(runs):
+    """Survivors out of the turbulence seeds, and the shortest exit time."""
+    ok = sum(r["survived"] for r in runs)
+    t = [r["t_leave"] for r in runs if not r["survived"]]
+    return f"{ok}/{len(runs)}" + (f" (first {min(t):.1f}s)" if t else "")
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--airframe", default="x8-pyfly")
     ap.add_argument("--offsets", default=",".join(str(o) for o in OFFSETS))
     ap.add_argument("--turbulence", action="store_true")
+    ap.add_argument("--seeds", type=int, default=1,
+                    help="turbulence records (seeds 26, 27, ...) per lock")
     ap.add_argument("--json", default=None)
     a = ap.parse_args(argv)
     t_start = time.time()
@@ -182,11 +192,13 @@ def main(argv=None):
                 row[f"turn{delay:g}"] = fly(tp, K_nom, plant.u_lower, plant.u_upper, side,
                                             lock, d, delay)
             if a.turbulence:
-                winds = turbulence_record(int(round(T_END / DT)), seed=26)
-                row["none_turb"] = fly(tp, K_nom, plant.u_lower, plant.u_upper, side, lock,
-                                       winds=winds)
-                row["turn1_turb"] = fly(tp, K_nom, plant.u_lower, plant.u_upper, side, lock,
-                                        d, 1.0, winds=winds)
+                row["none_turb"], row["turn1_turb"] = [], []
+                for seed in range(26, 26 + a.seeds):
+                    winds = turbulence_record(round(T_END / DT), seed=seed)
+                    row["none_turb"].append(fly(tp, K_nom, plant.u_lower, plant.u_upper,
+                                                side, lock, winds=winds))
+                    row["turn1_turb"].append(fly(tp, K_nom, plant.u_lower, plant.u_upper,
+                                                 side, lock, d, 1.0, winds=winds))
             rows.append(row)
             v = row["design"]
             print(f"{side:5s} {off:+6.1f} | design {row['design_offset_deg']:+6.2f} "
@@ -196,8 +208,8 @@ def main(argv=None):
                   + " | ".join(f"d{dl:g} {fmt_run(row[f'turn{dl:g}'])}" for dl in DELAYS)
                   + f" | d3h {fmt_run(row['turn3_hold'])}"
                   + ("" if not a.turbulence else
-                     f" || turb none {fmt_run(row['none_turb'])} d1 "
-                     f"{fmt_run(row['turn1_turb'])}"), flush=True)
+                     f" || turb none {fmt_turb(row['none_turb'])} d1 "
+                     f"{fmt_turb(row['turn1_turb'])}"), flush=True)
     print(f"wall {time.time() - t_start:.0f} s")
     if a.json:
         with open(a.json, "w") as f:
