@@ -1,0 +1,104 @@
+"""The lock-turn controller (ftc_mc/design/lock_turn.py, issue 26 items 4-5):
+design point, reduced linear model about the steady turn, discounted LQR."""
+
+import math
+
+import numpy as np
+import pytest
+import scipy.linalg
+
+from ftc_mc.core.sixdof.layout import COMMAND, OUTPUT, STATE
+from ftc_mc.design.lock_turn import DesignBox, lock_turn_lqr, turn_states
+from ftc_mc.model.linear import jacobian
+from ftc_mc.model.presets import PRESETS
+from ftc_mc.model.sixdof import derivatives, outputs, trim6
+
+AF = PRESETS["x8-pyfly"].airframe
+TRIM = trim6(AF)
+
+
+def lock_at(side, offset_deg):
+    return TRIM.u0[COMMAND[side]] + math.radians(offset_deg)
+
+
+@pytest.fixture(scope="module", params=[("left", 1.0), ("right", -4.0)])
+def steady(request):
+    side, off = request.param
+    return lock_turn_lqr(AF, side, lock_at(side, off))
+
+
+def test_the_design_point_is_a_steady_turn_in_the_box(steady):
+    pt = steady.point
+    assert pt.steady and pt.design_lock == pt.lock
+    assert pt.x[STATE[pt.side]] == pt.lock == pt.cmd[COMMAND[pt.side]]
+    d = derivatives(pt.x, pt.cmd, TRIM.params)
+    rows = [STATE[n] for n in ("u", "v", "w", "p", "q", "r", "phi", "theta")]
+    assert np.abs(d[rows]).max() < 1e-10
+    # actuators at their commands, and it turns
+    assert np.abs(d[[STATE[n] for n in ("throttle", "left", "right")]]).max() == 0.0
+    v = pt.values
+    assert abs(v["turn_rate"]) > math.radians(1.0)
+    box = DesignBox()
+    tol = 1e-9
+    assert box.airspeed[0] - tol <= v["airspeed"] <= box.airspeed[1] + tol
+    assert abs(v["phi"]) <= box.bank + tol
+    assert box.throttle[0] - tol <= v["throttle"] <= box.throttle[1] + tol
+    y = outputs(pt.x, TRIM.params)
+    assert abs(y[OUTPUT["gamma"]] - v["gamma"]) < 1e-15
+    assert abs(y[OUTPUT["Va"]] - v["airspeed"]) < 1e-12
+
+
+def test_the_turn_states_see_neither_position_nor_heading(steady):
+    """The reduced model is exact: no row of the fed-back states depends on the
+    positions or the heading, which a steady turn changes."""
+    pt = steady.point
+    Jx = jacobian(lambda x: derivatives(x, pt.cmd, TRIM.params), pt.x)
+    idx = steady.idx
+    away = [STATE[n] for n in ("x", "y", "z", "psi")]
+    assert np.abs(Jx[np.ix_(idx, away)]).max() < 1e-20  # finite differences of 0
+    np.testing.assert_array_equal(Jx[np.ix_(idx, idx)], steady.Ac)
+    assert steady.states == turn_states(pt.side) and len(steady.states) == 10
+
+
+def test_the_gain_is_the_riccati_solution_and_stabilises(steady):
+    d = steady
+    sa = math.sqrt(d.alpha)
+    P = scipy.linalg.solve_discrete_are(sa * d.A, sa * d.B, d.Q, d.R)
+    K = np.linalg.solve(d.R + d.alpha * d.B.T @ P @ d.B, d.alpha * d.B.T @ P @ d.A)
+    np.testing.assert_allclose(d.P, P, rtol=1e-9, atol=1e-9 * np.abs(P).max())
+    np.testing.assert_allclose(d.K, K, rtol=1e-8, atol=1e-10)
+    assert not d.F.any() and not d.k.any()
+    assert np.max(np.abs(d.closed_loop)) < 0.99
+    # the open loop is not (the Dutch roll)
+    assert np.max(np.abs(np.linalg.eigvals(d.A))) > 1.0
+
+
+def test_the_gain_matches_python_control(steady):
+    control = pytest.importorskip("control")
+    d = steady
+    sa = math.sqrt(d.alpha)
+    K, _, _ = control.dlqr(sa * d.A, sa * d.B, d.Q, d.R)
+    np.testing.assert_allclose(d.K, K, rtol=1e-7, atol=1e-9)
+
+
+def test_the_law_holds_the_design_point(steady):
+    pt = steady.point
+    np.testing.assert_allclose(steady.command(pt.x), pt.cmd, rtol=0, atol=1e-15)
+
+
+def test_a_lock_with_no_steady_flight_designs_about_the_nearest_one():
+    d = lock_turn_lqr(AF, "left", lock_at("left", 5.0))
+    pt = d.point
+    assert not pt.steady
+    # x8-pyfly's edge is about +2.25 deg from trim in the whole envelope;
+    # the design box leaves a little less
+    assert 1.5 < pt.design_offset_deg < 2.3
+    assert abs(pt.offset_deg - 5.0) < 1e-12
+    assert np.abs(d.F).max() > 0 and np.abs(d.k).max() > 0
+    assert np.max(np.abs(d.closed_loop)) < 1.0
+    # the design point is steady with its own lock
+    dd = derivatives(pt.x, pt.cmd, TRIM.params)
+    assert np.abs(dd[[STATE[n] for n in ("u", "v", "w", "p", "q", "r")]]).max() < 1e-10
+    assert pt.x[STATE["left"]] == pt.design_lock
+    # the command holds the true lock on the dead elevon
+    assert d.command(pt.x)[COMMAND["left"]] == pt.lock
