@@ -14,8 +14,8 @@ TRIAL_KERNEL_FILES = {
     "test_airframe_runs.py", "test_api.py", "test_big_runs.py", "test_campaign.py",
     "test_compile_notice.py", "test_dask.py", "test_designs.py", "test_fuzz_configs.py",
     "test_golden.py", "test_lock.py", "test_operating.py", "test_report.py",
-    "test_report_plant.py", "test_resume.py", "test_scenario.py", "test_sensor_faults.py",
-    "test_sweep.py", "test_trial_validity.py", "test_truth_plant.py",
+    "test_report_plant.py", "test_reset_scale.py", "test_resume.py", "test_scenario.py",
+    "test_sensor_faults.py", "test_sweep.py", "test_trial_validity.py", "test_truth_plant.py",
 }
 """Test files that run campaigns, sweeps or scenarios (the trial kernel
 ``core.longitudinal.trial.advance``); the other files test kernels and models piece by piece."""

@@ -107,6 +107,8 @@ class Design:
     controller : str or None
         ``nominal`` or ``reconfiguring``: the design's own controller kind;
         None: the config's ``controller.kind``.
+    reset_scale : float
+        Factor on the reset variances of section 3.2.2 (:func:`scaled_reset`).
     """
 
     name: str
@@ -120,6 +122,7 @@ class Design:
     biases: tuple = ()
     excitation: dict = dataclasses.field(default_factory=lambda: dict(NO_POLICY))
     controller: str | None = None
+    reset_scale: float = 1.0
 
     @property
     def n_aug(self) -> int:
@@ -140,7 +143,8 @@ class Design:
         """
         if math.isinf(t_q) and math.isinf(t_nx):
             return self.det._replace(t_q=math.inf, t_nx=math.inf)
-        det = detection(plant, dataclasses.replace(self.est, t_q=t_q, t_nx=t_nx))
+        det = scaled_reset(detection(plant, dataclasses.replace(self.est, t_q=t_q, t_nx=t_nx)),
+                           self.reset_scale)
         return _with_test(det, self.test, self.window, self.det.min_window)._replace(
             settle=self.det.settle, startup=self.det.startup)
 
@@ -150,6 +154,24 @@ def builtin_design(name: str, est: EstimatorConfig) -> DesignConfig:
     at the ``estimator`` section's thresholds, Table 1 as printed or swapped."""
     assert name in BUILTIN_DESIGNS, name
     return DesignConfig(signature=name, t_q=est.t_q, t_nx=est.t_nx)
+
+
+def scaled_reset(det: Detection, scale: float) -> Detection:
+    """``det`` with its reset variances (section 3.2.2) multiplied by ``scale``
+    (a design's ``reset_scale``; 1 leaves ``det`` as built, the paper's).
+
+    Parameters
+    ----------
+    det : Detection
+    scale : float
+        Factor on the five variances, > 0 (dimensionless).
+
+    Returns
+    -------
+    Detection
+    """
+    assert scale > 0, scale
+    return det if scale == 1.0 else det._replace(reset_var=det.reset_var * scale)
 
 
 def _with_test(det: Detection, test: int, window: int, min_window: int = 1) -> Detection:
@@ -216,14 +238,16 @@ def build_design(name: str, dc: DesignConfig, plant: LinearPlant, est: Estimator
     window = int(round(dc.window_s / plant.dt)) if test == TEST_GLR else 1
     min_window = (1 if test != TEST_GLR or dc.min_change_s is None
                   else int(round(dc.min_change_s / plant.dt)))
-    det = _with_test(detection(plant, s), test, window, min_window)._replace(
+    det = _with_test(scaled_reset(detection(plant, s), dc.reset_scale), test, window,
+                     min_window)._replace(
         settle=int(round(dc.settle_s / plant.dt)), startup=int(round(dc.startup_s / plant.dt)))
     # every field but those Table 1 reads only when it decides (a shared start runs
     # with resets disabled); the excitation policy's are in: it flies before any reset
     key = dc.model_dump_json(exclude={"signature", "t_q", "t_nx"})
     return Design(name=name, est=s, fm=fm, det=det, P0=_c(P0), test=test, window=window,
                   key=key, biases=tuple(dc.sensor_biases),
-                  excitation=excitation_policy(dc, plant.dt), controller=dc.controller)
+                  excitation=excitation_policy(dc, plant.dt), controller=dc.controller,
+                  reset_scale=dc.reset_scale)
 
 
 SENSOR_BIAS_SD = {"q": 5.0 * math.pi / 180.0, "n_x": 0.08, "n_z": 0.08}
