@@ -111,4 +111,34 @@ def scenario_figures(res, out: Path) -> list:
     axs[-1].set_xlabel("time [s]")
     fig.suptitle("Fig. 12: commands (difference from trim)")
     paths.append(save(fig, out / "fig12_commands.png"))
+    if "phi_true" in ts:  # the 6-DOF plant: its lateral motion (issue 26)
+        paths.append(lateral_figure(res, out / "fig13_lateral.png"))
     return paths
+
+
+LATERAL_PANELS = (("phi_true", "bank [deg]", True), ("p_true", "roll rate [deg/s]", True),
+                  ("psi_true", "heading [deg]", True), ("y_true", "cross-track y [m]", False))
+"""Panels of :func:`lateral_figure`: column, label, shown in degrees."""
+
+
+def lateral_figure(res, path: Path) -> Path:
+    """Bank, roll rate, heading and lateral position of a 6-DOF scenario
+    (deviations from trim; the columns of
+    :data:`ftc_mc.scenario.run.LATERAL_COLUMNS`), with the validity's bank
+    bound."""
+    import numpy as np
+
+    ts = res.timeseries
+    t = ts.time_s
+    fig, axs = plt.subplots(len(LATERAL_PANELS), 1, figsize=(8, 8.5), sharex=True)
+    for ax, (col, ylabel, deg) in zip(axs, LATERAL_PANELS):
+        ax.plot(t, np.degrees(ts[col]) if deg else ts[col], lw=0.9)
+        ax.set_ylabel(ylabel)
+        _switch_lines(ax, res)
+        ax.grid(alpha=0.3)
+    bound = res.config.validity.bank_max_deg
+    for b in (-bound, bound):
+        axs[0].axhline(b, color="r", ls="--", lw=0.8)
+    axs[-1].set_xlabel("time [s]")
+    fig.suptitle("Fig. 13 (6-DOF): bank, roll rate, heading and lateral position")
+    return save(fig, path)

@@ -120,7 +120,7 @@ def _timeseries(setup, sc, rec, k_sw, b0, b1) -> pd.DataFrame:
             cols[f"{nm}_true"] = rec.hist_x[:, STATE[nm], 0]
     g = plant.trim.gamma0
     ix, iz = lay.state("x"), lay.state("z")
-    x, z = rec.hist_x[:, ix, 0], rec.hist_x[:, iz, 0]
+    x, z = cols["x_true"], cols["z_true"]  # the truth's rows of x and z (above)
     cols["along_track_error_m"] = x * math.cos(g) - z * math.sin(g)
     cols["cross_track_error_m"] = x * math.sin(g) + z * math.cos(g)
     cols["x_est_error_m"] = rec.hist_xa[:, ix, 0] - x
