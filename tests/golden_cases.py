@@ -36,12 +36,22 @@ CAMPAIGNS = {
                            "controller": {"kind": "reconfiguring"},
                            "plant": {"kind": "nonlinear", "turbulence": "moderate"},
                            "model": PINNED, "timing": SHORT},
+    # the 6-DOF flying wing (issue 26): left and right elevon and an engine row,
+    # nonlinear equations in moderate turbulence, with the lateral autopilot
+    "sixdof_moderate": {"campaign": {"transitions": ["elevon_lock", "right_elevon_loss",
+                                                     "engine_loss"],
+                                     "trials": 4, "chunk_size": 4, "seed": 2026,
+                                     "signature": "both"},
+                        "controller": {"kind": "reconfiguring"},
+                        "plant": {"kind": "nonlinear", "turbulence": "moderate", "dof": 6},
+                        "model": PINNED, "timing": SHORT},
 }
 
 SCENARIOS = {
     "linear": {"model": PINNED},
     "nonlinear_moderate": {"model": PINNED,
                            "plant": {"kind": "nonlinear", "turbulence": "moderate"}},
+    "sixdof": {"model": PINNED, "plant": {"kind": "nonlinear", "dof": 6}},
 }
 
 
