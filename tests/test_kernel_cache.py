@@ -235,3 +235,19 @@ def test_an_unwritable_cache_folder_caches_nothing(tmp_path):
     (root / "ftc_mc" / "core" / "probe_parts" / "scale.py").write_text(SCALE.format(factor=3.0))
     edited = _run(root, cache)
     assert edited["value"] == 3.0 * 1.5 + 9 and edited["hits"] == 0
+
+
+def test_a_source_removed_while_a_process_runs_is_a_change(tmp_path):
+    """``sources_unchanged`` is asked at each save, inside Numba's compile: a
+    module a kernel source imports, removed while the importer kept its stamp,
+    raised FileNotFoundError there (and failed the compile) instead of saying
+    the sources changed."""
+    root = tmp_path / "b"
+    shutil.copytree(PACKAGE, root / "ftc_mc", ignore=shutil.ignore_patterns("__pycache__"))
+    core = root / "ftc_mc" / "core"
+    (root / "ftc_mc" / "layouts.py").write_text("N = 3\n")
+    (core / "uses.py").write_text("from ..layouts import N\n")
+    jit.full_source_digest(core)  # the first stamps of these sources
+    assert jit.sources_unchanged(core)
+    (root / "ftc_mc" / "layouts.py").unlink()
+    assert jit.sources_unchanged(core) is False

@@ -151,7 +151,12 @@ def sources_unchanged(core: Path | None = None) -> bool:
     """
     core = CORE if core is None else Path(core).resolve()
     first = _FIRST_STATS.get(str(core))
-    return first is None or _source_stats(core) == first
+    if first is None:
+        return True
+    try:
+        return _source_stats(core) == first
+    except OSError:  # a source (or one it imports) went while it was listed
+        return False
 
 
 def source_digest(core: Path | None = None) -> str:
