@@ -86,3 +86,26 @@ def test_old_runs_without_the_columns_give_no_table():
 def test_bins_cover_every_offset():
     assert OFFSET_EDGES_DEG[0] == -math.inf and OFFSET_EDGES_DEG[-1] == math.inf
     assert np.all(np.diff(OFFSET_EDGES_DEG) > 0)
+
+
+def test_trials_without_a_lock_offset_are_in_no_bin():
+    """A resumed run assembles older chunks without ``lock_offset`` beside newer
+    ones (the column union, nulls in the older rows): those trials have no
+    offset, and np.digitize put NaN in the last bin ("10 and above")."""
+    t = _trials()
+    old = t[t["transition"] == "elevon_lock"].assign(lock_offset=math.nan,
+                                                     height_lost_m=math.nan)
+    tab = survival_table(pd.concat([t, old], ignore_index=True), 20.0, 100.0)
+    ref = survival_table(t, 20.0, 100.0)
+    assert list(tab["bin"]) == list(ref["bin"])
+    assert list(tab["flying"]) == list(ref["flying"])
+
+
+def test_markdown_rows_follow_the_offset_whatever_design_has_them():
+    """A bin only the second design has is placed by its offset, not after the
+    first design's bins."""
+    t = _trials()
+    a = t[(t["lock_offset"] > 0) | (t["transition"] != "elevon_lock")]
+    tab = survival_table(pd.concat([a, t.assign(variant="robust")]), 20.0, 100.0)
+    md = survival_markdown(tab)
+    assert md.index("| -2 to -0.5") < md.index("| 2 to 5")
