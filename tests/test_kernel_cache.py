@@ -218,3 +218,36 @@ def test_sources_edited_while_a_process_runs_never_leave_a_stale_kernel(tmp_path
     assert res["digest"] == race["digest"] and res["hits"] == 0
     assert res["value"] == 3.0 * 1.5 - 1.0
     assert "not cached" not in after.stderr
+
+
+@pytest.mark.skipif(not jit.CACHE, reason="FTC_MC_NUMBA_CACHE=0")
+def test_an_unwritable_cache_folder_caches_nothing(tmp_path):
+    """When the content-keyed folder cannot be written, a kernel of core/ is not
+    cached at all: Numba's own locators (the source tree's ``__pycache__``) stamp
+    an index with the kernel's own file only, so after an edit of a kernel it
+    inlines, the next process loaded the old value."""
+    root = _copy(tmp_path / "a")
+    (tmp_path / "blocker").write_text("a file, not a folder")
+    cache = tmp_path / "blocker" / "cache"  # mkdir fails, even as root
+    first = _run(root, cache)
+    assert first["value"] == 2.0 * 1.5 + 9 and first["cache"] is None
+    assert not list((root / "ftc_mc" / "core").rglob("probe.*.nbi"))
+    (root / "ftc_mc" / "core" / "probe_parts" / "scale.py").write_text(SCALE.format(factor=3.0))
+    edited = _run(root, cache)
+    assert edited["value"] == 3.0 * 1.5 + 9 and edited["hits"] == 0
+
+
+def test_a_source_removed_while_a_process_runs_is_a_change(tmp_path):
+    """``sources_unchanged`` is asked at each save, inside Numba's compile: a
+    module a kernel source imports, removed while the importer kept its stamp,
+    raised FileNotFoundError there (and failed the compile) instead of saying
+    the sources changed."""
+    root = tmp_path / "b"
+    shutil.copytree(PACKAGE, root / "ftc_mc", ignore=shutil.ignore_patterns("__pycache__"))
+    core = root / "ftc_mc" / "core"
+    (root / "ftc_mc" / "layouts.py").write_text("N = 3\n")
+    (core / "uses.py").write_text("from ..layouts import N\n")
+    jit.full_source_digest(core)  # the first stamps of these sources
+    assert jit.sources_unchanged(core)
+    (root / "ftc_mc" / "layouts.py").unlink()
+    assert jit.sources_unchanged(core) is False

@@ -86,3 +86,46 @@ def test_old_runs_without_the_columns_give_no_table():
 def test_bins_cover_every_offset():
     assert OFFSET_EDGES_DEG[0] == -math.inf and OFFSET_EDGES_DEG[-1] == math.inf
     assert np.all(np.diff(OFFSET_EDGES_DEG) > 0)
+
+
+def test_trials_without_a_lock_offset_are_in_no_bin():
+    """A resumed run assembles older chunks without ``lock_offset`` beside newer
+    ones (the column union, nulls in the older rows): those trials have no
+    offset, and np.digitize put NaN in the last bin ("10 and above")."""
+    t = _trials()
+    old = t[t["transition"] == "elevon_lock"].assign(lock_offset=math.nan,
+                                                     height_lost_m=math.nan)
+    tab = survival_table(pd.concat([t, old], ignore_index=True), 20.0, 100.0)
+    ref = survival_table(t, 20.0, 100.0)
+    assert list(tab["bin"]) == list(ref["bin"])
+    assert list(tab["flying"]) == list(ref["flying"])
+
+
+def test_markdown_rows_follow_the_offset_whatever_design_has_them():
+    """A bin only the second design has is placed by its offset, not after the
+    first design's bins."""
+    t = _trials()
+    a = t[(t["lock_offset"] > 0) | (t["transition"] != "elevon_lock")]
+    tab = survival_table(pd.concat([a, t.assign(variant="robust")]), 20.0, 100.0)
+    md = survival_markdown(tab)
+    assert md.index("| -2 to -0.5") < md.index("| 2 to 5")
+
+
+def test_the_report_loads_the_columns_it_needs(tmp_path):
+    """The report reads only ``report.load.TRIAL_COLUMNS`` of trials.parquet: the
+    survival table's columns must be among them, or the report's section and
+    figure never appear."""
+    from ftc_mc.io.results import write_parquet
+    from ftc_mc.report.load import load_result_dir
+    from ftc_mc.report.runs import survival_lines
+
+    cfg = {"timing": {"fault_time_s": 20.0, "duration_s": 100.0}}
+    meta = {"kind": "run", "config": cfg, "seed": 0}
+    t = _trials().assign(trial_id=np.arange(len(_trials())))
+    write_parquet(t, tmp_path / "trials.parquet", meta)
+    write_parquet(pd.DataFrame({"transition": ["elevon_lock"]}), tmp_path / "summary.parquet",
+                  meta)
+    r = load_result_dir(tmp_path)
+    assert len(survival_table(r.tables["trials"], 20.0, 100.0)) == 2
+    lines = survival_lines(r.tables["trials"], cfg, tmp_path / "s.png", tmp_path / "r.md")
+    assert lines and "### Survival after an elevon lock" in lines[0]

@@ -94,14 +94,17 @@ def survival_table(trials: pd.DataFrame, fault_time_s: float, duration_s: float,
         ``left``, ``survived_rate``, ``survived_ci_low``, ``survived_ci_high``,
         ``median_leave_s``, ``height_lost_median_m``, ``unknown``,
         ``horizon_s``; empty when the run has no elevon-lock row or its trials
-        lack the columns (a run written before them).
+        lack the columns (a run written before them); trials without a
+        ``lock_offset`` (older chunks of a resumed run) are left out.
     """
     need = {"lock_offset", "height_lost_m", "status", "stop_s"}
     rows = []
     if not need <= set(trials.columns):
         return pd.DataFrame(rows)
     horizon = horizon_of(fault_time_s, duration_s)
-    locks = trials[trials["transition"].map(_is_elevon_lock)]
+    # a trial without an offset (an older chunk of a resumed run) is in no bin
+    locks = trials[trials["transition"].map(_is_elevon_lock)
+                   & np.isfinite(trials["lock_offset"].to_numpy(dtype=float))]
     edges = np.asarray(edges, dtype=float)
     for (name, variant), g in locks.groupby(["transition", "variant"], sort=False):
         off = np.degrees(g["lock_offset"].to_numpy(dtype=float))
@@ -152,7 +155,8 @@ def survival_markdown(table: pd.DataFrame) -> str:
     for name, g in table.groupby("transition", sort=False):
         out += [f"### `{name}`", ""]
         rows = []
-        for b, gb in g.groupby("bin", sort=False):
+        for b, gb in g.sort_values("offset_lo_deg", kind="stable").groupby("bin",
+                                                                          sort=False):
             row = {"lock offset [deg]": b}
             for _, r in gb.iterrows():
                 v = r["variant"]

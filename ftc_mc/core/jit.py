@@ -14,7 +14,9 @@ such as ``conventions.py``), and its index is stamped with that digest:
 by default).  No path of the clone enters the folder or the stamp, so another
 clone or install of identical sources loads the kernels, while any edit of a
 kernel source starts a new folder.  A process whose kernel sources change while
-it runs saves no kernel (:func:`sources_unchanged`).  ``NUMBA_CACHE_DIR`` in the environment takes
+it runs saves no kernel (:func:`sources_unchanged`), and a kernel whose cache
+folder cannot be written is not cached (Numba's own locators, keyed on the
+kernel's file alone, are not tried for the kernels of ``core/``).  ``NUMBA_CACHE_DIR`` in the environment takes
 precedence over ``$FTC_MC_CACHE_DIR/numba`` (``$NUMBA_CACHE_DIR/<digest>``; the
 benchmarks point it at an empty folder), and ``FTC_MC_NUMBA_CACHE=0`` turns caching off.  ``fastmath`` stays
 off: it was no faster here (``scripts/bench_core.py``) and breaks bit-for-bit
@@ -149,7 +151,12 @@ def sources_unchanged(core: Path | None = None) -> bool:
     """
     core = CORE if core is None else Path(core).resolve()
     first = _FIRST_STATS.get(str(core))
-    return first is None or _source_stats(core) == first
+    if first is None:
+        return True
+    try:
+        return _source_stats(core) == first
+    except OSError:  # a source (or one it imports) went while it was listed
+        return False
 
 
 def source_digest(core: Path | None = None) -> str:
@@ -210,9 +217,18 @@ class ContentCacheLocator(caching._CacheLocator):
         self = cls(py_func, path, CORE)
         try:
             self.ensure_cache_path()
-        except OSError:  # not writable: Numba's other locators may do
-            return None
+        except OSError as exc:
+            # not writable: no disk cache for this kernel.  Numba's own locators
+            # (next in the list) would stamp it with its own file only, so a
+            # later process would load it stale after an edit of a kernel it
+            # inlines (:func:`_njit` leaves the kernel uncached)
+            raise CacheUnavailable(f"{self._cache_path}: {exc}") from exc
         return self
+
+
+class CacheUnavailable(RuntimeError):
+    """The content-keyed cache folder of a kernel of :data:`CORE` cannot be
+    written (:meth:`ContentCacheLocator.from_function`)."""
 
 
 class ContentCacheImpl(caching.FunctionCache._impl_class):
@@ -275,8 +291,20 @@ def _njit(func, opts):
     cache = opts.pop("cache")
     dispatcher = numba.njit(**opts)(func)
     if cache:
-        dispatcher._cache = ContentFunctionCache(func)  # Dispatcher.enable_caching
+        try:
+            dispatcher._cache = ContentFunctionCache(func)  # Dispatcher.enable_caching
+        except CacheUnavailable as exc:  # compiled in every process
+            global _UNCACHED_WARNED
+            if not _UNCACHED_WARNED:
+                import sys
+                print(f"ftc-mc: the kernel cache folder cannot be written ({exc}); "
+                      "the kernels are compiled in every process (set FTC_MC_CACHE_DIR "
+                      "to a writable folder)", file=sys.stderr, flush=True)
+                _UNCACHED_WARNED = True
     return dispatcher
+
+
+_UNCACHED_WARNED = False
 
 
 COMPILE_NOTICE = ("ftc-mc: compiling the simulation kernels of this path once: {} "

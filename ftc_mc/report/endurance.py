@@ -17,17 +17,19 @@ import numpy as np
 import pandas as pd
 
 from .load import ResultDir
-from .markdown import plant_text
+from .markdown import controller_of, plant_text
 
 THRESHOLDS = ("t_q", "t_nx")
 
 
 def _definition(cfg: dict, design: str) -> str:
     """The design ``design`` of a stored config as JSON, without its thresholds: a
-    key of ``designs``, or a built-in one (the ``estimator`` section)."""
+    key of ``designs``, or a built-in one (the ``estimator`` section), with the
+    controller it flies (its own, else the ``controller`` section's kind)."""
     d = dict(cfg.get("designs", {}).get(design) or cfg.get("estimator", {}))
     for t in THRESHOLDS:
         d.pop(t, None)
+    d["controller"] = controller_of(cfg, design)
     return json.dumps(d, sort_keys=True)
 
 

@@ -31,7 +31,7 @@ TRIAL_COLUMNS = ("transition", "variant", "trial_id", "correct", "inappropriate"
                  "no_reset", "first_reset_s", "false_resets", "detection_s", "mode_changed",
                  "detected", "small_b1", "lock_near_trim", "resets_truncated", "judged",
                  "status", "stop_s", "sensor_output", "sensor_kind", "sensor_size",
-                 *SUMMARY_COLUMNS)
+                 "lock_offset", "height_lost_m", *SUMMARY_COLUMNS)
 """The ``trials.parquet`` columns the report reads (its sections, figures and the
 summary function); only these are loaded, so the report of a run of millions
 of trials fits in memory (issue 27).  The others (draws, final estimates, the

@@ -107,6 +107,14 @@ def airframe_of(cfg: dict) -> str:
     return Path(spec).stem if Path(spec).suffix.lower() in AIRFRAME_FILE_SUFFIXES else spec
 
 
+def controller_of(cfg: dict, design: str | None) -> str:
+    """The controller kind the design ``design`` flies in a stored config: its
+    own ``controller``, else the ``controller`` section's ``kind``
+    (``Config.controller_of``)."""
+    own = (cfg.get("designs", {}).get(design) or {}).get("controller") if design else None
+    return own or cfg.get("controller", {}).get("kind", "?")
+
+
 def plant_text(cfg: dict) -> str:
     """``airframe `name`, truth plant `kind`, turbulence `level``` of a config."""
     kind, turbulence = plant_condition(cfg)

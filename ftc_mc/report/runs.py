@@ -347,18 +347,22 @@ def _design_text(cfg: dict) -> str:
         d = defs.get(n, {})
         test = d.get("test", "?") + (f" {d.get('window_s', '?'):g} s"
                                      if d.get("test") == "glr" else "")
+        own = f", controller `{d['controller']}`" if d.get("controller") else ""
         return (f"`{n}` ({d.get('estimator', '?')} estimator, {test}, "
-                f"t_q {d.get('t_q', '?')}, t_nx {d.get('t_nx', '?')})")
+                f"t_q {d.get('t_q', '?')}, t_nx {d.get('t_nx', '?')}{own})")
 
     return (", designs " + ", ".join(one(n) for n in names)) if names else ""
 
 
 def _run_header(cfg: dict) -> str:
     c = cfg.get("campaign", {})
+    own = any((cfg.get("designs", {}).get(n) or {}).get("controller")
+              for n in c.get("designs", []))
     return (f"{len(c.get('transitions', []))} transition(s), {c.get('trials', '?')} trials "
             f"each, seed {c.get('seed', '?')}, signature `{c.get('signature', '?')}`"
             f"{_design_text(cfg)}, "
-            f"controller `{cfg.get('controller', {}).get('kind', '?')}`, "
+            f"controller `{cfg.get('controller', {}).get('kind', '?')}`"
+            f"{' where a design names none' if own else ''}, "
             f"{plant_text(cfg)}.")
 
 

@@ -14,7 +14,7 @@ import pandas as pd
 
 from ..paper import PAPER_EXCITATIONS, PAPER_TIMELINE
 from .load import ResultDir
-from .markdown import num, plant_text, rel_link
+from .markdown import controller_of, num, plant_text, rel_link
 
 
 def _in_segment(ev: pd.DataFrame, kind: str, t0: float, t1: float) -> pd.DataFrame:
@@ -128,7 +128,7 @@ def scenario_section(r: ResultDir, report: Path) -> list:
     return ([f"## Scenario `{r.path}`", "",
              (f"Design `{sc['design']}`, controller " if sc.get("design") else
               f"Signature `{sc.get('signature', '?')}`, controller ") +
-             f"`{r.meta.get('config', {}).get('controller', {}).get('kind', '?')}`, seed "
+             f"`{controller_of(r.meta.get('config', {}), sc.get('design'))}`, seed "
              f"{sc.get('seed', '?')}, {sc.get('duration_s', '?')} s, "
              f"{len(sc.get('schedule', []))} schedule entries, "
              f"{plant_text(r.meta.get('config', {}))}.", "",

@@ -1,0 +1,56 @@
+"""The controller a design flies (its own ``controller``, else the controller
+section's kind) in the report: run and scenario headers, and the endurance runs
+an operating characteristic matches to a sweep's designs."""
+
+from __future__ import annotations
+
+from types import SimpleNamespace
+
+import pandas as pd
+
+from ftc_mc.report.endurance import matching_endurance
+from ftc_mc.report.markdown import controller_of
+from ftc_mc.report.runs import _run_header
+
+DESIGN = {"estimator": "paper", "test": "one_step", "t_q": 25.0, "t_nx": 25.0}
+
+
+def _cfg(kind="reconfiguring", own=None):
+    return {"campaign": {"transitions": ["elevon_lock"], "trials": 10, "seed": 1,
+                         "signature": "paper", "designs": ["d"]},
+            "controller": {"kind": kind}, "estimator": {"sigma_qx": 1.0},
+            "designs": {"d": dict(DESIGN, controller=own)},
+            "plant": {"kind": "nonlinear", "turbulence": "none"},
+            "model": {"airframe": "x8-pyfly"}}
+
+
+def test_controller_of_a_stored_config():
+    assert controller_of(_cfg(own="nominal"), "d") == "nominal"
+    assert controller_of(_cfg(own=None), "d") == "reconfiguring"
+    assert controller_of(_cfg(own="nominal"), "paper") == "reconfiguring"  # built-in
+    assert controller_of(_cfg(own="nominal"), None) == "reconfiguring"
+
+
+def test_run_header_names_a_designs_own_controller():
+    head = _run_header(_cfg(own="nominal"))
+    assert "t_nx 25.0, controller `nominal`)" in head
+    assert "controller `reconfiguring` where a design names none" in head
+    plain = _run_header(_cfg(own=None))
+    assert "controller `reconfiguring`," in plain and "names none" not in plain
+
+
+def test_endurance_rows_match_the_controller_a_design_flies():
+    """An endurance run whose design flew another controller (its own, or the
+    config's kind) is not the sweep's design."""
+    table = pd.DataFrame({"variant": ["d", "paper"]})
+
+    def run(cfg):
+        return SimpleNamespace(meta={"config": cfg}, tables={"endurance": table})
+
+    sweep = _cfg(kind="reconfiguring")
+    same = matching_endurance([run(_cfg(kind="reconfiguring"))], sweep)
+    assert list(same["variant"]) == ["d", "paper"]
+    assert matching_endurance([run(_cfg(kind="nominal"))], sweep) is None
+    # the design's own controller wins over the kind, on either side
+    own = matching_endurance([run(_cfg(kind="nominal", own="reconfiguring"))], sweep)
+    assert list(own["variant"]) == ["d"]
