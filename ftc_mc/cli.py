@@ -332,7 +332,8 @@ def terminal_table(summary) -> str:
               help="Table 1 variant(s) (overrides the config).")
 @click.option("--design", "design", multiple=True, metavar="NAME", help=DESIGN_HELP)
 @click.option("--controller", type=click.Choice(["nominal", "reconfiguring"]),
-              help="Controller in the loop (overrides the config).")
+              help="Controller in the loop (overrides the config's controller.kind; a "
+                   "design that sets its own controller keeps it).")
 @click.option("--overwrite", is_flag=True, help="Replace results already in --out.")
 @click.option("--resume", is_flag=True,
               help="Continue an interrupted run in --out, skipping its finished chunks.")
