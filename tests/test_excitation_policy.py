@@ -158,3 +158,21 @@ def test_sweep_runs_a_policy_like_any_design():
                                  jobs=1, progress=False).trials
         shared = res.trials[res.trials.t_q == t].drop(columns=["t_q", "t_nx"])
         pd.testing.assert_frame_equal(alone, shared.reset_index(drop=True), check_exact=True)
+
+
+def test_report_shows_the_cost_of_flying():
+    """The report's cost table (issue 25) reads the summary's cost columns, one
+    row per transition and design; a run written before them gets none."""
+    from ftc_mc.report.runs import cost_lines
+
+    summary = pd.DataFrame([
+        {"label": "Elevon loss", "variant": v, "track_rms_m": rms, "track_max_m_mean": 0.5,
+         "track_max_m": mx, "control_energy_throttle": 0.002,
+         "control_energy_elevon_left": 0.117, "control_energy_elevon_right": 0.157}
+        for v, rms, mx in (("swapped", 0.025, 0.9), ("per", 0.0312, 1.25))])
+    text = "\n".join(cost_lines(summary))
+    assert "### Cost of flying" in text
+    rows = [line for line in text.splitlines() if line.startswith("| Elevon loss")]
+    assert len(rows) == 2 and "per" in rows[1] and "0.0312" in rows[1]
+    assert "0.5 / 1.25" in text and "0.117 / 0.157" in text
+    assert cost_lines(summary.drop(columns=["track_rms_m"])) == []

@@ -109,6 +109,30 @@ def paper_tables(summary: pd.DataFrame) -> list:
     return lines
 
 
+def cost_lines(summary: pd.DataFrame) -> list:
+    """Markdown lines: what flying cost, per row and design (issue 25), from the
+    summary's cost columns (:func:`ftc_mc.campaign.summary.cost_summary`);
+    nothing for a run written before them."""
+    if "track_rms_m" not in summary:
+        return []
+    rows = [{"transition": r["label"], "design": r["variant"],
+             "track RMS [m]": num(r["track_rms_m"], "{:.3g}"),
+             "largest track error, mean / max [m]":
+                 f"{num(r['track_max_m_mean'], '{:.3g}')} / {num(r['track_max_m'], '{:.3g}')}",
+             "energy throttle [s]": num(r["control_energy_throttle"], "{:.3g}"),
+             "energy left / right elevon [rad^2 s]":
+                 f"{num(r['control_energy_elevon_left'], '{:.3g}')} / "
+                 f"{num(r['control_energy_elevon_right'], '{:.3g}')}"}
+            for _, r in summary.iterrows()]
+    return ["### Cost of flying", "",
+            pd.DataFrame(rows).to_markdown(index=False), "",
+            "Over the judged trials: the RMS of the glide path's cross-track error "
+            "`x sin(gamma0) + z cos(gamma0)` (each trial weighted equally), the mean and "
+            "the largest of each trial's largest error, and the mean control energy of "
+            "each command (its squared deviation from trim times dt, excitation "
+            "included), over the steps each trial flew.", ""]
+
+
 # ------------------------------------------------------------------ exclusions
 
 
@@ -398,7 +422,7 @@ def run_section(r: ResultDir, fig_dir: Path, slug: str, report: Path) -> list:
         return head + sensor
     fig = delay_figure(trials, fig_dir / f"{slug}_delays.png", LABELS)
     return (head + ["### Tables 2-3: ours beside the paper", ""] + paper_tables(summary)
-            + ["### Excluded trials", ""] + exclusion_table(summary, trials, cfg)
+            + cost_lines(summary) + ["### Excluded trials", ""] + exclusion_table(summary, trials, cfg)
             + [_comparison_heading(trials), ""] + variant_comparison(trials)
             + ["### Delay distributions", "", f"![delays of {slug}]({rel_link(fig, report)})",
                ""] + real_flight_lines(trials)
