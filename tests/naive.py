@@ -721,8 +721,11 @@ def commands_ref(scheme, st, k):
         s, A_s = 0.0, 0.0
         if running_ref(k, st.s_start[l], s_len):
             s = signal_3211_ref(k - st.s_start[l], exc.s3211_unit, exc.s3211_amp)
-            if st.cur[l] == C2:  # eq. 23
-                s = (1.0 - X[B1_L]) * s
+            if st.cur[l] == C2:  # eq. 23, with the design's floor (issue 25)
+                g = 1.0 - X[B1_L]
+                if exc.s3211_floor > 0.0:
+                    g = max(g, exc.s3211_floor)
+                s = g * s
             A_s = exc.s3211_amp
         sig, amp = (sd, s, -s), (A_d, A_s, A_s)
         for i in range(3):

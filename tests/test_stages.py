@@ -391,6 +391,36 @@ def test_commands(fixture, request):
         assert scaled > 0
 
 
+@pytest.mark.parametrize("floor", [0.0, 0.2, 0.5])
+def test_commands_s3211_floor(linear, floor):
+    """Under c2 the 3211 is scaled by ``max(1 - b1_left_hat, floor)`` (a design's
+    ``s3211_floor``, issue 25): with the left elevon estimated locked (b1 = 1)
+    eq. 23 sends nothing, a floor sends ``floor`` times the signal; an estimate
+    whose ``1 - b1`` exceeds the floor is scaled as eq. 23 prints."""
+    scheme = scheme_of(linear)
+    scheme = scheme._replace(excitation=scheme.excitation._replace(s3211_floor=floor))
+    exc = scheme.excitation
+    rng = np.random.default_rng(41)
+    k = 40
+    st = random_lanes(linear, rng, k)
+    st.cur[:] = C_ELEVON
+    st.s_start[:] = k - np.arange(L) % (7 * exc.s3211_unit)  # every lane mid-3211
+    st.xa[I_B1_LEFT, :] = 1.0
+    st.xa[I_B1_LEFT, 1] = 0.3  # 1 - b1 = 0.7 above every floor: eq. 23 as printed
+    work = new_trial_work(L, N_AUG)
+    stages.commands(path_of(scheme), scheme, st, k, work)
+    u_n, exc_n = naive.commands_ref(scheme, st, k)
+    assert np.array_equal(work.exc, exc_n)
+    assert_lanes(work.u, u_n, 1e-12, "u")
+    sig = np.array([naive.signal_3211_ref(k - st.s_start[l], exc.s3211_unit, exc.s3211_amp)
+                    for l in range(L)])
+    assert np.all(sig != 0.0)
+    want = floor * sig
+    want[1] = (1.0 - 0.3) * sig[1]
+    assert np.array_equal(work.exc[1], want)
+    assert np.all(work.exc[1, np.arange(L) != 1] == 0.0) == (floor == 0.0)
+
+
 @pytest.mark.parametrize("fixture", ["linear", "linear_gusts", "nonlinear_gusts"])
 def test_truth_step(fixture, request):
     """Effect (eq. 2, exact), gusts, plant and measurement at 1e-12 relative,

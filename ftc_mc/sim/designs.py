@@ -58,22 +58,25 @@ from .estimator import EstimatorSettings, detection, filter_model, initial_covar
 
 
 NO_POLICY = {"policy": EXCITE_NONE, "period": 1, "phase": 0, "belief_max": 0.0,
-             "suspect": math.inf}
+             "suspect": math.inf, "s3211_floor": 0.0}
 """The policy fields of :class:`~ftc_mc.core.longitudinal.settings.Excitation` of a
-design without an excitation policy (the paper's: signals on resets only)."""
+design without an excitation policy (the paper's: signals on resets only, the 3211
+under c2 scaled by ``1 - b1_left_hat`` as eq. 23 prints)."""
 
 
 def excitation_policy(dc: DesignConfig, dt: float) -> dict:
     """The policy fields of the kernels' ``Excitation`` for the design ``dc``
-    (``dt``: the control period [s]); :data:`NO_POLICY` for ``none``."""
+    (``dt``: the control period [s]); :data:`NO_POLICY` for ``none``, with the
+    design's ``s3211_floor`` (issue 25) either way."""
     if dc.excitation_policy == "none":
-        return dict(NO_POLICY)
+        return {**NO_POLICY, "s3211_floor": float(dc.s3211_floor)}
     return {"policy": EXCITATION_POLICIES.index(dc.excitation_policy),
             "period": int(round(dc.excitation_period_s / dt)),
             "phase": int(round(dc.excitation_phase_s / dt)),
             "belief_max": float(dc.excitation_belief),
             "suspect": (math.inf if dc.excitation_residual is None
-                        else float(dc.excitation_residual))}
+                        else float(dc.excitation_residual)),
+            "s3211_floor": float(dc.s3211_floor)}
 
 
 @dataclasses.dataclass(frozen=True)

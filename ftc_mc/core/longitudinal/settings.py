@@ -151,6 +151,8 @@ Excitation = namedtuple("Excitation", [
                         #    is below this (0: never)
     "suspect",          # ambiguous: send when r_q or r_nx (the decision statistics)
                         #    reach this (inf: never)
+    "s3211_floor",      # under c2 the 3211 is scaled by max(1 - b1_left_hat, this)
+                        #    (0: eq. 23 as printed; DesignConfig.s3211_floor, issue 25)
 ])
 """Excitation on reset requests (paper sections 3.2.3 and 4.1.1), and the
 design's policy of sending more (issue 25)."""

@@ -97,7 +97,8 @@ def commands(path, scheme, st, k, work):
     c2 of eqs. 20-25).  Then the saturation with excitation
     headroom (eq. 15, eq. 16 without a signal): the doublet on the engine while
     one runs; the 3211 on the left elevon and its negative on the right while
-    one runs, scaled by ``1 - b1_left_hat`` under c2 (eq. 23).
+    one runs, scaled by ``1 - b1_left_hat`` under c2 (eq. 23), or by the
+    design's ``exc.s3211_floor`` where that is larger (issue 25; 0: eq. 23).
 
     Parameters
     ----------
@@ -140,7 +141,10 @@ def commands(path, scheme, st, k, work):
         if running(k, st.s_start[l], s_len):
             s = signal_3211(ks, exc.s3211_unit, exc.s3211_amp)
             if st.cur[l] == C_ELEVON:  # eq. 23: scaled by the left elevon's efficiency
-                s *= 1.0 - xa[I_B1_LEFT, l]
+                g = 1.0 - xa[I_B1_LEFT, l]
+                if exc.s3211_floor > 0.0 and g < exc.s3211_floor:  # the design's floor
+                    g = exc.s3211_floor
+                s *= g
             a = exc.s3211_amp
         else:
             s = 0.0
