@@ -53,6 +53,8 @@ def config(transitions=("elevon_loss",), trials=8, **over):
     ({"excitation_policy": "ambiguous", "excitation_belief": 1.5}, "designs.x.excitation_belief"),
     ({"excitation_policy": "ambiguous", "excitation_residual": 0.0},
      "designs.x.excitation_residual"),
+    ({"s3211_floor": 1.5}, "designs.x.s3211_floor"),
+    ({"s3211_floor": -0.1}, "designs.x.s3211_floor"),
 ])
 def test_bad_policies_are_one_line(design, needle):
     with pytest.raises(UserError) as exc:
@@ -76,6 +78,23 @@ def test_policy_reaches_the_kernels_as_data():
     assert [type(v) for v in per] == [type(v) for v in sw] == [type(v) for v in amb]
     keys = {n: setup.designs[n].key for n in ("per", "amb", "swapped")}
     assert len(set(keys.values())) == 3
+
+
+def test_s3211_floor_reaches_the_kernels():
+    """A design's ``s3211_floor`` (issue 25) fills ``Excitation.s3211_floor`` as a
+    float, with or without a policy; the built-in designs keep 0 (eq. 23); it is
+    part of the design key."""
+    cfg = config(designs={"per": {**PERIODIC, "s3211_floor": 0.5},
+                          "fl": {"signature": "swapped", "s3211_floor": 0.2},
+                          "amb": AMBIGUOUS},
+                 campaign={"transitions": ["elevon_unlock"], "trials": 8, "chunk_size": 8,
+                           "signature": "swapped", "designs": ["per", "fl"]})
+    setup = chunk_spec(cfg).setup
+    per, fl, sw = (setup.scheme(n).excitation for n in ("per", "fl", "swapped"))
+    assert (per.s3211_floor, fl.s3211_floor, sw.s3211_floor) == (0.5, 0.2, 0.0)
+    assert fl._asdict() == {**sw._asdict(), "s3211_floor": 0.2}
+    assert type(sw.s3211_floor) is type(fl.s3211_floor) is float
+    assert setup.designs["fl"].key != setup.designs["swapped"].key
 
 
 def test_shared_start_with_a_policy_equals_running_alone():
