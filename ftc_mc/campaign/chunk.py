@@ -518,12 +518,17 @@ def classify_flights(variant: str, flight_ids, rec: TrialRecord, dt: float, n_s:
     return flights, resets
 
 
+def steps_flown(rec: TrialRecord, n_steps: int) -> np.ndarray:
+    """Per lane, the steps flown: to the stop (``stop_k``), or all ``n_steps``."""
+    return np.where(rec.stop_k >= 0, rec.stop_k, n_steps)
+
+
 def lateral_columns(rec: TrialRecord, n_steps: int) -> dict:
     """The 6-DOF plant's lateral columns of each trial: ``bank_rms_deg`` and
     ``heading_rms_deg``, the RMS of the bank and heading deviations from trim
     [deg] over the steps the trial flew (to its end, or to its exit from the
     validity envelope)."""
-    flown = np.maximum(np.where(rec.stop_k >= 0, rec.stop_k, n_steps), 1)
+    flown = np.maximum(steps_flown(rec, n_steps), 1)
     return {"bank_rms_deg": np.degrees(np.sqrt(rec.sq_lat[0] / flown)),
             "heading_rms_deg": np.degrees(np.sqrt(rec.sq_lat[1] / flown))}
 
@@ -541,7 +546,7 @@ def cost_columns(rec: TrialRecord, n_steps: int, dt: float) -> dict:
     true state after each step; ``control_energy_<command>``, the sum of the
     command's squared deviation from trim times ``dt`` (throttle: [s], elevons:
     [rad^2 s]), excitation included."""
-    flown = np.maximum(np.where(rec.stop_k >= 0, rec.stop_k, n_steps), 1)
+    flown = np.maximum(steps_flown(rec, n_steps), 1)
     out = {"track_rms_m": np.sqrt(rec.cost[COST_TRACK_SQ] / flown),
            "track_max_m": rec.cost[COST_TRACK_MAX].copy()}
     for i, name in enumerate(LONGITUDINAL.inputs):
@@ -557,7 +562,7 @@ def height_columns(rec: TrialRecord, setup) -> dict:
     ``V0 t sin(gamma0) - z`` above the start, ``z`` the vertical deviation, down,
     from the reference point flying the glide path)."""
     dt = setup.plant.dt
-    last = np.where(rec.stop_k >= 0, rec.stop_k, setup.tim.n_steps) * dt
+    last = steps_flown(rec, setup.tim.n_steps) * dt
     climb = setup.plant.trim.V0 * np.sin(setup.plant.trim.gamma0)
     z_switch, z_last = rec.z_switch_last
     return {"height_lost_m": climb * (setup.tim.k_fault * dt - last) + z_last - z_switch}
