@@ -139,13 +139,15 @@ def survival_table(trials: pd.DataFrame, fault_time_s: float, duration_s: float,
     return pd.DataFrame(rows)
 
 
-def survival_markdown(table: pd.DataFrame) -> str:
+def survival_markdown(table: pd.DataFrame, level: int = 2) -> str:
     """The survival table in Markdown, one block per elevon-lock row: a line per
-    offset bin, a column group per design."""
+    offset bin, a column group per design; headings at ``level`` (``#`` count),
+    one deeper per row."""
     if not len(table):
         return ""
     horizon = table["horizon_s"].iloc[0]
-    out = [f"## Survival after an elevon lock ({horizon:g} s horizon)", "",
+    head = "#" * level
+    out = [f"{head} Survival after an elevon lock ({horizon:g} s horizon)", "",
            "Share of the trials flying at the lock that stay inside the validity envelope "
            f"for {horizon:g} s after it (95 % Wilson interval), median time from the lock "
            "to the exit (`>H`: at least half stay in), median height lost until the exit "
@@ -153,7 +155,7 @@ def survival_markdown(table: pd.DataFrame) -> str:
            "command. Trials that stopped numerically within the horizon are left out "
            "(`unknown`).", ""]
     for name, g in table.groupby("transition", sort=False):
-        out += [f"### `{name}`", ""]
+        out += [f"{head}# `{name}`", ""]
         rows = []
         for b, gb in g.sort_values("offset_lo_deg", kind="stable").groupby("bin",
                                                                           sort=False):

@@ -422,7 +422,8 @@ def run_section(r: ResultDir, fig_dir: Path, slug: str, report: Path) -> list:
         return head + sensor
     fig = delay_figure(trials, fig_dir / f"{slug}_delays.png", LABELS)
     return (head + ["### Tables 2-3: ours beside the paper", ""] + paper_tables(summary)
-            + cost_lines(summary) + ["### Excluded trials", ""] + exclusion_table(summary, trials, cfg)
+            + cost_lines(summary)
+            + ["### Excluded trials", ""] + exclusion_table(summary, trials, cfg)
             + [_comparison_heading(trials), ""] + variant_comparison(trials)
             + ["### Delay distributions", "", f"![delays of {slug}]({rel_link(fig, report)})",
                ""] + real_flight_lines(trials)
@@ -442,6 +443,5 @@ def survival_lines(trials: pd.DataFrame, cfg: dict, fig_path: Path, report: Path
     if not len(table):
         return []
     fig = survival_figure(table, fig_path, LABELS)
-    text = survival_markdown(table).replace("## Survival", "### Survival", 1)
-    text = text.replace("\n### `", "\n#### `")
-    return [text, "", f"![survival of {fig_path.stem}]({rel_link(fig, report)})", ""]
+    return [survival_markdown(table, level=3), "",
+            f"![survival of {fig_path.stem}]({rel_link(fig, report)})", ""]
