@@ -56,6 +56,8 @@ def campaign_configs() -> dict:
     """File name -> YAML text of every shipped campaign config."""
     files = {}
     no_sensor = ("sensor_draws",)
+    six = no_sensor  # the 6-DOF configs show the side monitor, which flies only there
+    no_sensor = ("sensor_draws", "monitor")
     # the paper's eight rows (the right elevon's, issue 24, are not in the paper)
     for name in PAPER_TRANSITIONS:
         tr = TRANSITION_TABLE[name]
@@ -78,7 +80,7 @@ def campaign_configs() -> dict:
     files["sensor_faults.yaml"] = render_yaml(
         cfg, "ftc-mc run configs/sensor_faults.yaml -- what the actuator FDI does with "
              "sensor faults (issue 14): bias, stuck, drift on q, n_x, n_z, alpha, theta, "
-             "Va; default airframe, the paper's design")
+             "Va; default airframe, the paper's design", omit=("monitor",))
     cfg = Config.model_validate({
         "campaign": {"transitions": [*PAPER_TRANSITIONS, *(f"sensor_bias:{o}" for o in
                                                          ("q", "n_x", "n_z"))],
@@ -87,7 +89,8 @@ def campaign_configs() -> dict:
     files["sensor_aware.yaml"] = render_yaml(
         cfg, "ftc-mc run configs/sensor_aware.yaml -- a design that tells sensor biases "
              "from actuator faults (issue 14): biases of q, n_x, n_z in the filter, beside "
-             "the paper's design (swapped), on Tables 2-3 and the three bias faults")
+             "the paper's design (swapped), on Tables 2-3 and the three bias faults",
+        omit=("monitor",))
     cfg = Config.model_validate({
         "campaign": {"transitions": list(PAPER_TRANSITIONS),
                      "designs": ["gust_one_step", "gust_glr"]},
@@ -120,7 +123,7 @@ def campaign_configs() -> dict:
              "flying wing (issue 24): the twelve rows (left and right elevon, engine), the "
              "paper's Table 1 (paper, swapped) and the robust design side by side, with the "
              "lateral autopilot beside the paper's loop; add --turbulence moderate for "
-             "gusts", omit=no_sensor)
+             "gusts", omit=six)
     cfg = Config.model_validate({
         "campaign": {"transitions": ["elevon_lock", "right_elevon_lock"],
                      "signature": "paper", "designs": ["paper_nominal"]},
@@ -133,7 +136,7 @@ def campaign_configs() -> dict:
              "median time to leave it and the height lost, by lock offset, on the 6-DOF "
              "flying wing under the paper's reconfiguring scheme (paper) and the nominal "
              "controller alone (paper_nominal), on the same trials; --dof 3 for the "
-             "longitudinal plant", omit=no_sensor)
+             "longitudinal plant", omit=six)
     designs = excitation_designs()
     cfg = Config.model_validate({
         "campaign": {"transitions": list(EXCITATION_ROWS), "signature": "swapped",
@@ -147,7 +150,8 @@ def campaign_configs() -> dict:
         omit=no_sensor)
     files["paper_scenario.yaml"] = render_yaml(
         ScenarioConfig(), "ftc-mc scenario configs/paper_scenario.yaml -- the paper's 100 s "
-                          "landing approach (Table 4) with the full reconfiguring loop")
+                          "landing approach (Table 4) with the full reconfiguring loop",
+        omit=("monitor",))
     return files
 
 

@@ -246,3 +246,87 @@ def sixdof_truth_ref(scheme, flight, inp, k, st, rec, u):
             int(inp.sensor_kind[l]), float(inp.sensor_size[l]), int(inp.sensor_k[l]))
     return dict(u=u, e=e, x=x, gust=gust, glat=glat, lat=lat, z=z, va=va, alpha=alpha,
                 bank=bank, sq_lat=sq, zhold=zhold)
+
+
+class SideMonitorRef:
+    """The 6-DOF side monitor of one lane (``ftc_mc/core/sixdof/monitor.py``),
+    written from that module's docstring with whole matrices: the augmented
+    ``F`` built as a block matrix, ``F P F^T + Q``, one scalar update per
+    measurement with its gain ``K = P c^T / S``, the direction signatures
+    ``s <- s - K c s``, the projection, each direction's statistic as the
+    GLR of :func:`naive.glr_ref` over the projections since the last restart,
+    and the decision with its reset.
+
+    ``mon`` a :class:`~ftc_mc.core.sixdof.monitor.SideMonitor`, ``k_fault``
+    the switch step.  :meth:`step` takes the step ``k``, the commands ``u``
+    (3,), the 17 measurements ``z`` of ``k + 1`` and whether the lane is
+    alive; the attributes ``X``, ``P``, ``side_k``, ``side_block``,
+    ``side_pre``, ``b`` (9,) hold the lane's state and record.
+    """
+
+    def __init__(self, mon, k_fault):
+        self.mon, self.kf = mon, k_fault
+        n = mon.P0.shape[0]
+        self.X, self.P = np.zeros(n), np.zeros((n, n))
+        self.hist = []  # direction projections since the last restart, oldest first
+        self.side_k, self.side_block, self.side_pre = -1, 0, 0
+        self.b = np.zeros(9)
+
+    def step(self, k, u, z, alive):
+        from naive import glr_ref
+
+        mon = self.mon
+        ns, nu = mon.B.shape
+        n = ns + 2 * nu
+        if k == 0:
+            self.X, self.P = np.zeros(n), mon.P0.copy()
+        g = -(u + mon.u0)
+        F = np.eye(n)
+        F[:ns, :ns] = mon.A
+        F[:ns, ns:ns + nu] = mon.B
+        F[:ns, ns + nu:] = mon.B @ np.diag(g)
+        X = F @ self.X
+        X[:ns] += mon.B @ (u - mon.u_ff)
+        P = F @ self.P @ F.T + np.diag(mon.q)
+        S = np.zeros((n, nu))
+        S[:ns] = mon.B
+        num, den = np.zeros(nu), np.zeros(nu)
+        for r in range(mon.C.shape[0]):
+            c = np.zeros(n)
+            c[:ns] = mon.C[r]
+            s = c @ P @ c + mon.r[r]
+            innov = z[r] - c @ X
+            mu = (c @ S) / np.sqrt(s)
+            num += mu * innov / np.sqrt(s)
+            den += mu ** 2
+            K = P @ c / s
+            S = S - np.outer(K, c @ S)
+            X = X + K * innov
+            P = P - np.outer(P @ c, P @ c) / s
+            P = np.triu(P) + np.triu(P, 1).T
+        X[ns:ns + nu] = np.clip(X[ns:ns + nu], mon.lo, mon.hi)
+        X[ns + nu:] = np.clip(X[ns + nu:], 0.0, 1.0)
+        self.X, self.P = X, P
+        kn = k + 1
+        if kn <= mon.startup:
+            self.hist = []
+            return
+        d = np.where(den > 0, num / np.sqrt(np.where(den > 0, den, 1.0)), 0.0)
+        self.hist = (self.hist + [d])[-mon.window:]
+        stat = glr_ref(self.hist[::-1], mon.min_window)  # three directions
+        block = 0
+        if stat.max() > mon.threshold:
+            block = int(np.argmax(stat)) + 1
+            for i in (ns + block - 1, ns + nu + block - 1):
+                self.P[i, :] = 0.0
+                self.P[:, i] = 0.0
+                self.P[i, i] = mon.reset_var[i - ns]
+            if alive:
+                if kn >= self.kf:
+                    if self.side_k < 0:
+                        self.side_k, self.side_block = kn, block
+                else:
+                    self.side_pre += 1
+            self.hist = []
+        if alive and (self.side_k < 0 or kn <= self.side_k + mon.snap):
+            self.b = np.concatenate([X[ns:], X[ns:ns + nu] + (1 - X[ns + nu:]) * (u + mon.u0)])

@@ -383,7 +383,7 @@ def test_relinearised_whole_loop(nonlinear_gusts):
     xa0 = np.zeros((N, L))
     xa0[:N_X] = 0.1 * X_SCALE[:, None] * rng.standard_normal((N_X, L))
     inp = inp._replace(xa0=xa0, P0=P0, g0=d.P0_chol @ rng.standard_normal((4, L)))
-    st0 = trial.new_state(L, N, 1, N_X, 0, 0)
+    st0 = trial.new_state(L, N, 1, N_X, 0, 0, 0, 1)
     trial.init_jacobians(fm, st0)
     for f, M in trim_jacobians(fm).items():
         assert np.array_equal(getattr(st0, f), M), f

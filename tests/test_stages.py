@@ -140,7 +140,8 @@ def random_lanes(setup, rng, k, L=L):
                      last_k=k - rng.integers(1, 40, L).astype(np.int64),
                      last_block=rng.integers(0, 3, L).astype(np.int64),
                      lat=np.zeros((0, L)), glat=np.zeros((0, L)),
-                     **trim_jacobians(fm, L))
+                     mx=np.zeros((0, L)), mP=np.zeros((0, 0, L)), mbuf=np.zeros((1, 3, L)),
+                     mcount=np.zeros(L, dtype=np.int64), **trim_jacobians(fm, L))
 
 
 def trim_jacobians(fm, L=L):
@@ -207,7 +208,9 @@ def new_rec(tim, L=L, max_resets=4, history=True):
         hist_pdiag=np.zeros((n_hist, 5, L)), hist_u=np.zeros((n_hist, 3, L)),
         hist_res=np.zeros((n_hist, 3, L)), hist_exc=np.zeros((n_hist, 4, L)),
         hist_block=np.zeros((n_hist, L), i8), hist_wind=np.zeros((n_hist, 3, L)),
-        sq_lat=np.zeros((2, L)), cost=np.zeros((N_COST, L)), z_switch_last=np.zeros((2, L)))
+        sq_lat=np.zeros((2, L)), cost=np.zeros((N_COST, L)), z_switch_last=np.zeros((2, L)),
+        side_k=np.full(L, -1, i8), side_block=np.zeros(L, i8), side_pre=np.zeros(L, i8),
+        mon_b=np.zeros((0, L)))
 
 
 # ------------------------------------------------------------------ comparisons
@@ -758,7 +761,7 @@ def test_advance_matches_the_chained_twins(fixture, policy, request):
     if policy != "none":  # the policy started signals the resets alone did not
         plain = scheme._replace(excitation=scheme.excitation._replace(policy=EXCITE_NONE))
         rec0 = new_rec(flight.timing, max_resets=16)
-        st0 = trial.new_state(L, inp.xa0.shape[0], plain.detection.window, N_X, 0, 0)
+        st0 = trial.new_state(L, inp.xa0.shape[0], plain.detection.window, N_X, 0, 0, 0, 1)
         trial.init_state(inp, st0, rec0)
         trial.init_jacobians(plain.filter, st0)
         rec0, _ = naive.advance_ref(plain, flight, inp, rec0, st0, 0, 25)
@@ -770,7 +773,7 @@ def assert_loop_matches(scheme, flight, inp, n_steps, tol):
     same initial state: discrete record fields exactly, continuous ones and the
     final lane state to ``tol``.  Returns the kernel's record and state."""
     rec = new_rec(flight.timing, max_resets=16)
-    st = trial.new_state(L, inp.xa0.shape[0], scheme.detection.window, N_X, 0, 0)
+    st = trial.new_state(L, inp.xa0.shape[0], scheme.detection.window, N_X, 0, 0, 0, 1)
     trial.init_state(inp, st, rec)
     trial.init_jacobians(scheme.filter, st)
     rec_n, st_n = naive.advance_ref(scheme, flight, inp, copy_nt(rec), copy_nt(st), 0,

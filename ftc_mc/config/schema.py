@@ -47,16 +47,20 @@ MAX_STEPS = 1_000_000
 """Longest run [control steps] of a trial or scenario."""
 
 
+_MAY_BE_ZERO = ("excitation.resend_delay_s", "monitor.startup_s", "monitor.estimate_after_s")
+"""Periods that may be zero steps."""
+
+
 def _check_periods(dt: float, periods) -> None:
     """Each ``(name, seconds)`` must be a whole number of sampling periods ``dt``
-    (at least one, except ``excitation.resend_delay_s``) and at most 1e9 of them."""
+    (at least one, except those of :data:`_MAY_BE_ZERO`) and at most 1e9 of them."""
     for name, value in periods:
         steps = value / dt
         if not math.isfinite(steps) or steps > 1e9:
             raise ValueError(f"{name}: {value:g} s is more than 1e9 steps of "
                              f"model.dt_s ({dt:g} s)")
         if abs(steps - round(steps)) > 1e-9 * max(1.0, steps) or (
-                round(steps) < 1 and name != "excitation.resend_delay_s"):
+                round(steps) < 1 and name not in _MAY_BE_ZERO):
             raise ValueError(f"{name}: must be a positive multiple of model.dt_s "
                              f"({dt:g} s), got {value:g}")
 
@@ -70,14 +74,18 @@ def _check_length(name: str, duration_s: float, dt: float) -> None:
 
 def _shared_periods(cfg) -> list:
     """``(name, seconds)`` of the periods in the sections a campaign and a scenario
-    share (excitation, controller, validity)."""
+    share (excitation, controller, validity, monitor)."""
     e = cfg.excitation
     return [("excitation.doublet_half_period_s", e.doublet_half_period_s),
             ("excitation.s3211_unit_s", e.s3211_unit_s),
             ("excitation.resend_delay_s", e.resend_delay_s),
             ("controller.horizon_s", cfg.controller.horizon_s),
             ("controller.terminal_horizon_s", cfg.controller.terminal_horizon_s),
-            ("validity.psd_check_period_s", cfg.validity.psd_check_period_s)]
+            ("validity.psd_check_period_s", cfg.validity.psd_check_period_s),
+            ("monitor.window_s", cfg.monitor.window_s),
+            ("monitor.min_window_s", cfg.monitor.min_window_s),
+            ("monitor.startup_s", cfg.monitor.startup_s),
+            ("monitor.estimate_after_s", cfg.monitor.estimate_after_s)]
 
 
 def _check_airframe_use(cfg) -> tuple:
@@ -297,6 +305,36 @@ class ValidityConfig(_Strict):
     def _ordered(self):
         if not self.airspeed_min_mps < self.airspeed_max_mps:
             raise ValueError("airspeed_max_mps: must exceed airspeed_min_mps")
+        return self
+
+
+class MonitorConfig(_Strict):
+    """The 6-DOF side monitor: which actuator failed, from roll and pitch (6-DOF plant only)."""
+
+    enabled: bool = True
+    """Fly the side monitor beside every design on the 6-DOF plant
+    (``ftc_mc/core/sixdof/monitor.py``): an augmented filter of the 6-DOF
+    linear model with a fault of each actuator and a windowed GLR per
+    actuator; it records its decisions and does not act.  Ignored on the
+    longitudinal plants."""
+    threshold: Pos = 30.0
+    """GLR threshold on each actuator's statistic (chi-square, 1 degree of
+    freedom, per tested change under no fault)."""
+    window_s: Pos = 2.0
+    """GLR window [s]: the oldest change tested."""
+    min_window_s: Pos = 0.3
+    """Shortest change tested [s] (a multiple of model.dt_s, at most window_s):
+    an outlier of one step is not a persistent change."""
+    startup_s: NonNeg = 1.0
+    """Time from the start before a decision may be made [s]."""
+    estimate_after_s: NonNeg = 1.0
+    """Time after the first decision at or after the switch at which the
+    monitor's estimate (lock position, b0, b1) is recorded [s]."""
+
+    @model_validator(mode="after")
+    def _ordered(self):
+        if not self.min_window_s <= self.window_s:
+            raise ValueError("min_window_s: must not exceed window_s")
         return self
 
 
@@ -613,6 +651,7 @@ class Config(_Sampled):
     timing: TimingConfig = Field(default_factory=TimingConfig)
     explain: ExplainConfig = Field(default_factory=ExplainConfig)
     validity: ValidityConfig = Field(default_factory=ValidityConfig)
+    monitor: MonitorConfig = Field(default_factory=MonitorConfig)
     sensor_draws: SensorDrawsConfig = Field(default_factory=SensorDrawsConfig)
     designs: Designs = Field(default_factory=dict)
     """Detection designs compared on the same trials (issue 13): name -> design; run them with campaign.designs or --design NAME."""
@@ -762,6 +801,7 @@ class ScenarioConfig(_Sampled):
     excitation: ExcitationConfig = Field(default_factory=ExcitationConfig)
     noise: NoiseConfig = Field(default_factory=NoiseConfig)
     validity: ValidityConfig = Field(default_factory=ValidityConfig)
+    monitor: MonitorConfig = Field(default_factory=MonitorConfig)
     designs: Designs = Field(default_factory=dict)
     """Detection designs (issue 13): name -> design; fly one with scenario.design or --design NAME."""
 

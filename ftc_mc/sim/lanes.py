@@ -45,12 +45,14 @@ def start_lanes(scheme, flight, inp: TrialInputs, rec: TrialRecord):
     """The lane state of every trial of ``inp`` at step 0, and ``rec``'s per-lane
     fields initialised (:func:`ftc_mc.core.longitudinal.trial.init_state`; the extended
     filter's Jacobians at trim, :func:`~ftc_mc.core.longitudinal.trial.init_jacobians`).
-    The truth's sizes are the flight's plant's (the 6-DOF one has 15 states and
-    its lateral loop's)."""
+    The truth's sizes are the flight's plant's (the 6-DOF one has 15 states, its
+    lateral loop's and its side monitor's)."""
     pl = flight.plant
     n_lat = pl.K_lat.shape[0] if hasattr(pl, "K_lat") else 0
+    mon = getattr(pl, "monitor", None)
+    n_m, window_m = (mon.P0.shape[0], mon.window) if mon is not None else (0, 1)
     st = new_state(inp.w.shape[2], inp.xa0.shape[0], scheme.detection.window,
-                   pl.x0.shape[0], n_lat, inp.g0_lat.shape[0])
+                   pl.x0.shape[0], n_lat, inp.g0_lat.shape[0], n_m, window_m)
     init_state(inp, st, rec)
     init_jacobians(scheme.filter, st)
     return st
@@ -83,6 +85,8 @@ def new_record(setup, L: int, max_resets: int, history: bool = False,
     n_per = setup.tim.n_steps // setup.tim.reconf_every
     n_hist = setup.tim.n_steps if history else 0
     n_res, n_par = len(LAY.residuals), len(LAY.params)
+    mon = getattr(setup.truth, "monitor", None)
+    n_mon = 3 * mon.u0.shape[0] if mon is not None and mon.on else 0
     return TrialRecord(
         reset_k=np.zeros((max_resets, L), dtype=np.int64),
         reset_block=np.zeros((max_resets, L), dtype=np.int64),
@@ -99,7 +103,9 @@ def new_record(setup, L: int, max_resets: int, history: bool = False,
         hist_block=np.zeros((n_hist, L), dtype=np.int64),
         hist_wind=np.zeros((n_hist, N_WIND, L)),
         xa_end=np.zeros((n_est, L)), sq_lat=np.zeros((N_SQ_LAT, L)),
-        cost=np.zeros((N_COST, L)), z_switch_last=np.zeros((2, L)))
+        cost=np.zeros((N_COST, L)), z_switch_last=np.zeros((2, L)),
+        side_k=np.zeros(L, dtype=np.int64), side_block=np.zeros(L, dtype=np.int64),
+        side_pre=np.zeros(L, dtype=np.int64), mon_b=np.zeros((n_mon, L)))
 
 
 def run_alone(setup, name: str, det, inp: TrialInputs, max_resets: int,

@@ -242,8 +242,11 @@ def build_setup(cfg: Config | ScenarioConfig) -> SimSetup:
     r_std = cfg.noise.measurement_scale * np.sqrt(fm.r_diag)
     lat_std = gust_lat_chol = None
     if pc.dof == 6:
-        truth, gust, gust_lat = sixdof_truth_plant(plant, pc.kind, pc.substeps,
-                                                   pc.turbulence, pc.altitude_m)
+        from .monitor import monitor_spec  # the 6-DOF family only on its path
+
+        truth, gust, gust_lat = sixdof_truth_plant(
+            plant, pc.kind, pc.substeps, pc.turbulence, pc.altitude_m,
+            monitor=monitor_spec(cfg, fm, detection(plant, EstimatorSettings())))
         lat_std = lateral_noise(r_std)
         gust_lat_chol = None if gust_lat is None else gust_lat.P0_chol
     else:

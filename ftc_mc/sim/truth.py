@@ -71,7 +71,7 @@ def truth_plant(plant: LinearPlant, kind: str = "linear", substeps: int = 10,
 
 def sixdof_truth_plant(plant: LinearPlant, kind: str = "nonlinear", substeps: int = 10,
                        turbulence: str = "none", altitude_m: float = 100.0,
-                       where: str = "model.airframe"):
+                       where: str = "model.airframe", monitor=None):
     """Kernel settings of the 6-DOF truth plant (``plant.dof: 6``), and its gust
     models.
 
@@ -91,6 +91,9 @@ def sixdof_truth_plant(plant: LinearPlant, kind: str = "nonlinear", substeps: in
         As :func:`truth_plant`.
     where : str
         The config field naming the airframe, for error lines.
+    monitor : MonitorSpec or None
+        The side monitor flown beside the scheme (:mod:`ftc_mc.sim.monitor`);
+        None: off.
 
     Returns
     -------
@@ -112,6 +115,7 @@ def sixdof_truth_plant(plant: LinearPlant, kind: str = "nonlinear", substeps: in
     from ..errors import UserError
     from ..model.sixdof import build_sixdof_plant, require_lateral
     from ..model.turbulence import dryden_lateral_model
+    from .monitor import side_monitor
 
     assert kind in PLANT_KINDS and turbulence in TURBULENCE_LEVELS, (kind, turbulence)
     af = plant.airframe
@@ -141,7 +145,9 @@ def sixdof_truth_plant(plant: LinearPlant, kind: str = "nonlinear", substeps: in
         A=c(six.A), B=c(six.B), C=c(six.C), Bw=c(six.Bw), Dw=c(six.Dw),
         turb=lon.turb, Ad=lon.Ad, Bd=lon.Bd, Cd=lon.Cd, Adl=Adl, Bdl=Bdl, Cdl=Cdl,
         K_lat=c(lat.K[0], dtype=np.float64), a_act=elevon_lag(af.tau_elevon, plant.dt),
-        lon_state=lon_state, lon_out=lon_out, lat_out=lat_out)
+        lon_state=lon_state, lon_out=lon_out, lat_out=lat_out,
+        monitor=side_monitor(six, six.u0 - plant.u0, plant.u_lower, plant.u_upper, lon_out,
+                             monitor))
     return pl, gust, gust_lat
 
 

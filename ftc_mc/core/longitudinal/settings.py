@@ -223,6 +223,13 @@ TrialRecord = namedtuple("TrialRecord", [
                       #   path's reference point after the step reaching the switch
                       #   (timing.k_fault; NaN if the lane stopped before) and after
                       #   the last step flown (stages.record_cost)
+    # the 6-DOF side monitor (core/sixdof/monitor.py; -1 / 0 / zeros otherwise)
+    "side_k",       # (L,) int64 step of its first decision at or after timing.k_fault, or -1
+    "side_block",   # (L,) int64 that decision's direction: 1 throttle, 2 left, 3 right; 0 none
+    "side_pre",     # (L,) int64 its decisions before timing.k_fault (while the lane lived)
+    "mon_b",        # (9, L) its b0 (3), b1 (3) and estimated actuator positions (3)
+                    #        SideMonitor.snap steps after side_k, or after the last step
+                    #        flown if earlier (0 rows off the 6-DOF plant)
 ])
 """Per-lane outputs of :func:`ftc_mc.sim.lanes.run_trials`."""
 
@@ -300,6 +307,10 @@ LaneState = namedtuple("LaneState", [
                 #        and yaw rates, heading (deviations), then its model of the
                 #        commanded left and right elevon positions
     "glat",     # (4, L) lateral Dryden gust state, or (0, L)
+    "mx",       # (n_m, L) the side monitor's estimate [x (14), b0 (3), b1 (3)], or (0, L)
+    "mP",       # (n_m, n_m, L) its covariance
+    "mbuf",     # (W_m, 3, L) its GLR window of each direction's projection (ring)
+    "mcount",   # (L,) int64 projections in that window
     # the extended filter's Jacobians about the lane's estimate (FilterModel.relin > 0;
     # the trim matrices otherwise, never read)
     "JA",       # (9, 9, L)  d x_{k+1} / d x_k of the one-period airframe map

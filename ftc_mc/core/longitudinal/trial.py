@@ -19,7 +19,9 @@ described where it is defined:
 2. :func:`ftc_mc.core.longitudinal.plant.truth` -- effect, gusts, plant, ``z_{k+1}``
    (the longitudinal :func:`~ftc_mc.core.longitudinal.plant.truth_step`, or the
    6-DOF family's :func:`ftc_mc.core.sixdof.truth.sixdof_truth`), then
-   :func:`ftc_mc.core.longitudinal.stages.record_cost` -- tracking and command costs;
+   :func:`ftc_mc.core.longitudinal.stages.record_cost` -- tracking and command costs,
+   then :func:`side_monitor` -- on the 6-DOF plant its side monitor
+   (:func:`ftc_mc.core.sixdof.monitor.sixdof_monitor`), which records and does not act;
 3. :func:`ftc_mc.core.longitudinal.stages.filter_update` -- the filter with ``u_k``, ``z_{k+1}``;
 4. :func:`ftc_mc.core.longitudinal.stages.check_validity`;
 5. :func:`ftc_mc.core.longitudinal.stages.handle_resets` -- resets, excitation requests
@@ -40,6 +42,7 @@ from ..shared.dryden import N_GUST_STATE
 from .gustfilter import N_WIND
 from ..jit import kernel
 from .plant import truth
+from ..shared.paths import SIXDOF_PLANT, on_path
 from .settings import LaneState
 from .stages import (check_validity, commands, filter_update, handle_resets,  # noqa: F401
                      is_psd, reconfigure, record_cost, record_end, record_step)
@@ -50,6 +53,17 @@ NO_SIGNAL = -(1 << 40)
 
 N_RMAX = 2
 """Residuals whose running maximum a lane keeps (``r_q``, ``r_nx``)."""
+
+N_DIRECTIONS = N_U
+"""Fault directions of the 6-DOF side monitor: one per actuator
+(``core/sixdof/layout.MONITOR_DIRECTIONS``)."""
+
+
+@on_path("plant", {SIXDOF_PLANT: "ftc_mc.core.sixdof.monitor:sixdof_monitor"}, passes="marker")
+def side_monitor(path, scheme, flight, k, st, work, rec):
+    """Stage 2b: the 6-DOF side monitor over step ``k -> k+1``
+    (:func:`ftc_mc.core.sixdof.monitor.sixdof_monitor`, imported only by a
+    path that flies the 6-DOF plant); nothing on the longitudinal plants."""
 
 
 @kernel
@@ -95,6 +109,7 @@ def advance(path, scheme, flight, inp, rec, st, k0, k1):
         commands(path, scheme, st, k, work)
         truth(path, scheme, flight, inp, k, st, work, rec)
         record_cost(flight.track, flight.timing.k_fault, st, kn, work, rec)
+        side_monitor(path, scheme, flight, k, st, work, rec)
         filter_update(path, scheme, st, k, work)
         check_validity(flight.validity, st, kn, work, rec)
         handle_resets(scheme.excitation, st, kn, work, rec)
@@ -148,15 +163,23 @@ def init_state(inp, st, rec):
         st.ecount[l] = 0
         st.last_k[l] = NO_SIGNAL
         st.last_block[l] = 0
+        st.mcount[l] = 0
+        rec.side_k[l] = -1
+        rec.side_block[l] = 0
+        rec.side_pre[l] = 0
+        for i in range(rec.mon_b.shape[0]):
+            rec.mon_b[i, l] = 0.0
 
 
 @kernel
-def new_state(L, n, window, n_x, n_lat, n_glat):
+def new_state(L, n, window, n_x, n_lat, n_glat, n_m, window_m):
     """A :class:`LaneState` of ``L`` lanes, an ``n``-state estimate (14: the
     paper's filter; 18 with gust states), a GLR window of ``window`` steps
     (1 for the one-step test) and an ``n_x``-state truth (9 longitudinal, 15
     on the 6-DOF plant, with its lateral loop's ``n_lat`` and lateral gusts'
-    ``n_glat`` states; 0 otherwise); contents set by :func:`init_state`."""
+    ``n_glat`` states, and its side monitor's ``n_m`` states and window of
+    ``window_m`` steps; 0 otherwise); contents set by :func:`init_state` (the
+    side monitor's estimate by the monitor at step 0)."""
     return LaneState(x=np.zeros((n_x, L)), xa=np.zeros((n, L)),
                      P=np.zeros((n, n, L)),
                      d_start=np.zeros(L, dtype=np.int64),
@@ -169,6 +192,9 @@ def new_state(L, n, window, n_x, n_lat, n_glat):
                      last_k=np.zeros(L, dtype=np.int64),
                      last_block=np.zeros(L, dtype=np.int64),
                      lat=np.zeros((n_lat, L)), glat=np.zeros((n_glat, L)),
+                     mx=np.zeros((n_m, L)), mP=np.zeros((n_m, n_m, L)),
+                     mbuf=np.zeros((window_m, N_DIRECTIONS, L)),
+                     mcount=np.zeros(L, dtype=np.int64),
                      JA=np.zeros((N_X, N_X, L)), JB=np.zeros((N_X, N_U, L)),
                      JW=np.zeros((N_X, N_WIND, L)), JC=np.zeros((N_Z, N_X, L)),
                      JHW=np.zeros((N_Z, N_WIND, L)))

@@ -131,3 +131,19 @@ Y_ALPHA, Y_BETA, Y_GAMMA, Y_VA = (OUTPUT["alpha"], OUTPUT["beta"], OUTPUT["gamma
 assert LAYOUT.states[:N_RIGID] == LAYOUT.rigid
 assert LAYOUT.outputs[:N_RIGID] == LAYOUT.rigid
 assert tuple(LAYOUT.states[N_RIGID:]) == LAYOUT.actuators
+
+# The side monitor's augmented filter (core/sixdof/monitor.py; issue 26, items 1-2)
+MONITOR_STATES = tuple(n for n in LAYOUT.states if n != "y")
+"""States of the side monitor's filter: the 6-DOF states but the cross-track
+position, which no row of the linear model reads and no sensor measures (the
+along-track ``x`` is one of the longitudinal outputs)."""
+MONITOR_PARAMS = tuple(f"b0_{a}" for a in LAYOUT.commands) + tuple(
+    f"b1_{a}" for a in LAYOUT.commands)
+"""Its fault parameters after the states: a lock offset ``b0`` [throttle, rad]
+and an effectiveness loss ``b1`` [-] of each actuator (eq. 2 per actuator)."""
+MONITOR_LATERAL = ("phi", "v", "p", "r", "psi")
+"""The lateral outputs it measures after the 12 longitudinal ones: the lateral
+loop's sensors (core/sixdof/truth.LATERAL_LOOP), with their noise."""
+MONITOR_DIRECTIONS = LAYOUT.commands
+"""Its fault directions, one GLR each: the throttle, the left and the right
+elevon.  A decision's block code is the direction's index plus one."""

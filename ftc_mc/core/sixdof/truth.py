@@ -94,6 +94,7 @@ SixDofTruth = namedtuple("SixDofTruth", [
     "lon_state",  # (9,) int64: the 6-DOF state of each longitudinal state
     "lon_out",    # (12,) int64: the 6-DOF output of each longitudinal output
     "lat_out",    # (5,) int64: the 6-DOF output of each measured lateral state
+    "monitor",    # SideMonitor: the side monitor flown beside the scheme (monitor.py)
 ])
 """The 6-DOF truth plant a trial flies (module docstring); the kernels'
 ``Flight.plant`` on the ``SIXDOF_PLANT`` path."""

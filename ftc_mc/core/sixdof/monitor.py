@@ -1,0 +1,310 @@
+"""The 6-DOF side monitor: which elevon failed, read from roll and pitch (issue 26, items 1-2).
+
+On the 6-DOF plant the paper's scheme keeps its longitudinal filter, which sees
+a locked elevon only through pitch (``docs/airframes.md``).  Beside it, the
+flight computer runs this monitor on the sensors it has: an augmented Kalman
+filter of the 6-DOF linear model with a fault of each actuator, and a windowed
+GLR test per fault direction that names the actuator.  It does not act on the
+controllers: it records its decisions and estimates, so that a campaign
+measures how well roll tells left from right, and how soon.
+
+**Filter** (the paper's eqs. 4-11 on the 6-DOF model, per actuator).  The
+estimate is ``X = [x (14), b0 (3), b1 (3)]``: the 6-DOF states but the
+cross-track position (``layout.MONITOR_STATES``), then a lock offset and an
+effectiveness of the throttle, the left and the right elevon
+(``layout.MONITOR_PARAMS``)::
+
+    x_{k+1} = A x_k + B (u_k - u_ff) + B b0_k - B diag(u_k + u0) b1_k + w_k
+    b_{k+1} = b_k + w^b_k
+    z_{k+1} = C x_{k+1} + v_k
+
+``A``, ``B``, ``C`` the discrete 6-DOF linear model at the 6-DOF trim (rows
+and columns of the monitor's states), ``u_k`` the commands sent (deviations
+from the longitudinal trim ``u0``, lateral loop included), ``u_ff`` the 6-DOF
+trim's commands less ``u0``: with eq. (2) per actuator the 6-DOF model's input
+is ``u0 + e - u0_6 = (u - u_ff) + b0 - diag(u + u0) b1``.  ``z`` holds the
+12 longitudinal outputs the paper's filter reads and the 5 lateral ones of
+the lateral loop (bank, side velocity, roll and yaw rates, heading), each a
+deviation from the 6-DOF trim, with their sensors' noise ``R``.  Predict
+``P = F P F^T + Q`` (``F`` the Jacobian in ``X``); then one scalar update per
+measurement in order, ``P`` kept exactly symmetric; then the projection:
+``b1`` clipped to [0, 1], ``b0`` to the command range about the trim.
+
+**Directions.**  A fault of actuator ``j`` starting during step ``k`` moves
+the prediction by ``B_j delta`` (``b0``; a loss moves it along the same
+column).  The sequential updates see it as mean shifts ``m_jr delta`` of the
+normalised innovations ``e_r = nu_r / sqrt(S_r)``: with the error ``s``
+started at ``B_j`` and updated by each gain, ``m_jr = c_r s / sqrt(S_r)``,
+``s <- s - K_r c_r s``.  The projection ``d_j = sum_r m_jr e_r / |m_j|`` is
+standard normal under no fault (sequential innovations are independent) and
+shifted by ``|m_j| delta`` under the fault of ``j``: a left elevon pitches and
+rolls one way, the right one pitches the same way and rolls the other, and the
+throttle moves the airspeed and the load factors.
+
+**Test.**  The windowed GLR of :mod:`ftc_mc.core.shared.glr` on each ``d_j``
+(Willsky & Jones 1976, with the one-step signature above in place of their
+full signature over the window).  When the largest statistic passes the
+threshold, after the start-up, the monitor decides direction ``j``: it
+resets that actuator's block (``b0_j``, ``b1_j``: no correlation, variance
+``reset_var``) and restarts every window.  The first decision at or after the
+switch step and its step are recorded, and the decisions before it counted; so
+is the estimate ``snap`` steps after that decision (or at the last step flown,
+if earlier or without a decision): ``b0``, ``b1`` and each actuator's estimated
+position ``b0 + (1 - b1)(u + u0)``, what eq. (2) makes of the command.  Under a
+lock that is the lock position whatever the split between ``b0`` and ``b1``,
+which only a varying command separates.
+
+Plain-NumPy twin: ``tests/naive_sixdof.py::side_monitor_ref``.
+"""
+
+from __future__ import annotations
+
+from collections import namedtuple
+
+import numpy as np
+
+from ..jit import kernel
+from ..shared.glr import glr_lanes, glr_restart
+
+SideMonitor = namedtuple("SideMonitor", [
+    "on",         # 1: the monitor runs; 0: off (every array below may be empty)
+    "A",          # (ns, ns) discrete 6-DOF model on the monitor's states
+    "B",          # (ns, 3) its commands' columns
+    "C",          # (m, ns) its measured outputs (12 longitudinal, then 5 lateral)
+    "u0",         # (3,) the longitudinal trim commands (the commands' reference)
+    "u_ff",       # (3,) the 6-DOF trim commands less u0
+    "lo", "hi",   # (3,) command range about u0 (the b0 projection)
+    "P0",         # (n, n) initial covariance (the estimate starts at 0: trim, no fault)
+    "q",          # (n,) process noise variances of X (diagonal)
+    "r",          # (m,) measurement noise variances (diagonal)
+    "reset_var",  # (6,) variance of each fault parameter after its block's reset
+    "threshold",  # GLR threshold on each direction's statistic
+    "window",     # GLR window [steps] (LaneState.mbuf's rows)
+    "min_window", # shortest change tested [steps]
+    "startup",    # steps from the start before a decision may be made
+    "snap",       # steps after the first decision at or after the switch at which the
+                  # estimate is recorded (TrialRecord.mon_b)
+])
+"""Kernel settings of the side monitor (module docstring); built by
+:func:`ftc_mc.sim.monitor.side_monitor`."""
+
+
+@kernel
+def sixdof_monitor(plant, scheme, flight, k, st, work, rec):
+    """Advance the side monitor of every lane over step ``k -> k+1``.
+
+    Parameters
+    ----------
+    plant : SixdofPlant
+        The path's plant marker (the dispatcher's calling convention).
+    scheme : Scheme
+        Unused (the stage's calling convention).
+    flight : Flight
+        ``plant.monitor`` (:class:`SideMonitor`), ``timing.k_fault``.
+    k : int
+        Step.
+    st : LaneState
+        ``mx`` (n, L), ``mP`` (n, n, L) (set at step 0: zero and ``P0``),
+        the GLR window ``mbuf`` and ``mcount``, updated in place; ``lat`` the lateral loop's measurements
+        of ``k + 1``.
+    work : TrialWork
+        ``u`` the commands sent over the step, ``z`` the 12 longitudinal
+        measurements of ``k + 1``.
+    rec : TrialRecord
+        ``side_k``, ``side_block``, ``side_pre`` (on live lanes), ``mon_b``
+        (module docstring).
+    """
+    mon = flight.plant.monitor
+    if mon.on == 0:
+        return
+    x = st.mx
+    P = st.mP
+    n = x.shape[0]
+    L = x.shape[1]
+    ns = mon.A.shape[0]
+    nu = mon.B.shape[1]
+    m = mon.C.shape[0]
+    nz = work.z.shape[0]
+    nd = nu
+    if k == 0:
+        for l in range(L):
+            for i in range(n):
+                x[i, l] = 0.0
+                for j in range(n):
+                    P[i, j, l] = mon.P0[i, j]
+    # predict (eq. 5): X = F X + [B (u - u_ff); 0], F = [[A, B, B G], [0, I, 0], [0, 0, I]]
+    # with G = diag(g), g = -(u + u0) per lane; every loop runs over the lanes innermost
+    g = np.empty((nu, L))
+    for a in range(nu):
+        for l in range(L):
+            g[a, l] = -(work.u[a, l] + mon.u0[a])
+    xn = np.zeros((ns, L))
+    for i in range(ns):
+        for c in range(ns):
+            f = mon.A[i, c]
+            if f != 0.0:
+                for l in range(L):
+                    xn[i, l] += f * x[c, l]
+        for a in range(nu):
+            f = mon.B[i, a]
+            if f != 0.0:
+                for l in range(L):
+                    xn[i, l] += f * (work.u[a, l] - mon.u_ff[a] + x[ns + a, l]
+                                     + g[a, l] * x[ns + nu + a, l])
+    for i in range(ns):
+        for l in range(L):
+            x[i, l] = xn[i, l]
+    T = np.zeros((ns, n, L))  # the rows of F P that differ from P's
+    for i in range(ns):
+        for c in range(ns):
+            f = mon.A[i, c]
+            if f != 0.0:
+                for j in range(n):
+                    for l in range(L):
+                        T[i, j, l] += f * P[c, j, l]
+        for a in range(nu):
+            f = mon.B[i, a]
+            if f != 0.0:
+                for j in range(n):
+                    for l in range(L):
+                        T[i, j, l] += f * (P[ns + a, j, l] + g[a, l] * P[ns + nu + a, j, l])
+    acc = np.empty(L)
+    for i in range(n):
+        for j in range(i, n):
+            if j < ns:  # (F P F^T)[i, j] = sum_c (F P)[i, c] F[j, c]
+                for l in range(L):
+                    acc[l] = 0.0
+                for c in range(ns):
+                    f = mon.A[j, c]
+                    if f != 0.0:  # i <= j < ns: T holds row i
+                        for l in range(L):
+                            acc[l] += f * T[i, c, l]
+                for a in range(nu):
+                    f = mon.B[j, a]
+                    if f != 0.0:
+                        for l in range(L):
+                            acc[l] += f * (T[i, ns + a, l] + g[a, l] * T[i, ns + nu + a, l])
+            elif i < ns:
+                for l in range(L):
+                    acc[l] = T[i, j, l]
+            else:
+                for l in range(L):
+                    acc[l] = P[i, j, l]
+            if i == j:
+                for l in range(L):
+                    P[i, i, l] = acc[l] + mon.q[i]
+            else:
+                for l in range(L):
+                    P[i, j, l] = acc[l]  # the lower triangle is copied below
+    for i in range(n):
+        for j in range(i + 1, n):
+            for l in range(L):
+                P[j, i, l] = P[i, j, l]
+    # sequential scalar updates (eqs. 6-8), the direction signatures carried beside
+    sig = np.zeros((nd, n, L))
+    for d in range(nd):
+        for i in range(ns):
+            for l in range(L):
+                sig[d, i, l] = mon.B[i, d]
+    num = np.zeros((nd, L))
+    den = np.zeros((nd, L))
+    pc = np.empty((n, L))
+    sv = np.empty(L)
+    gain = np.empty(L)
+    cs = np.empty((nd, L))
+    for r in range(m):
+        for i in range(n):
+            for l in range(L):
+                pc[i, l] = 0.0
+        for j in range(ns):
+            c = mon.C[r, j]
+            if c != 0.0:
+                for i in range(n):
+                    for l in range(L):
+                        pc[i, l] += c * P[i, j, l]
+        for l in range(L):
+            sv[l] = mon.r[r]
+            gain[l] = work.z[r, l] if r < nz else st.lat[r - nz, l]
+        for d in range(nd):
+            for l in range(L):
+                cs[d, l] = 0.0
+        for j in range(ns):
+            c = mon.C[r, j]
+            if c != 0.0:
+                for l in range(L):
+                    sv[l] += c * pc[j, l]
+                    gain[l] -= c * x[j, l]
+                for d in range(nd):
+                    for l in range(L):
+                        cs[d, l] += c * sig[d, j, l]
+        # gain: the innovation nu_r, then nu_r / S
+        for d in range(nd):
+            for l in range(L):
+                rs = 1.0 / np.sqrt(sv[l])
+                mu = cs[d, l] * rs
+                num[d, l] += mu * gain[l] * rs
+                den[d, l] += mu * mu
+                cs[d, l] /= sv[l]
+        for l in range(L):
+            gain[l] /= sv[l]
+        for d in range(nd):
+            for i in range(n):
+                for l in range(L):
+                    sig[d, i, l] -= pc[i, l] * cs[d, l]
+        for i in range(n):
+            for l in range(L):
+                x[i, l] += pc[i, l] * gain[l]
+        for i in range(n):
+            for j in range(i, n):
+                for l in range(L):
+                    v = P[i, j, l] - pc[i, l] * pc[j, l] / sv[l]
+                    P[i, j, l] = v
+                    P[j, i, l] = v
+    for l in range(L):
+        for a in range(nu):
+            b0 = x[ns + a, l]
+            x[ns + a, l] = min(mon.hi[a], max(mon.lo[a], b0))
+            b1 = x[ns + nu + a, l]
+            x[ns + nu + a, l] = min(1.0, max(0.0, b1))
+    # the test: the windowed GLR of each direction's projection
+    innov = np.empty((nd, L))
+    for d in range(nd):
+        for l in range(L):
+            innov[d, l] = num[d, l] / np.sqrt(den[d, l]) if den[d, l] > 0.0 else 0.0
+    stat = np.empty((nd, L))
+    kn = k + 1
+    if kn <= mon.startup:
+        for l in range(L):
+            st.mcount[l] = 0
+        return
+    glr_lanes(innov, st.mbuf, st.mcount, k, mon.min_window, stat)
+    block = np.zeros(L, dtype=np.int64)
+    for l in range(L):
+        best = mon.threshold
+        for d in range(nd):
+            if stat[d, l] > best:
+                best = stat[d, l]
+                block[l] = d + 1
+        b = block[l]
+        if b == 0:
+            continue
+        for pidx in (ns + b - 1, ns + nu + b - 1):
+            for j in range(n):
+                P[pidx, j, l] = 0.0
+                P[j, pidx, l] = 0.0
+            P[pidx, pidx, l] = mon.reset_var[pidx - ns]
+        if st.alive[l]:
+            if kn >= flight.timing.k_fault:
+                if rec.side_k[l] < 0:
+                    rec.side_k[l] = kn
+                    rec.side_block[l] = b
+            else:
+                rec.side_pre[l] += 1
+    glr_restart(block, st.mcount)
+    for l in range(L):
+        if st.alive[l] and (rec.side_k[l] < 0 or kn <= rec.side_k[l] + mon.snap):
+            for i in range(2 * nu):
+                rec.mon_b[i, l] = x[ns + i, l]
+            for a in range(nu):
+                rec.mon_b[2 * nu + a, l] = x[ns + a, l] + (1.0 - x[ns + nu + a, l]) * (
+                    work.u[a, l] + mon.u0[a])

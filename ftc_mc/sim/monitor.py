@@ -1,0 +1,134 @@
+"""Kernel settings of the 6-DOF side monitor (:mod:`ftc_mc.core.sixdof.monitor`).
+
+The monitor's model is the discrete 6-DOF linear model of the truth plant
+(:func:`ftc_mc.model.sixdof.build_sixdof_plant`) on the states of
+``layout.MONITOR_STATES``; its noise follows the paper's filter:
+
+* ``Q``: ``sigma_qx^2 dt`` on every state and ``sigma_qb^2 dt`` on every fault
+  parameter (the paper's ``Q^x``, ``Q^b``, estimator section of the config);
+* ``R``: the paper's filter's ``R`` on the 12 longitudinal outputs, and on the
+  5 lateral ones the variance of the longitudinal sensor of the same kind
+  (:data:`ftc_mc.sim.truth.LATERAL_NOISE_AS`), as the truth draws them;
+* ``P0``: ``10 Q`` on the states and the reset variances on the fault
+  parameters, as the paper's filter starts (:func:`ftc_mc.sim.estimator.initial_covariance`);
+* reset variances: the paper's per block (section 3.2.2), the elevon block's
+  ``b0`` variance for each elevon's ``b0``.
+
+Imported only on the 6-DOF path (by :func:`ftc_mc.sim.truth.sixdof_truth_plant`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..conventions import LONGITUDINAL
+from ..core.sixdof.layout import (LAYOUT, MONITOR_DIRECTIONS, MONITOR_LATERAL,
+                                  MONITOR_PARAMS, MONITOR_STATES, OUTPUT, STATE)
+from ..core.sixdof.monitor import SideMonitor
+
+
+@dataclass(frozen=True)
+class MonitorSpec:
+    """What the config sets of the side monitor, in kernel units.
+
+    Attributes
+    ----------
+    threshold : float
+        GLR threshold.
+    window, min_window, startup, snap : int
+        GLR window, shortest change tested, start-up, and the time after the
+        first decision at which the estimate is recorded [steps].
+    q_x, q_b : float
+        Process noise variance per step of each state, each fault parameter.
+    r_lon : ndarray, shape (12,)
+        Measurement noise variances of the longitudinal outputs (the paper's ``R``).
+    r_lat : ndarray, shape (5,)
+        Those of the lateral outputs of ``layout.MONITOR_LATERAL``.
+    reset_var : ndarray, shape (6,)
+        Variance of each fault parameter of ``layout.MONITOR_PARAMS`` after a reset.
+    """
+
+    threshold: float
+    window: int
+    min_window: int
+    startup: int
+    snap: int
+    q_x: float
+    q_b: float
+    r_lon: np.ndarray
+    r_lat: np.ndarray
+    reset_var: np.ndarray
+
+
+def monitor_spec(cfg, fm, det) -> MonitorSpec | None:
+    """The side monitor of a campaign or scenario config, or None when it is off.
+
+    Parameters
+    ----------
+    cfg : Config or ScenarioConfig
+    fm : FilterModel
+        The paper's filter model (its ``q_diag``, ``r_diag``).
+    det : Detection
+        The paper's detection (its ``reset_var``: ``[b0_T, b0_elevons, b1_T,
+        b1_L, b1_R]``).
+    """
+    from .truth import lateral_noise
+
+    mc = cfg.monitor
+    if not mc.enabled:
+        return None
+    rv = dict(zip(LONGITUDINAL.params, np.asarray(det.reset_var, dtype=float)))
+    b0 = {"throttle": rv["b0_thrust"], "left": rv["b0_elevons"], "right": rv["b0_elevons"]}
+    b1 = {"throttle": rv["b1_thrust"], "left": rv["b1_left"], "right": rv["b1_right"]}
+    reset = np.array([b0[a] for a in MONITOR_DIRECTIONS] + [b1[a] for a in MONITOR_DIRECTIONS])
+    r_lon = np.asarray(fm.r_diag, dtype=float).copy()
+    return MonitorSpec(
+        threshold=float(mc.threshold), window=cfg.steps(mc.window_s),
+        min_window=cfg.steps(mc.min_window_s), startup=cfg.steps(mc.startup_s),
+        snap=cfg.steps(mc.estimate_after_s),
+        q_x=float(fm.q_diag[0]), q_b=float(fm.q_diag[LONGITUDINAL.n_x]),
+        r_lon=r_lon, r_lat=lateral_noise(np.sqrt(r_lon)) ** 2, reset_var=reset)
+
+
+def side_monitor(six, u_ff: np.ndarray, u_lower, u_upper, lon_out: np.ndarray,
+                 spec: MonitorSpec | None) -> SideMonitor:
+    """The kernels' :class:`SideMonitor` (off, with empty arrays, if ``spec`` is None).
+
+    Parameters
+    ----------
+    six : SixDofPlant
+        The 6-DOF model (``A``, ``B``, ``C``) at the 6-DOF trim.
+    u_ff : ndarray, shape (3,)
+        The 6-DOF trim commands less the longitudinal trim ``u0``.
+    u_lower, u_upper : array_like, shape (3,)
+        Absolute command limits (the bounds of ``b0``, eq. 6).
+    lon_out : ndarray of int, shape (12,)
+        The 6-DOF output of each longitudinal output
+        (:func:`ftc_mc.core.sixdof.truth.index_maps`).
+    spec : MonitorSpec or None
+    """
+    nu = len(LAYOUT.commands)
+    if spec is None:
+        z = np.zeros
+        return SideMonitor(on=0, A=z((0, 0)), B=z((0, nu)), C=z((0, 0)), u0=z(nu),
+                           u_ff=z(nu), lo=z(nu), hi=z(nu), P0=z((0, 0)), q=z(0), r=z(0),
+                           reset_var=z(2 * nu), threshold=np.inf, window=1, min_window=1,
+                           startup=0, snap=0)
+    states = np.array([STATE[n] for n in MONITOR_STATES])
+    outs = np.concatenate([lon_out, [OUTPUT[n] for n in MONITOR_LATERAL]]).astype(np.int64)
+    ns, npar = len(states), len(MONITOR_PARAMS)
+    q = np.concatenate([np.full(ns, spec.q_x), np.full(npar, spec.q_b)])
+    P0 = np.diag(np.concatenate([10.0 * q[:ns], spec.reset_var]))
+    c = np.ascontiguousarray
+    u_lower = np.asarray(u_lower, dtype=float)
+    u_upper = np.asarray(u_upper, dtype=float)
+    u0 = six.u0 - u_ff
+    return SideMonitor(
+        on=1, A=c(six.A[np.ix_(states, states)]), B=c(six.B[states]),
+        C=c(six.C[np.ix_(outs, states)]), u0=c(u0, dtype=np.float64),
+        u_ff=c(u_ff, dtype=np.float64), lo=c(u_lower), hi=c(u_upper), P0=c(P0), q=c(q),
+        r=c(np.concatenate([spec.r_lon, spec.r_lat])), reset_var=c(spec.reset_var),
+        threshold=float(spec.threshold), window=int(spec.window),
+        min_window=int(spec.min_window), startup=int(spec.startup), snap=int(spec.snap))
