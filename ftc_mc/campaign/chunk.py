@@ -28,6 +28,7 @@ from ..sim.paths import path_of
 from ..sim.inputs import build_inputs, draw_lanes, flight_inputs, sensor_faults
 from ..sim.lanes import simulate
 from ..sim.setup import SimSetup, build_setup, runs_of
+from .side import side_columns
 from .transitions import (ELEVON_MODES, ENGINE, TRANSITION_TABLE, FaultRanges,
                           SensorTransition, fault_ranges, is_sensor, transition_of)
 
@@ -254,6 +255,8 @@ def classify(spec: ChunkSpec, tr_name: str, variant: str, trial_ids, values,
         "correct_side": correct_side(tr, inp.mode_post, rec.belief, judged & ~truncated,
                                      kf + window_steps, setup.tim.reconf_every),
     }
+    if rec.mon_b.shape[0]:  # the 6-DOF side monitor flew beside the design
+        trials.update(side_columns(rec, a, inp.mode_pre == MODE_NOMINAL, kf, window_steps, dt))
     return trials, resets
 
 
@@ -439,6 +442,9 @@ def classify_sensor(spec: ChunkSpec, tr_name: str, variant: str, trial_ids, size
         "envelope_exit": (rec.status == STATUS_AIRSPEED) | (rec.status == STATUS_ALPHA),
     }
     trials.update(_isolation(setup.designs[variant], tr, sizes, rec))
+    if rec.mon_b.shape[0]:  # the 6-DOF side monitor flew beside the design
+        trials.update(side_columns(rec, None, inp.mode_pre == MODE_NOMINAL, kf, spec.window,
+                                   dt))
     return trials, resets
 
 

@@ -23,6 +23,7 @@ from .assemble import write_run_tables
 from .chunk import chunk_spec
 from .parallel import run_chunks
 from .summary import markdown_table, summarize
+from .side import SIDE_COLUMNS, side_markdown, side_table
 from .survival import survival_markdown, survival_table
 
 
@@ -77,11 +78,31 @@ class CampaignResult:
         t = self.config.timing
         return survival_table(trials, t.fault_time_s, t.duration_s)
 
+    def side(self) -> pd.DataFrame:
+        """Which actuator the 6-DOF side monitor named, per row and design
+        (:func:`~.side.side_table`; empty without the monitor)."""
+        cols = ["transition", "variant", "mode_pre", "stop_s", "lock_position", "loss_b1",
+                *SIDE_COLUMNS]
+        if self._trials is None and self.out is not None:
+            import pyarrow.parquet as pq
+            names = pq.read_schema(self.out / "trials.parquet").names
+            if "side_correct" not in names:
+                return pd.DataFrame()
+            trials = pd.read_parquet(self.out / "trials.parquet", columns=cols)
+        else:
+            trials = self.trials
+        t = self.config.timing
+        return side_table(trials, t.fault_time_s, t.window_s)
+
     def markdown(self) -> str:
-        """The summary table in Markdown, and the survival after an elevon lock
-        when the run has elevon-lock rows."""
-        survival = survival_markdown(self.survival()) if self.config is not None else ""
-        return markdown_table(self.summary) + ("\n\n" + survival if survival else "")
+        """The summary table in Markdown, then the survival after an elevon lock
+        when the run has elevon-lock rows, and the side monitor's decisions
+        when it flew (6-DOF plant)."""
+        extra = ""
+        if self.config is not None:
+            extra = "".join("\n\n" + s for s in (survival_markdown(self.survival()),
+                                                  side_markdown(self.side())) if s)
+        return markdown_table(self.summary) + extra
 
 
 def resolve_config(config, trials=None, seed=None, signature=None) -> Config:

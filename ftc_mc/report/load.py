@@ -16,6 +16,7 @@ import pyarrow.parquet as pq
 from ..errors import UserError
 from ..io.chunks import FOLDER as CHUNKS_FOLDER
 from ..io.lock import holder
+from ..campaign.side import SIDE_COLUMNS
 from ..campaign.summary import SUMMARY_COLUMNS
 from ..io.results import read_metadata
 
@@ -31,9 +32,10 @@ TRIAL_COLUMNS = ("transition", "variant", "trial_id", "correct", "inappropriate"
                  "no_reset", "first_reset_s", "false_resets", "detection_s", "mode_changed",
                  "detected", "small_b1", "lock_near_trim", "resets_truncated", "judged",
                  "status", "stop_s", "sensor_output", "sensor_kind", "sensor_size",
-                 "lock_offset", "height_lost_m", *SUMMARY_COLUMNS)
+                 "lock_offset", "height_lost_m", "mode_pre", "lock_position", "loss_b1",
+                 *SIDE_COLUMNS, *SUMMARY_COLUMNS)
 """The ``trials.parquet`` columns the report reads (its sections, figures and the
-summary function); only these are loaded, so the report of a run of millions
+summary function and the side monitor's table); only these are loaded, so the report of a run of millions
 of trials fits in memory (issue 27).  The others (draws, final estimates, the
 first reset's block, reset counts) are left on disk."""
 

@@ -427,7 +427,8 @@ def run_section(r: ResultDir, fig_dir: Path, slug: str, report: Path) -> list:
             + [_comparison_heading(trials), ""] + variant_comparison(trials)
             + ["### Delay distributions", "", f"![delays of {slug}]({rel_link(fig, report)})",
                ""] + real_flight_lines(trials)
-            + survival_lines(trials, cfg, fig_dir / f"{slug}_survival.png", report) + sensor)
+            + survival_lines(trials, cfg, fig_dir / f"{slug}_survival.png", report)
+            + side_lines(r.tables["trials"], cfg) + sensor)
 
 
 def survival_lines(trials: pd.DataFrame, cfg: dict, fig_path: Path, report: Path) -> list:
@@ -445,3 +446,15 @@ def survival_lines(trials: pd.DataFrame, cfg: dict, fig_path: Path, report: Path
     fig = survival_figure(table, fig_path, LABELS)
     return [survival_markdown(table, level=3), "",
             f"![survival of {fig_path.stem}]({rel_link(fig, report)})", ""]
+
+
+def side_lines(trials: pd.DataFrame, cfg: dict) -> list:
+    """Which actuator the 6-DOF side monitor named (:mod:`ftc_mc.campaign.side`);
+    nothing for a run without it."""
+    from ..campaign.side import side_markdown, side_table
+
+    timing = cfg.get("timing", {})
+    if "fault_time_s" not in timing or "side_correct" not in trials:
+        return []
+    md = side_markdown(side_table(trials, timing["fault_time_s"], timing["window_s"]), level=3)
+    return [md, ""] if md else []
