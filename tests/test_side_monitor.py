@@ -1,0 +1,238 @@
+"""The 6-DOF side monitor (``ftc_mc/core/sixdof/monitor.py``; issue 26, items 1-2):
+its kernel against a plain-NumPy twin and against filterpy, its direction
+projections against their no-fault distribution, and what a campaign makes of
+it."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from filterpy.kalman import KalmanFilter
+
+from ftc_mc import api
+from ftc_mc.campaign.side import SIDE_COLUMNS, side_markdown, side_table
+from ftc_mc.core.longitudinal.trial import new_state
+from ftc_mc.core.longitudinal.workspace import new_trial_work
+from ftc_mc.core.shared.paths import SIXDOF_PLANT
+from ftc_mc.core.sixdof.layout import MONITOR_DIRECTIONS, MONITOR_PARAMS, MONITOR_STATES
+from ftc_mc.core.sixdof.monitor import sixdof_monitor
+from ftc_mc.core.sixdof.truth import N_LAT
+from ftc_mc.sim.lanes import new_record
+from ftc_mc.sim.setup import build_setup
+
+from naive_sixdof import SideMonitorRef
+
+L = 8
+
+
+def monitor_config(kind="linear", **campaign):
+    """A small 6-DOF campaign config (dict), the switch at 2 s."""
+    return {"campaign": {"transitions": ["elevon_lock", "right_elevon_lock"], "trials": 8,
+                         "seed": 5, "signature": "paper", "chunk_size": 8, **campaign},
+            "plant": {"kind": kind, "dof": 6},
+            "timing": {"fault_time_s": 2.0, "window_s": 2.0, "duration_s": 5.0}}
+
+
+@pytest.fixture(scope="module")
+def setup():
+    return build_setup(api.campaign_config(monitor_config()))
+
+
+def lanes(setup, mon):
+    """A fresh lane state and record for the monitor's kernel."""
+    window = mon.window
+    st = new_state(L, 14, 1, setup.truth.x0.shape[0], N_LAT, 0, mon.P0.shape[0], window)
+    st.alive[:] = True
+    st.alive[-1] = False
+    rec = new_record(setup, L, 4)
+    rec.side_k[:] = -1
+    return st, rec
+
+
+def flown_data(setup, mon, n_steps, rng, faults):
+    """Commands and the 17 measurements of lanes flying the monitor's own
+    linear model with its noise, each lane's actuator ``faults[l]`` (or None)
+    offset by 0.1 rad (throttle 0.1) from the switch on."""
+    ns, nu = mon.B.shape
+    x = np.zeros((ns, L))
+    u = 0.02 * rng.standard_normal((n_steps, nu, L))
+    z = np.zeros((n_steps, mon.C.shape[0], L))
+    kf = setup.tim.k_fault
+    for k in range(n_steps):
+        d = np.zeros((nu, L))
+        if k >= kf:
+            for l, a in enumerate(faults):
+                if a is not None:
+                    d[a, l] = 0.1
+        w = np.sqrt(mon.q[:ns])[:, None] * rng.standard_normal((ns, L))
+        x = mon.A @ x + mon.B @ (u[k] - mon.u_ff[:, None] + d) + w
+        z[k] = mon.C @ x + np.sqrt(mon.r)[:, None] * rng.standard_normal((mon.C.shape[0], L))
+    return u, z
+
+
+def run_kernel(setup, mon, st, rec, u, z, k):
+    scheme = setup.scheme("paper")
+    flight = setup.flight._replace(plant=setup.truth._replace(monitor=mon))
+    work = new_trial_work(L, 14)
+    nz = work.z.shape[0]
+    work.u[:] = u[k]
+    work.z[:] = z[k, :nz]
+    st.lat[:z.shape[1] - nz] = z[k, nz:]
+    sixdof_monitor(SIXDOF_PLANT, scheme, flight, k, st, work, rec)
+
+
+def test_layout_names_the_monitor():
+    """The monitor's states, parameters and directions come from the 6-DOF layout."""
+    assert "y" not in MONITOR_STATES and "x" in MONITOR_STATES and len(MONITOR_STATES) == 14
+    assert MONITOR_PARAMS == ("b0_throttle", "b0_left", "b0_right", "b1_throttle", "b1_left",
+                              "b1_right")
+    assert MONITOR_DIRECTIONS == ("throttle", "left", "right")
+
+
+def test_monitor_matches_its_twin(setup):
+    """Every step of every lane against ``naive_sixdof.SideMonitorRef``:
+    initialisation, prediction, the 17 sequential updates, projection,
+    the three GLR statistics, decisions with their resets, and the record
+    (a lane stopped: no record)."""
+    mon = setup.truth.monitor
+    rng = np.random.default_rng(3)
+    n_steps = setup.tim.k_fault + 15
+    faults = [1, 2, 0, 1, 2, None, 1, 2]
+    u, z = flown_data(setup, mon, n_steps, rng, faults)
+    st, rec = lanes(setup, mon)
+    refs = [SideMonitorRef(mon, setup.tim.k_fault) for _ in range(L)]
+    for k in range(n_steps):
+        run_kernel(setup, mon, st, rec, u, z, k)
+        for l, ref in enumerate(refs):
+            ref.step(k, u[k, :, l], z[k, :, l], bool(st.alive[l]))
+            np.testing.assert_allclose(st.mx[:, l], ref.X, rtol=1e-9, atol=1e-12,
+                                       err_msg=f"X, step {k}, lane {l}")
+            np.testing.assert_allclose(st.mP[:, :, l], ref.P, rtol=1e-9, atol=1e-14,
+                                       err_msg=f"P, step {k}, lane {l}")
+    for l, ref in enumerate(refs):
+        assert (rec.side_k[l], rec.side_block[l], rec.side_pre[l]) == (
+            ref.side_k, ref.side_block, ref.side_pre), l
+        np.testing.assert_allclose(rec.mon_b[:, l], ref.b, rtol=1e-9, atol=1e-12)
+    # the faulted live lanes decided, on their own actuator; the stopped one recorded nothing
+    live = [l for l in range(L - 1) if faults[l] is not None]
+    assert all(rec.side_block[l] == faults[l] + 1 for l in live)
+    assert rec.side_k[-1] == -1 and not rec.mon_b[:, -1].any()
+
+
+def test_monitor_filter_equals_filterpy(setup):
+    """Step 0 of the monitor's filter (no decision possible in the start-up)
+    against filterpy's ``KalmanFilter`` (batch update: equal to the sequential
+    scalar updates for a diagonal ``R``), fault parameters clipped as eq. 6."""
+    mon = setup.truth.monitor
+    rng = np.random.default_rng(8)
+    u, z = flown_data(setup, mon, 1, rng, [None] * L)
+    z += 0.05 * rng.standard_normal(z.shape)  # innovations that move the fault parameters
+    st, rec = lanes(setup, mon)
+    run_kernel(setup, mon, st, rec, u, z, 0)
+    ns, nu = mon.B.shape
+    n = ns + 2 * nu
+    for l in range(L):
+        kf = KalmanFilter(dim_x=n, dim_z=mon.C.shape[0], dim_u=nu)
+        F = np.eye(n)
+        F[:ns, :ns] = mon.A
+        F[:ns, ns:ns + nu] = mon.B
+        F[:ns, ns + nu:] = -mon.B * (u[0, :, l] + mon.u0)
+        kf.F, kf.Q, kf.P, kf.x = F, np.diag(mon.q), mon.P0.copy(), np.zeros(n)
+        kf.B = np.vstack([mon.B, np.zeros((2 * nu, nu))])
+        kf.H = np.hstack([mon.C, np.zeros((mon.C.shape[0], 2 * nu))])
+        kf.R = np.diag(mon.r)
+        kf.predict(u=u[0, :, l] - mon.u_ff)
+        kf.update(z[0, :, l])
+        want = kf.x.copy()
+        want[ns:ns + nu] = np.clip(want[ns:ns + nu], mon.lo, mon.hi)
+        want[ns + nu:] = np.clip(want[ns + nu:], 0.0, 1.0)
+        np.testing.assert_allclose(st.mx[:, l], want, rtol=1e-7, atol=1e-10)
+        np.testing.assert_allclose(st.mP[:, :, l], kf.P, rtol=1e-7, atol=1e-12)
+
+
+def test_direction_projections_are_standard_normal_without_fault(setup):
+    """On data from the monitor's own model with no fault, each direction's
+    projection (the GLR's input, read from the window ``mbuf``) is standard
+    normal: over 8 lanes x 150 steps x 3 directions its mean lies within 4
+    standard errors of 0 and its mean square inside the chi-square (1 degree
+    of freedom) 99.99 % interval."""
+    from scipy.stats import chi2
+
+    mon = setup.truth.monitor._replace(threshold=np.inf, startup=0)
+    rng = np.random.default_rng(21)
+    n_steps = 150
+    u, z = flown_data(setup, mon, n_steps, rng, [None] * L)
+    st, rec = lanes(setup, mon)
+    d = []
+    for k in range(n_steps):
+        run_kernel(setup, mon, st, rec, u, z, k)
+        if k >= 20:  # past the filter's transient from P0
+            d.append(st.mbuf[k % mon.window].copy())
+    d = np.array(d)
+    assert d.shape[1] == 3
+    N = d[..., :-1].size
+    assert abs(d.mean()) < 4.0 / np.sqrt(N)
+    lo, hi = chi2.ppf([5e-5, 1 - 5e-5], N) / N
+    assert lo < (d[..., :-1] ** 2).mean() < hi
+
+
+def test_campaign_names_the_locked_elevon(tmp_path):
+    """On the 6-DOF linear plant, the monitor names the locked elevon, left or
+    right, in every trial flying at the switch, within a second; it makes no
+    decision before the switch; the summary and the report show it."""
+    res = api.run_campaign(monitor_config(), jobs=1, progress=False, out=tmp_path / "run")
+    t = res.trials
+    assert set(SIDE_COLUMNS) <= set(t.columns)
+    for tr, side in (("elevon_lock", "left"), ("right_elevon_lock", "right")):
+        g = t[t["transition"] == tr]
+        flying = np.isfinite(g["side_correct"])
+        assert flying.sum() >= 6
+        assert (g.loc[flying, "side_block"] == side).all(), g["side_block"].tolist()
+        assert (g.loc[flying, "side_s"] <= 1.0).all()
+    assert (t["side_false"] == 0).all()
+    table = side_table(t, 2.0, 2.0)
+    assert (table["side_correct_rate"] == 1.0).all()
+    md = side_markdown(table)
+    assert "the 6-DOF side monitor" in md and "100.0 %" in md
+    assert "the 6-DOF side monitor" in (tmp_path / "run" / "summary.md").read_text()
+    report = api.build_report([tmp_path / "run"], out=tmp_path / "r.md")
+    assert "the 6-DOF side monitor" in report.read_text()
+
+
+def test_monitor_off_and_on_the_longitudinal_plant():
+    """``monitor.enabled: false`` leaves the monitor's columns out, and the
+    other columns equal to the bit; a longitudinal run has none either."""
+    on = api.run_campaign(monitor_config(trials=4), jobs=1, progress=False).trials
+    cfg = monitor_config(trials=4)
+    cfg["monitor"] = {"enabled": False}
+    off = api.run_campaign(cfg, jobs=1, progress=False).trials
+    assert not set(SIDE_COLUMNS) & set(off.columns)
+    assert on.drop(columns=list(SIDE_COLUMNS)).equals(off)
+    cfg = monitor_config(trials=4)
+    cfg["plant"]["dof"] = 3
+    lon = api.run_campaign(cfg, jobs=1, progress=False).trials
+    assert not set(SIDE_COLUMNS) & set(lon.columns)
+
+
+@pytest.mark.parametrize("field, value, message", [
+    ("min_window_s", 3.0, "min_window_s: must not exceed window_s"),
+    ("window_s", 1.25, "monitor.window_s: must be a positive multiple of model.dt_s"),
+    ("threshold", -1.0, "monitor.threshold"),
+])
+def test_bad_monitor_config_is_one_line(tmp_path, field, value, message):
+    """A wrong monitor field is one line naming it, exit 2, nothing written."""
+    import yaml
+    from click.testing import CliRunner
+
+    from ftc_mc.cli import cli
+
+    cfg = monitor_config()
+    cfg["monitor"] = {field: value}
+    path = tmp_path / "c.yaml"
+    path.write_text(yaml.safe_dump(cfg))
+    out = tmp_path / "out"
+    r = CliRunner().invoke(cli, ["run", str(path), "--quiet", "--out", str(out)])
+    assert r.exit_code == 2
+    assert message in r.output and "Traceback" not in r.output
+    assert len(r.output.strip().splitlines()) == 1
+    assert not out.exists()
