@@ -13,6 +13,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
+import ftc_mc  # noqa: E402,F401  -- first: it pins OpenBLAS's kernels before numpy loads (blas.py)
 from golden_cases import GOLDEN, all_frames  # noqa: E402
 
 
