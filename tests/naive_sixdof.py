@@ -287,7 +287,7 @@ class SideMonitorRef:
         F[:ns, ns + nu:] = mon.B @ np.diag(g)
         X = F @ self.X
         X[:ns] += mon.B @ (u - mon.u_ff)
-        P = F @ self.P @ F.T + np.diag(mon.q)
+        P = F @ self.P @ F.T + mon.Q
         S = np.zeros((n, nu))
         S[:ns] = mon.B
         num, den = np.zeros(nu), np.zeros(nu)

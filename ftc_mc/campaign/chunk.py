@@ -256,7 +256,7 @@ def classify(spec: ChunkSpec, tr_name: str, variant: str, trial_ids, values,
                                      kf + window_steps, setup.tim.reconf_every),
     }
     if rec.mon_b.shape[0]:  # the 6-DOF side monitor flew beside the design
-        trials.update(side_columns(rec, a, inp.mode_pre == MODE_NOMINAL, kf, window_steps, dt))
+        trials.update(side_columns(rec, a, tr.onset, kf, window_steps, dt))
     return trials, resets
 
 
@@ -443,8 +443,7 @@ def classify_sensor(spec: ChunkSpec, tr_name: str, variant: str, trial_ids, size
     }
     trials.update(_isolation(setup.designs[variant], tr, sizes, rec))
     if rec.mon_b.shape[0]:  # the 6-DOF side monitor flew beside the design
-        trials.update(side_columns(rec, None, inp.mode_pre == MODE_NOMINAL, kf, spec.window,
-                                   dt))
+        trials.update(side_columns(rec, None, True, kf, spec.window, dt))
     return trials, resets
 
 

@@ -81,8 +81,7 @@ class CampaignResult:
     def side(self) -> pd.DataFrame:
         """Which actuator the 6-DOF side monitor named, per row and design
         (:func:`~.side.side_table`; empty without the monitor)."""
-        cols = ["transition", "variant", "mode_pre", "stop_s", "lock_position", "loss_b1",
-                *SIDE_COLUMNS]
+        cols = ["transition", "variant", "stop_s", "lock_position", "loss_b1", *SIDE_COLUMNS]
         if self._trials is None and self.out is not None:
             import pyarrow.parquet as pq
             names = pq.read_schema(self.out / "trials.parquet").names

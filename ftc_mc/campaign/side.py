@@ -17,8 +17,10 @@ follows the measurement of ``k``):
   the envelope before a decision is a miss); NaN for other trials.  Unlike the
   scheme's rates it keeps the trials that leave the envelope within the
   window, most of the 6-DOF elevon locks;
-* ``side_false``: its decisions before the switch in a row that starts nominal
-  (false alarms; 0 in unlock and recover rows);
+* ``side_false``: its decisions before the switch in a row whose truth is
+  fault-free before it (an onset from nominal, a sensor fault): false alarms;
+  0 in unlock and recover rows, which start faulted (a loss too small for the
+  belief's nominal box is still a fault the monitor may name);
 * ``side_b0``, ``side_b1``, ``side_position``: its estimate of the transition
   actuator's ``b0``, ``b1`` and position ``b0 + (1 - b1)(u + u0)`` [throttle
   fraction, rad; absolute] ``monitor.estimate_after_s`` after that decision
@@ -68,8 +70,9 @@ def side_columns(rec, actuator: int | None, starts_nominal, kf: int, window: int
     actuator : int or None
         The transition's actuator (index into ``ACTUATOR_NAMES``); None for a
         sensor fault (``side_correct`` and the estimates NaN).
-    starts_nominal : ndarray of bool, shape (L,)
-        The row starts nominal (its decisions before the switch are false alarms).
+    starts_nominal : bool
+        The row's truth is fault-free before the switch (its decisions there
+        are false alarms).
     kf, window : int
         Switch step and window [steps].
     dt : float
@@ -107,7 +110,7 @@ def side_table(trials: pd.DataFrame, fault_time_s: float, window_s: float) -> pd
     ----------
     trials : DataFrame
         A run's trials (``transition``, ``variant``, the
-        :data:`SIDE_COLUMNS`, ``lock_position``, ``stop_s``, ``mode_pre``).
+        :data:`SIDE_COLUMNS`, ``lock_position``, ``loss_b1``, ``stop_s``).
     fault_time_s, window_s : float
         The switch time and the judging window [s].
     """
@@ -127,8 +130,7 @@ def side_table(trials: pd.DataFrame, fault_time_s: float, window_s: float) -> pd
         wrong = (~ok) & first_in & (judged["side_block"] != "none")
         stop = g["stop_s"].to_numpy(float)
         flown_pre = np.where(np.isfinite(stop), np.minimum(stop, fault_time_s), fault_time_s)
-        nominal = (g["mode_pre"] == "nominal").to_numpy()
-        hours = float(flown_pre[nominal].sum()) / 3600.0
+        hours = float(flown_pre.sum()) / 3600.0 if tr.onset else 0.0
         row = {"transition": tr_name, "variant": variant, "side_trials": n,
                "side_correct": k, "side_correct_rate": k / n if n else np.nan,
                "side_ci_low": lo, "side_ci_high": hi,

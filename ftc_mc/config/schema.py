@@ -317,6 +317,10 @@ class MonitorConfig(_Strict):
     linear model with a fault of each actuator and a windowed GLR per
     actuator; it records its decisions and does not act.  Ignored on the
     longitudinal plants."""
+    design_turbulence: Literal[TURBULENCE_LEVELS] = "none"
+    """Dryden level the monitor's filter models (``none``: no gust states; else
+    the 8 states of the longitudinal and lateral Dryden models at that level,
+    as a ``gust_aware`` design adds the longitudinal ones)."""
     threshold: Pos = 30.0
     """GLR threshold on each actuator's statistic (chi-square, 1 degree of
     freedom, per tested change under no fault)."""

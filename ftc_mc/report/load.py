@@ -32,7 +32,7 @@ TRIAL_COLUMNS = ("transition", "variant", "trial_id", "correct", "inappropriate"
                  "no_reset", "first_reset_s", "false_resets", "detection_s", "mode_changed",
                  "detected", "small_b1", "lock_near_trim", "resets_truncated", "judged",
                  "status", "stop_s", "sensor_output", "sensor_kind", "sensor_size",
-                 "lock_offset", "height_lost_m", "mode_pre", "lock_position", "loss_b1",
+                 "lock_offset", "height_lost_m", "lock_position", "loss_b1",
                  *SIDE_COLUMNS, *SUMMARY_COLUMNS)
 """The ``trials.parquet`` columns the report reads (its sections, figures and the
 summary function and the side monitor's table); only these are loaded, so the report of a run of millions

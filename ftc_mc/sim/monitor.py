@@ -11,6 +11,10 @@ The monitor's model is the discrete 6-DOF linear model of the truth plant
   (:data:`ftc_mc.sim.truth.LATERAL_NOISE_AS`), as the truth draws them;
 * ``P0``: ``10 Q`` on the states and the reset variances on the fault
   parameters, as the paper's filter starts (:func:`ftc_mc.sim.estimator.initial_covariance`);
+* gust states (``monitor.design_turbulence`` other than ``none``): the
+  longitudinal and lateral Dryden models at that level (:func:`gust_block`),
+  their ``Q`` block ``B_d B_d^T`` and ``P0`` block their stationary covariance,
+  as the truth's gusts start;
 * reset variances: the paper's per block (section 3.2.2), the elevon block's
   ``b0`` variance for each elevon's ``b0``.
 
@@ -24,8 +28,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..conventions import LONGITUDINAL
-from ..core.sixdof.layout import (LAYOUT, MONITOR_DIRECTIONS, MONITOR_LATERAL,
-                                  MONITOR_PARAMS, MONITOR_STATES, OUTPUT, STATE)
+from ..core.sixdof.layout import (LAYOUT, MONITOR_DIRECTIONS, MONITOR_GUST_STATES,
+                                  MONITOR_LATERAL, MONITOR_PARAMS, MONITOR_STATES, OUTPUT,
+                                  STATE, WIND)
 from ..core.sixdof.monitor import SideMonitor
 
 
@@ -48,6 +53,10 @@ class MonitorSpec:
         Those of the lateral outputs of ``layout.MONITOR_LATERAL``.
     reset_var : ndarray, shape (6,)
         Variance of each fault parameter of ``layout.MONITOR_PARAMS`` after a reset.
+    design_turbulence : str
+        Dryden level of the gust states (``none``: no gust states).
+    altitude_m : float
+        Altitude of the Dryden scale lengths [m].
     """
 
     threshold: float
@@ -60,6 +69,8 @@ class MonitorSpec:
     r_lon: np.ndarray
     r_lat: np.ndarray
     reset_var: np.ndarray
+    design_turbulence: str = "none"
+    altitude_m: float = 100.0
 
 
 def monitor_spec(cfg, fm, det) -> MonitorSpec | None:
@@ -89,11 +100,34 @@ def monitor_spec(cfg, fm, det) -> MonitorSpec | None:
         min_window=cfg.steps(mc.min_window_s), startup=cfg.steps(mc.startup_s),
         snap=cfg.steps(mc.estimate_after_s),
         q_x=float(fm.q_diag[0]), q_b=float(fm.q_diag[LONGITUDINAL.n_x]),
-        r_lon=r_lon, r_lat=lateral_noise(np.sqrt(r_lon)) ** 2, reset_var=reset)
+        r_lon=r_lon, r_lat=lateral_noise(np.sqrt(r_lon)) ** 2, reset_var=reset,
+        design_turbulence=mc.design_turbulence, altitude_m=float(cfg.plant.altitude_m))
+
+
+def gust_block(six, spec: MonitorSpec, span: float):
+    """The gust states of a gust-aware monitor: ``(G, Dg, Ad, Qg, Pg)`` with
+    ``G = B_w C_d`` (15, 8) their effect on the 6-DOF states, ``Dg = D_w C_d``
+    (19, 8) on the outputs, their transition ``Ad`` and noise ``Qg = B_d B_d^T``
+    (8, 8) and stationary covariance ``Pg``; the longitudinal Dryden model's
+    four states first (``u_g, w_g, q_g``), then the lateral one's
+    (``v_g, p_g, r_g``), at ``spec.design_turbulence``."""
+    from scipy.linalg import block_diag
+
+    from ..model.turbulence import dryden_lateral_model, dryden_model
+
+    V = float(six.trim.V0)
+    lon = dryden_model(spec.design_turbulence, V=V, altitude_m=spec.altitude_m, dt=six.dt)
+    lat = dryden_lateral_model(spec.design_turbulence, V=V, altitude_m=spec.altitude_m,
+                               dt=six.dt, span=span)
+    cols = [WIND[n] for n in ("u_g", "w_g", "q_g")], [WIND[n] for n in ("v_g", "p_g", "r_g")]
+    G = np.hstack([six.Bw[:, cols[0]] @ lon.Cd, six.Bw[:, cols[1]] @ lat.Cd])
+    Dg = np.hstack([six.Dw[:, cols[0]] @ lon.Cd, six.Dw[:, cols[1]] @ lat.Cd])
+    return (G, Dg, block_diag(lon.Ad, lat.Ad), block_diag(lon.Bd @ lon.Bd.T, lat.Bd @ lat.Bd.T),
+            block_diag(lon.P0, lat.P0))
 
 
 def side_monitor(six, u_ff: np.ndarray, u_lower, u_upper, lon_out: np.ndarray,
-                 spec: MonitorSpec | None) -> SideMonitor:
+                 spec: MonitorSpec | None, span: float = 0.0) -> SideMonitor:
     """The kernels' :class:`SideMonitor` (off, with empty arrays, if ``spec`` is None).
 
     Parameters
@@ -108,27 +142,48 @@ def side_monitor(six, u_ff: np.ndarray, u_lower, u_upper, lon_out: np.ndarray,
         The 6-DOF output of each longitudinal output
         (:func:`ftc_mc.core.sixdof.truth.index_maps`).
     spec : MonitorSpec or None
+    span : float
+        Wing span [m] (the lateral Dryden model of a gust-aware monitor).
     """
     nu = len(LAYOUT.commands)
     if spec is None:
         z = np.zeros
         return SideMonitor(on=0, A=z((0, 0)), B=z((0, nu)), C=z((0, 0)), u0=z(nu),
-                           u_ff=z(nu), lo=z(nu), hi=z(nu), P0=z((0, 0)), q=z(0), r=z(0),
+                           u_ff=z(nu), lo=z(nu), hi=z(nu), P0=z((0, 0)), Q=z((0, 0)), r=z(0),
                            reset_var=z(2 * nu), threshold=np.inf, window=1, min_window=1,
                            startup=0, snap=0)
     states = np.array([STATE[n] for n in MONITOR_STATES])
     outs = np.concatenate([lon_out, [OUTPUT[n] for n in MONITOR_LATERAL]]).astype(np.int64)
-    ns, npar = len(states), len(MONITOR_PARAMS)
-    q = np.concatenate([np.full(ns, spec.q_x), np.full(npar, spec.q_b)])
-    P0 = np.diag(np.concatenate([10.0 * q[:ns], spec.reset_var]))
+    nx, npar = len(states), len(MONITOR_PARAMS)
+    A = six.A[np.ix_(states, states)]
+    B = six.B[states]
+    C = six.C[np.ix_(outs, states)]
+    q = np.concatenate([np.full(nx, spec.q_x), np.full(npar, spec.q_b)])
+    P0 = np.diag(np.concatenate([10.0 * q[:nx], spec.reset_var]))
+    Q = np.diag(q)
+    if spec.design_turbulence != "none":  # the gust states after the 6-DOF ones
+        G, Dg, Ad, Qg, Pg = gust_block(six, spec, span)
+        ng = len(MONITOR_GUST_STATES)
+        assert G.shape[1] == ng
+        A = np.block([[A, G[states]], [np.zeros((ng, nx)), Ad]])
+        B = np.vstack([B, np.zeros((ng, nu))])
+        C = np.hstack([C, Dg[outs]])
+        ns = nx + ng
+        Q = np.zeros((ns + npar, ns + npar))
+        Q[:nx, :nx] = np.diag(q[:nx])
+        Q[nx:ns, nx:ns] = Qg
+        Q[ns:, ns:] = np.diag(q[nx:])
+        P0 = np.zeros_like(Q)
+        P0[:nx, :nx] = np.diag(10.0 * q[:nx])
+        P0[nx:ns, nx:ns] = Pg
+        P0[ns:, ns:] = np.diag(spec.reset_var)
     c = np.ascontiguousarray
     u_lower = np.asarray(u_lower, dtype=float)
     u_upper = np.asarray(u_upper, dtype=float)
     u0 = six.u0 - u_ff
     return SideMonitor(
-        on=1, A=c(six.A[np.ix_(states, states)]), B=c(six.B[states]),
-        C=c(six.C[np.ix_(outs, states)]), u0=c(u0, dtype=np.float64),
-        u_ff=c(u_ff, dtype=np.float64), lo=c(u_lower), hi=c(u_upper), P0=c(P0), q=c(q),
+        on=1, A=c(A), B=c(B), C=c(C), u0=c(u0, dtype=np.float64),
+        u_ff=c(u_ff, dtype=np.float64), lo=c(u_lower), hi=c(u_upper), P0=c(P0), Q=c(Q),
         r=c(np.concatenate([spec.r_lon, spec.r_lat])), reset_var=c(spec.reset_var),
         threshold=float(spec.threshold), window=int(spec.window),
         min_window=int(spec.min_window), startup=int(spec.startup), snap=int(spec.snap))

@@ -137,6 +137,11 @@ MONITOR_STATES = tuple(n for n in LAYOUT.states if n != "y")
 """States of the side monitor's filter: the 6-DOF states but the cross-track
 position, which no row of the linear model reads and no sensor measures (the
 along-track ``x`` is one of the longitudinal outputs)."""
+MONITOR_GUST_STATES = tuple(f"gust_lon_{i}" for i in range(4)) + tuple(
+    f"gust_lat_{i}" for i in range(4))
+"""States a gust-aware monitor appends to :data:`MONITOR_STATES`: those of the
+longitudinal (``u_g, w_g, q_g``) and lateral (``v_g, p_g, r_g``) Dryden models
+(``model/turbulence.py``), in their own order."""
 MONITOR_PARAMS = tuple(f"b0_{a}" for a in LAYOUT.commands) + tuple(
     f"b1_{a}" for a in LAYOUT.commands)
 """Its fault parameters after the states: a lock offset ``b0`` [throttle, rad]

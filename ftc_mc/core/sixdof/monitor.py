@@ -19,7 +19,10 @@ effectiveness of the throttle, the left and the right elevon
     z_{k+1} = C x_{k+1} + v_k
 
 ``A``, ``B``, ``C`` the discrete 6-DOF linear model at the 6-DOF trim (rows
-and columns of the monitor's states), ``u_k`` the commands sent (deviations
+and columns of the monitor's states; a gust-aware monitor appends the 8 states
+of the longitudinal and lateral Dryden models to ``x``, entering ``A`` through
+``B_w C_d`` and ``C`` through ``D_w C_d``, with their noise ``B_d B_d^T`` in
+``Q``: ``monitor.design_turbulence``), ``u_k`` the commands sent (deviations
 from the longitudinal trim ``u0``, lateral loop included), ``u_ff`` the 6-DOF
 trim's commands less ``u0``: with eq. (2) per actuator the 6-DOF model's input
 is ``u0 + e - u0_6 = (u - u_ff) + b0 - diag(u + u0) b1``.  ``z`` holds the
@@ -68,14 +71,14 @@ from ..shared.glr import glr_lanes, glr_restart
 
 SideMonitor = namedtuple("SideMonitor", [
     "on",         # 1: the monitor runs; 0: off (every array below may be empty)
-    "A",          # (ns, ns) discrete 6-DOF model on the monitor's states
+    "A",          # (ns, ns) discrete 6-DOF model on the monitor's states (gust states last)
     "B",          # (ns, 3) its commands' columns
     "C",          # (m, ns) its measured outputs (12 longitudinal, then 5 lateral)
     "u0",         # (3,) the longitudinal trim commands (the commands' reference)
     "u_ff",       # (3,) the 6-DOF trim commands less u0
     "lo", "hi",   # (3,) command range about u0 (the b0 projection)
     "P0",         # (n, n) initial covariance (the estimate starts at 0: trim, no fault)
-    "q",          # (n,) process noise variances of X (diagonal)
+    "Q",          # (n, n) process noise covariance of X (diagonal but a gust block)
     "r",          # (m,) measurement noise variances (diagonal)
     "reset_var",  # (6,) variance of each fault parameter after its block's reset
     "threshold",  # GLR threshold on each direction's statistic
@@ -190,12 +193,9 @@ def sixdof_monitor(plant, scheme, flight, k, st, work, rec):
             else:
                 for l in range(L):
                     acc[l] = P[i, j, l]
-            if i == j:
-                for l in range(L):
-                    P[i, i, l] = acc[l] + mon.q[i]
-            else:
-                for l in range(L):
-                    P[i, j, l] = acc[l]  # the lower triangle is copied below
+            q = mon.Q[i, j]
+            for l in range(L):
+                P[i, j, l] = acc[l] + q  # the lower triangle is copied below
     for i in range(n):
         for j in range(i + 1, n):
             for l in range(L):
