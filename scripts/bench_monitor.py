@@ -59,8 +59,8 @@ def monitor_data(mon, n_steps, L, seed=0):
     U = 0.02 * rng.standard_normal((n_steps, nu, L))
     Z = np.zeros((n_steps, mon.C.shape[0], L))
     for k in range(n_steps):
-        x = mon.A @ x + mon.B @ (U[k] - mon.u_ff[:, None]) + np.sqrt(np.diag(mon.Q)[:ns])[:, None] \
-            * rng.standard_normal((ns, L))
+        w = np.sqrt(np.diag(mon.Q)[:ns])[:, None] * rng.standard_normal((ns, L))
+        x = mon.A @ x + mon.B @ (U[k] - mon.u_ff[:, None]) + w
         Z[k] = mon.C @ x + np.sqrt(mon.r)[:, None] * rng.standard_normal((mon.C.shape[0], L))
     return U, Z
 

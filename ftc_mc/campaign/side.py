@@ -31,8 +31,8 @@ Wilson interval over those trials, the median delay of the
 correct decisions, ``side_wrong_rate`` (the first decision in the window named
 another actuator), the correct rate over the losses of at least
 :data:`LARGE_LOSS` (``side_correct_rate_large``), the false decisions and the
-hours of fault-free flight before the switch, and for lock rows the median error of ``side_position`` against
-the lock position.
+hours of fault-free flight before the switch, and for lock rows the median
+error of ``side_position`` against the lock position.
 """
 
 from __future__ import annotations
@@ -157,8 +157,10 @@ def side_markdown(table: pd.DataFrame, level: int = 2) -> str:
     head = "#" * level
     lines = [f"{head} Which actuator failed: the 6-DOF side monitor", "",
              "First decision of the side monitor (augmented 6-DOF filter, one windowed "
-             "GLR per actuator, roll and pitch) in the window after the switch; "
-             "judged fault trials (docs/airframes.md, \"The side monitor\").", "",
+             "GLR per actuator, roll and pitch) in the window after the switch, over "
+             "the trials flying at the switch; false decisions before it in the rows "
+             "that start fault-free (docs/airframes.md, \"Which elevon failed: the side "
+             "monitor\").", "",
              "| transition | design | correct actuator | b1 >= 0.5 | median delay | "
              "wrong actuator | false decisions (fault-free hours) | median lock error |",
              "|---|---|---|---|---|---|---|---|"]

@@ -108,8 +108,8 @@ def sixdof_monitor(plant, scheme, flight, k, st, work, rec):
         Step.
     st : LaneState
         ``mx`` (n, L), ``mP`` (n, n, L) (set at step 0: zero and ``P0``),
-        the GLR window ``mbuf`` and ``mcount``, updated in place; ``lat`` the lateral loop's measurements
-        of ``k + 1``.
+        the GLR window ``mbuf`` and ``mcount``, updated in place; ``lat``
+        the lateral loop's measurements of ``k + 1``.
     work : TrialWork
         ``u`` the commands sent over the step, ``z`` the 12 longitudinal
         measurements of ``k + 1``.
