@@ -261,7 +261,7 @@ class SideMonitorRef:
     the switch step.  :meth:`step` takes the step ``k``, the commands ``u``
     (3,), the 17 measurements ``z`` of ``k + 1`` and whether the lane is
     alive; the attributes ``X``, ``P``, ``side_k``, ``side_block``,
-    ``side_pre``, ``b`` (9,) hold the lane's state and record.
+    ``side_pre``, ``side_n``, ``b`` (9,) hold the lane's state and record.
     """
 
     def __init__(self, mon, k_fault):
@@ -269,7 +269,7 @@ class SideMonitorRef:
         n = mon.P0.shape[0]
         self.X, self.P = np.zeros(n), np.zeros((n, n))
         self.hist = []  # direction projections since the last restart, oldest first
-        self.side_k, self.side_block, self.side_pre = -1, 0, 0
+        self.side_k, self.side_block, self.side_pre, self.side_n = -1, 0, 0, 0
         self.b = np.zeros(9)
 
     def step(self, k, u, z, alive):
@@ -322,6 +322,7 @@ class SideMonitorRef:
                 self.P[:, i] = 0.0
                 self.P[i, i] = mon.reset_var[i - ns]
             if alive:
+                self.side_n += 1
                 if kn >= self.kf:
                     if self.side_k < 0:
                         self.side_k, self.side_block = kn, block

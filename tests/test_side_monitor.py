@@ -130,8 +130,8 @@ def test_monitor_matches_its_twin(setup):
                 err = np.linalg.norm(got - want) / np.linalg.norm(want)
                 assert err < 1e-10, f"{what}, step {k}, lane {l}: {err:.1e}"
     for l, ref in enumerate(refs):
-        assert (rec.side_k[l], rec.side_block[l], rec.side_pre[l]) == (
-            ref.side_k, ref.side_block, ref.side_pre), l
+        assert (rec.side_k[l], rec.side_block[l], rec.side_pre[l], rec.side_n[l]) == (
+            ref.side_k, ref.side_block, ref.side_pre, ref.side_n), l
         np.testing.assert_allclose(rec.mon_b[:, l], ref.b, rtol=1e-9, atol=1e-12)
     # the stopped lane recorded nothing; without gusts in the data, the faulted
     # live lanes decided, on their own actuator
@@ -284,3 +284,21 @@ def test_side_columns_count_false_decisions_only_from_a_fault_free_start():
     np.testing.assert_allclose(on["side_s"], [0.5, 2.0, np.nan, 0.2])
     assert on["side_block"].tolist() == ["left", "left", "none", "right"]
     np.testing.assert_array_equal(on["side_position"], rec.mon_b[7])
+
+
+def test_endurance_counts_the_monitors_false_decisions():
+    """An endurance run on the 6-DOF plant counts every decision of the side
+    monitor as a false alarm, per flight and per design with its exact
+    interval; in still air on the linear plant it makes none, and in
+    unmodelled moderate turbulence (no gust states) it makes some."""
+    cfg = monitor_config()
+    res = api.run_endurance(cfg, hours=8 * 20 / 3600, flight_s=20.0, jobs=1, progress=False)
+    assert (res.flights["side_decisions"] == 0).all()
+    s = res.summary.iloc[0]
+    assert s["side_decisions"] == 0 and s["side_decisions_per_hour"] == 0.0
+    assert s["side_decisions_per_hour_ci_high"] > 0  # the exact upper bound of 0 events
+    assert "side monitor decisions" in res.markdown()
+    cfg["plant"]["turbulence"] = "moderate"
+    gusty = api.run_endurance(cfg, hours=8 * 20 / 3600, flight_s=20.0, jobs=1, progress=False)
+    assert gusty.flights["side_decisions"].sum() > 0
+    assert gusty.summary.iloc[0]["side_decisions"] == gusty.flights["side_decisions"].sum()

@@ -210,7 +210,7 @@ def new_rec(tim, L=L, max_resets=4, history=True):
         hist_block=np.zeros((n_hist, L), i8), hist_wind=np.zeros((n_hist, 3, L)),
         sq_lat=np.zeros((2, L)), cost=np.zeros((N_COST, L)), z_switch_last=np.zeros((2, L)),
         side_k=np.full(L, -1, i8), side_block=np.zeros(L, i8), side_pre=np.zeros(L, i8),
-        mon_b=np.zeros((0, L)))
+        side_n=np.zeros(L, i8), mon_b=np.zeros((0, L)))
 
 
 # ------------------------------------------------------------------ comparisons

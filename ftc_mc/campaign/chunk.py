@@ -490,7 +490,8 @@ def classify_flights(variant: str, flight_ids, rec: TrialRecord, dt: float, n_s:
     flights : dict of str to ndarray
         ``variant, flight_id, status, stop_s, judged, flown_s, false_resets`` (all resets,
         stored or not), ``first_false_reset_s`` (from the flight's start, NaN
-        without one).
+        without one); on the 6-DOF plant with its side monitor,
+        ``side_decisions`` (its decisions, every one a false alarm).
     resets : dict of str to ndarray
         ``variant, flight_id, time_s`` (from the flight's start), ``block``,
         ``r_q, r_nx, r_nz`` of every stored reset.
@@ -511,6 +512,8 @@ def classify_flights(variant: str, flight_ids, rec: TrialRecord, dt: float, n_s:
         "false_resets": rec.n_resets.astype(np.int64),
         "first_false_reset_s": np.where(rec.n_resets > 0, rec.reset_k[0] * dt, np.nan),
     }
+    if rec.mon_b.shape[0]:  # the 6-DOF side monitor: every decision of a fault-free flight
+        flights["side_decisions"] = rec.side_n.astype(np.int64)
     resets = {
         "variant": np.full(len(lane), variant, dtype=object),
         "flight_id": ids[lane],

@@ -155,7 +155,10 @@ def summarize_endurance(flights: pd.DataFrame, resets: pd.DataFrame, cfg: Config
     ``target_shown`` (the one-sided bound at most the target), ``hours_to_show``
     [h] (:func:`ftc_mc.stats.hours_to_show` at the count seen), ``early_false_resets``
     (in the first :data:`EARLY_S` s of a flight, judged flights) and
-    ``median_false_reset_s`` (median time of a false reset from the flight's start).
+    ``median_false_reset_s`` (median time of a false reset from the flight's start);
+    on the 6-DOF plant with its side monitor, ``side_decisions`` (the monitor's
+    decisions, all false) and their rate ``side_decisions_per_hour`` with its
+    exact 95 % interval.
     """
     flight_s = cfg.timing.duration_s
     rows = []
@@ -184,6 +187,12 @@ def summarize_endurance(flights: pd.DataFrame, resets: pd.DataFrame, cfg: Config
             "early_false_resets": int((r["time_s"] <= EARLY_S).sum()),
             "median_false_reset_s": float(r["time_s"].median()) if len(r) else np.nan})
         row.update(lateral_summary(f))  # 6-DOF: bank and heading RMS
+        if "side_decisions" in ok:  # 6-DOF: the side monitor's false decisions
+            n = int(ok["side_decisions"].sum())
+            rate, lo, hi = poisson_rate(n, hours)
+            row.update({"side_decisions": n, "side_decisions_per_hour": rate,
+                        "side_decisions_per_hour_ci_low": lo,
+                        "side_decisions_per_hour_ci_high": hi})
         rows.append(row)
     return pd.DataFrame(rows)
 
@@ -287,6 +296,12 @@ def endurance_markdown(summary: pd.DataFrame) -> str:
                    for s, h, t, k in zip(summary["target_shown"], summary["hours_to_show"],
                                          summary["target_per_h"], summary["false_resets"])],
     })
+    if "side_decisions" in summary:  # the 6-DOF side monitor
+        view["side monitor decisions (per h, 95 % CI)"] = [
+            f"{n} ({fmt(r)}, {fmt(lo)}-{fmt(hi)})" for n, r, lo, hi in zip(
+                summary["side_decisions"], summary["side_decisions_per_hour"],
+                summary["side_decisions_per_hour_ci_low"],
+                summary["side_decisions_per_hour_ci_high"])]
     if "bank_rms_deg" in summary:  # the 6-DOF plant
         view["bank / heading RMS [deg]"] = [f"{b:.2f} / {h:.2f}" for b, h in zip(
             summary["bank_rms_deg"], summary["heading_rms_deg"])]

@@ -105,7 +105,8 @@ def new_record(setup, L: int, max_resets: int, history: bool = False,
         xa_end=np.zeros((n_est, L)), sq_lat=np.zeros((N_SQ_LAT, L)),
         cost=np.zeros((N_COST, L)), z_switch_last=np.zeros((2, L)),
         side_k=np.zeros(L, dtype=np.int64), side_block=np.zeros(L, dtype=np.int64),
-        side_pre=np.zeros(L, dtype=np.int64), mon_b=np.zeros((n_mon, L)))
+        side_pre=np.zeros(L, dtype=np.int64), side_n=np.zeros(L, dtype=np.int64),
+        mon_b=np.zeros((n_mon, L)))
 
 
 def run_alone(setup, name: str, det, inp: TrialInputs, max_resets: int,

@@ -227,6 +227,7 @@ TrialRecord = namedtuple("TrialRecord", [
     "side_k",       # (L,) int64 step of its first decision at or after timing.k_fault, or -1
     "side_block",   # (L,) int64 that decision's direction: 1 throttle, 2 left, 3 right; 0 none
     "side_pre",     # (L,) int64 its decisions before timing.k_fault (while the lane lived)
+    "side_n",       # (L,) int64 all its decisions while the lane lived
     "mon_b",        # (9, L) its b0 (3), b1 (3) and estimated actuator positions (3)
                     #        SideMonitor.snap steps after side_k, or after the last step
                     #        flown if earlier (0 rows off the 6-DOF plant)

@@ -167,6 +167,7 @@ def init_state(inp, st, rec):
         rec.side_k[l] = -1
         rec.side_block[l] = 0
         rec.side_pre[l] = 0
+        rec.side_n[l] = 0
         for i in range(rec.mon_b.shape[0]):
             rec.mon_b[i, l] = 0.0
 

@@ -50,7 +50,8 @@ full signature over the window).  When the largest statistic passes the
 threshold, after the start-up, the monitor decides direction ``j``: it
 resets that actuator's block (``b0_j``, ``b1_j``: no correlation, variance
 ``reset_var``) and restarts every window.  The first decision at or after the
-switch step and its step are recorded, and the decisions before it counted; so
+switch step and its step are recorded, and the decisions before it and in all
+counted; so
 is the estimate ``snap`` steps after that decision (or at the last step flown,
 if earlier or without a decision): ``b0``, ``b1`` and each actuator's estimated
 position ``b0 + (1 - b1)(u + u0)``, what eq. (2) makes of the command.  Under a
@@ -114,7 +115,7 @@ def sixdof_monitor(plant, scheme, flight, k, st, work, rec):
         ``u`` the commands sent over the step, ``z`` the 12 longitudinal
         measurements of ``k + 1``.
     rec : TrialRecord
-        ``side_k``, ``side_block``, ``side_pre`` (on live lanes), ``mon_b``
+        ``side_k``, ``side_block``, ``side_pre``, ``side_n`` (on live lanes), ``mon_b``
         (module docstring).
     """
     mon = flight.plant.monitor
@@ -294,6 +295,7 @@ def sixdof_monitor(plant, scheme, flight, k, st, work, rec):
                 P[j, pidx, l] = 0.0
             P[pidx, pidx, l] = mon.reset_var[pidx - ns]
         if st.alive[l]:
+            rec.side_n[l] += 1
             if kn >= flight.timing.k_fault:
                 if rec.side_k[l] < 0:
                     rec.side_k[l] = kn
