@@ -64,32 +64,29 @@ class CampaignResult:
             return pd.read_parquet(self.out / "resets.parquet")
         return self._resets
 
-    def survival(self) -> pd.DataFrame:
-        """Survival after an elevon lock by lock offset
-        (:func:`~.survival.survival_table`; empty without elevon-lock rows)."""
-        cols = ["transition", "variant", "lock_offset", "status", "stop_s", "height_lost_m"]
+    def _trial_columns(self, cols) -> pd.DataFrame:
+        """The trials, or of a run on disk only those of ``cols`` it has (a
+        run of millions of trials is not read whole)."""
         if self._trials is None and self.out is not None:
             import pyarrow.parquet as pq
             names = pq.read_schema(self.out / "trials.parquet").names
-            trials = pd.read_parquet(self.out / "trials.parquet",
-                                     columns=[c for c in cols if c in names])
-        else:
-            trials = self.trials
+            return pd.read_parquet(self.out / "trials.parquet",
+                                   columns=[c for c in cols if c in names])
+        return self.trials
+
+    def survival(self) -> pd.DataFrame:
+        """Survival after an elevon lock by lock offset
+        (:func:`~.survival.survival_table`; empty without elevon-lock rows)."""
+        trials = self._trial_columns(["transition", "variant", "lock_offset", "status",
+                                      "stop_s", "height_lost_m"])
         t = self.config.timing
         return survival_table(trials, t.fault_time_s, t.duration_s)
 
     def side(self) -> pd.DataFrame:
         """Which actuator the 6-DOF side monitor named, per row and design
         (:func:`~.side.side_table`; empty without the monitor)."""
-        cols = ["transition", "variant", "stop_s", "lock_position", "loss_b1", *SIDE_COLUMNS]
-        if self._trials is None and self.out is not None:
-            import pyarrow.parquet as pq
-            names = pq.read_schema(self.out / "trials.parquet").names
-            if "side_correct" not in names:
-                return pd.DataFrame()
-            trials = pd.read_parquet(self.out / "trials.parquet", columns=cols)
-        else:
-            trials = self.trials
+        trials = self._trial_columns(["transition", "variant", "stop_s", "lock_position",
+                                      "loss_b1", *SIDE_COLUMNS])
         t = self.config.timing
         return side_table(trials, t.fault_time_s, t.window_s)
 

@@ -66,7 +66,8 @@ def side_columns(rec, actuator: int | None, starts_nominal, kf: int, window: int
     Parameters
     ----------
     rec : TrialRecord
-        With the monitor's ``side_k``, ``side_block``, ``side_pre``, ``mon_b``.
+        The monitor's ``side_k``, ``side_block``, ``side_pre``, ``mon_b``, and
+        ``status``, ``stop_k`` (which trials are flying at the switch).
     actuator : int or None
         The transition's actuator (index into ``ACTUATOR_NAMES``); None for a
         sensor fault (``side_correct`` and the estimates NaN).

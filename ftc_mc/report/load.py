@@ -34,9 +34,9 @@ TRIAL_COLUMNS = ("transition", "variant", "trial_id", "correct", "inappropriate"
                  "status", "stop_s", "sensor_output", "sensor_kind", "sensor_size",
                  "lock_offset", "height_lost_m", "lock_position", "loss_b1",
                  *SIDE_COLUMNS, *SUMMARY_COLUMNS)
-"""The ``trials.parquet`` columns the report reads (its sections, figures and the
-summary function and the side monitor's table); only these are loaded, so the report of a run of millions
-of trials fits in memory (issue 27).  The others (draws, final estimates, the
+"""The ``trials.parquet`` columns the report reads (its sections, figures, the
+summary function and the side monitor's table); only these are loaded, so the
+report of a run of millions of trials fits in memory (issue 27).  The others (draws, final estimates, the
 first reset's block, reset counts) are left on disk."""
 
 
