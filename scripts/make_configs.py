@@ -32,6 +32,12 @@ armed 1 s after the start, which removes the start-up false resets
 (docs/designs.md has the measurements)."""
 
 
+SIXDOF = {"signature": "paper", "controller": "lock_turn"}
+"""The 6-DOF design (issue 26): the paper's filter, Table 1 and reconfiguring loop
+until the side monitor names an elevon, then the lock-turn controller of that
+side (``ftc_mc/core/sixdof/lockturn.py``; docs/airframes.md)."""
+
+
 SENSOR_AWARE = {"sensor_biases": ["q", "n_x", "n_z"], "settle_s": 3.0, "signature": "swapped"}
 """The sensor-aware design of ``configs/sensor_aware.yaml`` (issue 14): the paper's
 filter and Table 1 (swapped) with the biases of the residuals' sensors; chosen
@@ -115,27 +121,32 @@ def campaign_configs() -> dict:
              "design (swapped), all eight transitions", omit=no_sensor)
     cfg = Config.model_validate({
         "campaign": {"transitions": list(TRANSITION_TABLE), "signature": "both",
-                     "designs": ["robust"]},
+                     "designs": ["robust", "sixdof"]},
         "plant": {"kind": "nonlinear", "dof": 6},
-        "designs": {"robust": ROBUST_MODERATE}})
+        "designs": {"robust": ROBUST_MODERATE, "sixdof": SIXDOF}})
     files["sixdof_tables.yaml"] = render_yaml(
         cfg, "ftc-mc run configs/sixdof_tables.yaml -- the paper's scheme on the 6-DOF "
              "flying wing (issue 24): the twelve rows (left and right elevon, engine), the "
-             "paper's Table 1 (paper, swapped) and the robust design side by side, with the "
+             "paper's Table 1 (paper, swapped), the robust design and sixdof (the paper's "
+             "loop until the side monitor names an elevon, then the lock-turn controller "
+             "of the other elevon and the throttle; issue 26) side by side, with the "
              "lateral autopilot beside the paper's loop; add --turbulence moderate for "
              "gusts", omit=six)
     cfg = Config.model_validate({
         "campaign": {"transitions": ["elevon_lock", "right_elevon_lock"],
-                     "signature": "paper", "designs": ["paper_nominal"]},
+                     "signature": "paper", "designs": ["paper_nominal", "sixdof"]},
         "plant": {"kind": "nonlinear", "dof": 6},
         "timing": {"duration_s": 80.0},
-        "designs": {"paper_nominal": {"signature": "paper", "controller": "nominal"}}})
+        "designs": {"paper_nominal": {"signature": "paper", "controller": "nominal"},
+                    "sixdof": SIXDOF}})
     files["sixdof_survival.yaml"] = render_yaml(
         cfg, "ftc-mc run configs/sixdof_survival.yaml -- survival after an elevon lock "
              "(issue 26): the share of trials inside the envelope 60 s after the lock, the "
              "median time to leave it and the height lost, by lock offset, on the 6-DOF "
-             "flying wing under the paper's reconfiguring scheme (paper) and the nominal "
-             "controller alone (paper_nominal), on the same trials; --dof 3 for the "
+             "flying wing under the paper's reconfiguring scheme (paper), the nominal "
+             "controller alone (paper_nominal) and the reconfiguring 6-DOF loop (sixdof: "
+             "the lock-turn controller once the side monitor names the elevon), on the "
+             "same trials; --dof 3 --design paper --design paper_nominal for the "
              "longitudinal plant", omit=six)
     designs = excitation_designs()
     cfg = Config.model_validate({

@@ -261,7 +261,9 @@ class SideMonitorRef:
     the switch step.  :meth:`step` takes the step ``k``, the commands ``u``
     (3,), the 17 measurements ``z`` of ``k + 1`` and whether the lane is
     alive; the attributes ``X``, ``P``, ``side_k``, ``side_block``,
-    ``side_pre``, ``side_n``, ``b`` (9,) hold the lane's state and record.
+    ``side_pre``, ``side_n``, ``b`` (9,) hold the lane's state and record,
+    ``side`` the first elevon named (its block code) and ``pos`` its
+    estimated position ``b0 + (1 - b1)(u + u0)`` (``core/sixdof/lockturn.py``).
     """
 
     def __init__(self, mon, k_fault):
@@ -271,6 +273,7 @@ class SideMonitorRef:
         self.hist = []  # direction projections since the last restart, oldest first
         self.side_k, self.side_block, self.side_pre, self.side_n = -1, 0, 0, 0
         self.b = np.zeros(9)
+        self.side, self.pos = 0, 0.0  # the first elevon named and its position estimate
 
     def step(self, k, u, z, alive):
         from naive import glr_ref
@@ -321,6 +324,8 @@ class SideMonitorRef:
                 self.P[i, :] = 0.0
                 self.P[:, i] = 0.0
                 self.P[i, i] = mon.reset_var[i - ns]
+            if block > 1 and self.side == 0:
+                self.side = block
             if alive:
                 self.side_n += 1
                 if kn >= self.kf:
@@ -329,5 +334,30 @@ class SideMonitorRef:
                 else:
                     self.side_pre += 1
             self.hist = []
+        if self.side:
+            a = self.side - 1
+            self.pos = self.X[ns + a] + (1 - self.X[ns + nu + a]) * (u[a] + mon.u0[a])
         if alive and (self.side_k < 0 or kn <= self.side_k + mon.snap):
             self.b = np.concatenate([X[ns:], X[ns:ns + nu] + (1 - X[ns + nu:]) * (u + mon.u0)])
+
+
+def lock_turn_law_ref(tab, s, p, xhat, u0, lo_dev, hi_dev):
+    """The lock-turn law of one lane (``ftc_mc/core/sixdof/lockturn.py``),
+    written from that module's docstring: every table entry interpolated with
+    ``np.interp`` over the side's lock grid at the position ``p`` (clamped to
+    its ends), ``u* - K (x_hat - x*) - k`` on the throttle and the healthy
+    elevon, the locked elevon at ``p``, each clipped.  ``xhat`` (n_f,) the
+    fed-back states.  Returns the commands (3,) less ``u0``."""
+    n = tab.x.shape[1]
+    grid = tab.lo[s] + tab.step * np.arange(n)
+
+    def at(a):  # entry-wise interpolation of a (n, ...) table
+        flat = a.reshape(n, -1)
+        return np.array([np.interp(p, grid, flat[:, j]) for j in range(flat.shape[1])]
+                        ).reshape(a.shape[1:])
+
+    x, u, K, k = at(tab.x[s]), at(tab.u[s]), at(tab.K[s]), at(tab.k[s])
+    out = np.zeros(3)
+    out[tab.cmd[s]] = u[tab.cmd[s]] - K @ (xhat - x) - k
+    out[tab.locked[s]] = p - u0[tab.locked[s]]
+    return np.clip(out, lo_dev, hi_dev)

@@ -141,7 +141,8 @@ def random_lanes(setup, rng, k, L=L):
                      last_block=rng.integers(0, 3, L).astype(np.int64),
                      lat=np.zeros((0, L)), glat=np.zeros((0, L)),
                      mx=np.zeros((0, L)), mP=np.zeros((0, 0, L)), mbuf=np.zeros((1, 3, L)),
-                     mcount=np.zeros(L, dtype=np.int64), **trim_jacobians(fm, L))
+                     mcount=np.zeros(L, dtype=np.int64), mside=np.zeros(L, dtype=np.int64),
+                     mpos=np.zeros(L), **trim_jacobians(fm, L))
 
 
 def trim_jacobians(fm, L=L):

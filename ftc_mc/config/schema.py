@@ -123,6 +123,27 @@ class _Sampled(_Strict):
         dc = self.designs.get(design)
         return dc.controller if dc is not None and dc.controller else self.controller.kind
 
+    def flies_lock_turn(self, runs) -> bool:
+        """Whether a design of ``runs`` flies ``controller: lock_turn``."""
+        return any(self.controller_of(r) == "lock_turn" for r in runs)
+
+
+def _check_lock_turn(cfg, runs) -> None:
+    """A ``lock_turn`` controller needs the 6-DOF plant and its side monitor;
+    the error names the field that asks for it."""
+    for r in runs:
+        if cfg.controller_of(r) != "lock_turn":
+            continue
+        dc = cfg.designs.get(r)
+        field = (f"designs.{r}.controller" if dc is not None and dc.controller
+                 else "controller.kind")
+        if cfg.plant.dof != 6:
+            raise ValueError(f"{field}: lock_turn flies the 6-DOF plant (plant.dof: 6), "
+                             f"got plant.dof {cfg.plant.dof}")
+        if not cfg.monitor.enabled:
+            raise ValueError(f"{field}: lock_turn is scheduled on the side monitor, but "
+                             "monitor.enabled is false")
+
 
 class ModelConfig(_Strict):
     """Airframe, trim point and sampling (paper section 5.1)."""
@@ -191,8 +212,8 @@ class EstimatorConfig(_Strict):
 class ControllerConfig(_Strict):
     """Controllers and their selection (sections 4.1-4.2, 5.1)."""
 
-    kind: Literal["nominal", "reconfiguring"] = "reconfiguring"
-    """``nominal``: c0 only; ``reconfiguring``: c0/c1/c2 chosen by eqs. 45-47."""
+    kind: Literal["nominal", "reconfiguring", "lock_turn"] = "reconfiguring"
+    """``nominal``: c0 only; ``reconfiguring``: c0/c1/c2 chosen by eqs. 45-47; ``lock_turn`` (6-DOF plant, side monitor on): reconfiguring until the side monitor names an elevon, then the lock-turn controller of that side, scheduled on the monitor's lock estimate (``ftc_mc/core/sixdof/lockturn.py``)."""
     discount: Annotated[float, NoBool, Field(gt=0, lt=1, allow_inf_nan=False)] = 0.999
     """Discount factor alpha (< 1: a locked engine needs it, section 4.1.2)."""
     r_lqr: Pos = 0.1
@@ -315,8 +336,8 @@ class MonitorConfig(_Strict):
     """Fly the side monitor beside every design on the 6-DOF plant
     (``ftc_mc/core/sixdof/monitor.py``): an augmented filter of the 6-DOF
     linear model with a fault of each actuator and a windowed GLR per
-    actuator; it records its decisions and does not act.  Ignored on the
-    longitudinal plants."""
+    actuator; it records its decisions, and acts only in a design with
+    ``controller: lock_turn``.  Ignored on the longitudinal plants."""
     design_turbulence: Literal[TURBULENCE_LEVELS] = "none"
     """Dryden level the monitor's filter models (``none``: no gust states; else
     the 8 states of the longitudinal and lateral Dryden models at that level,
@@ -334,12 +355,33 @@ class MonitorConfig(_Strict):
     estimate_after_s: NonNeg = 1.0
     """Time after the first decision at or after the switch at which the
     monitor's estimate (lock position, b0, b1) is recorded [s]."""
+    turn_offsets_deg: tuple[Finite, Finite] = (-14.0, 4.0)
+    """Lock offsets from trim [deg] the lock-turn table of a ``controller: lock_turn`` design spans, each side (``ftc_mc/design/lock_turn.py``; an estimate beyond them takes the end's design). Designed once per airframe and cached (about 1-10 s per lock)."""
+    turn_step_deg: Pos = 1.0
+    """Step of that table [deg]: its range must hold a whole number of steps."""
+    turn_feedback: Literal["measured", "estimate"] = "measured"
+    """What the lock-turn law feeds back: ``measured``, the sensors' bank, pitch, body velocities and rates (the actuators from the monitor's estimate); ``estimate``, the monitor's estimate of every state, whose linear model drifts in steep turns."""
 
     @model_validator(mode="after")
     def _ordered(self):
         if not self.min_window_s <= self.window_s:
             raise ValueError("min_window_s: must not exceed window_s")
+        lo, hi = self.turn_offsets_deg
+        if not lo < hi:
+            raise ValueError(f"turn_offsets_deg: the first must be below the second, got "
+                             f"[{lo:g}, {hi:g}]")
+        n = (hi - lo) / self.turn_step_deg
+        if abs(n - round(n)) > 1e-9 * max(1.0, n) or n > 200:
+            raise ValueError(f"turn_step_deg: must divide turn_offsets_deg's range "
+                             f"({hi - lo:g} deg) into at most 200 steps, got "
+                             f"{self.turn_step_deg:g}")
         return self
+
+    def turn_offsets(self) -> list:
+        """The lock-turn table's offsets from trim [deg], ascending."""
+        lo, hi = self.turn_offsets_deg
+        n = int(round((hi - lo) / self.turn_step_deg))
+        return [lo + i * self.turn_step_deg for i in range(n + 1)]
 
 
 def parse_sensor_transition(name: str):
@@ -504,8 +546,8 @@ class DesignConfig(_Strict):
     excitation_residual: Pos | None = None
     """ambiguous: send when r_q or r_nx (the design's decision statistics: one-step residuals or GLR) reach this; null: never on the residuals. Below Table 1's thresholds it excites a suspected change before it is decided."""
 
-    controller: Literal["nominal", "reconfiguring"] | None = None
-    """Controller of this design's flights: nominal (c0 throughout) or reconfiguring (c0/c1/c2 chosen by eqs. 45-47), so one campaign compares both on the same trials; null: the controller section's kind."""
+    controller: Literal["nominal", "reconfiguring", "lock_turn"] | None = None
+    """Controller of this design's flights: nominal (c0 throughout), reconfiguring (c0/c1/c2 chosen by eqs. 45-47) or lock_turn (6-DOF plant: reconfiguring until the side monitor names an elevon, then the lock-turn controller of that side), so one campaign compares them on the same trials; null: the controller section's kind."""
 
     @model_validator(mode="after")
     def _biases(self):
@@ -676,6 +718,7 @@ class Config(_Sampled):
             raise ValueError("controller.horizon_s: must not exceed timing.duration_s "
                              f"({t.duration_s:g} s), got {self.controller.horizon_s:g}")
         _check_length("timing.duration_s", t.duration_s, dt)
+        _check_lock_turn(self, self.campaign.runs())
         lower, upper = _check_airframe_use(self)
         for actuator, name in (("engine", "engine_lock_range"),
                                ("left_elevon", "elevon_lock_range_rad"),
@@ -821,6 +864,7 @@ class ScenarioConfig(_Sampled):
         if self.controller.horizon_s > sc.duration_s:
             raise ValueError(f"controller.horizon_s: must not exceed scenario.duration_s "
                              f"({sc.duration_s:g} s), got {self.controller.horizon_s:g}")
+        _check_lock_turn(self, (sc.design or sc.signature,))
         lower, upper = _check_airframe_use(self)
         for i, e in enumerate(sc.schedule):
             if e.fault == "lock" and e.position != "trim":

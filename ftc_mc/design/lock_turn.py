@@ -56,7 +56,11 @@ with the locked elevon's command its lock position.
 from __future__ import annotations
 
 import dataclasses
+import hashlib
 import math
+import os
+import time
+from pathlib import Path
 
 import numpy as np
 import scipy.optimize
@@ -66,6 +70,7 @@ from ..model.airframe import Airframe
 from ..model.linear import jacobian, zoh
 from ..model.sixdof import derivatives, outputs, trim6
 from ..model.trimmable import UNKNOWNS, _state, steady_flight
+from .cache import default_cache_dir, write_atomic
 from .theorem41 import ALPHA, biased_discounted_lqr
 
 TURN_RIGID = ("phi", "theta", "u", "v", "w", "p", "q", "r")
@@ -481,6 +486,151 @@ def lock_turn_lqr(airframe: Airframe, side: str, lock: float, dt: float = 0.1,
                           u_upper=np.array(airframe.command_upper, dtype=float))
 
 
+LOCK_TURN_TABLE_VERSION = "1"
+"""Bumped when :func:`lock_turn_designs` changes what it computes (cache key)."""
+
+
+@dataclasses.dataclass(frozen=True)
+class LockTurnDesigns:
+    """Lock-turn designs of both sides over a grid of lock offsets from trim.
+
+    Attributes
+    ----------
+    offsets : ndarray, shape (n,)
+        Lock offsets from each side's trim position [rad], uniform, ascending.
+    lock : ndarray, shape (2, n)
+        Absolute lock positions [rad] (left, right).
+    x : ndarray, shape (2, n, 15)
+        Design states, absolute (the 15-state layout).
+    cmd : ndarray, shape (2, n, 3)
+        Design commands, absolute.
+    K : ndarray, shape (2, n, 2, 10)
+        Gains on the fed-back states (:func:`turn_states` of the side).
+    k : ndarray, shape (2, n, 2)
+        Theorem 4.1's constant term.
+    steady : ndarray of bool, shape (2, n)
+        The lock has its own steady flight in the design box (else the design
+        is about the nearest lock that has one).
+    """
+
+    offsets: np.ndarray
+    lock: np.ndarray
+    x: np.ndarray
+    cmd: np.ndarray
+    K: np.ndarray
+    k: np.ndarray
+    steady: np.ndarray
+
+
+SIDES = ("left", "right")
+"""The elevons a lock-turn table holds, in its order (block codes 2 and 3)."""
+
+
+def lock_turn_designs(airframe: Airframe, offsets, V0: float = 20.0,
+                      gamma0_deg: float = -3.0, dt: float = 0.1) -> LockTurnDesigns:
+    """:func:`lock_turn_lqr` of both sides at each lock offset from trim.
+
+    Parameters
+    ----------
+    airframe : Airframe
+        With lateral-directional data.
+    offsets : array_like, shape (n,)
+        Lock offsets from the side's position in the 6-DOF trim [rad].
+    V0, gamma0_deg : float
+        The nominal glide [m/s], [deg]: the trim and the design point's target.
+    dt : float
+        Sampling period [s].
+
+    Returns
+    -------
+    LockTurnDesigns
+    """
+    offsets = np.asarray(offsets, dtype=float)
+    n = offsets.size
+    trim_cmd = trim6(airframe, V0, gamma0_deg).u0
+    lock = np.empty((2, n))
+    x = np.empty((2, n, len(STATE)))
+    cmd = np.empty((2, n, len(COMMAND)))
+    K = np.empty((2, n, 2, len(turn_states("left"))))
+    k = np.empty((2, n, 2))
+    steady = np.empty((2, n), dtype=bool)
+    for s, side in enumerate(SIDES):
+        for i, off in enumerate(offsets):
+            lock[s, i] = trim_cmd[COMMAND[side]] + off
+            d = lock_turn_lqr(airframe, side, float(lock[s, i]), dt, V0=V0,
+                              gamma0_deg=gamma0_deg)
+            x[s, i], cmd[s, i] = d.point.x, d.point.cmd
+            K[s, i], k[s, i] = d.K, d.k
+            steady[s, i] = d.point.lock == d.point.design_lock
+    return LockTurnDesigns(offsets=offsets, lock=lock, x=x, cmd=cmd, K=K, k=k,
+                           steady=steady)
+
+
+def lock_turn_designs_key(airframe: Airframe, offsets, V0: float, gamma0_deg: float,
+                          dt: float) -> str:
+    """SHA-256 cache key of every input of :func:`lock_turn_designs`: the packed
+    6-DOF parameters and command limits of the airframe, the grid, the glide,
+    the period, the default design box and weights, :data:`LOCK_TURN_TABLE_VERSION`
+    and the OpenBLAS kernels in force (``ftc_mc/blas.py``)."""
+    h = hashlib.sha256()
+    h.update(LOCK_TURN_TABLE_VERSION.encode())
+    h.update(f"blas:{os.environ.get('OPENBLAS_CORETYPE')}".encode())
+    h.update(repr((DesignBox(), DesignWeights(), TurnWeights(), ALPHA, LOCK_TOLERANCE)).encode())
+    for a in (trim6(airframe, V0, gamma0_deg).params, airframe.command_lower,
+              airframe.command_upper, offsets, [V0, gamma0_deg, dt]):
+        b = np.ascontiguousarray(a, dtype=np.float64)
+        h.update(repr(b.shape).encode())
+        h.update(b.tobytes())
+    return h.hexdigest()
+
+
+def cached_lock_turn_designs(airframe: Airframe, offsets, V0: float = 20.0,
+                             gamma0_deg: float = -3.0, dt: float = 0.1,
+                             cache_dir=None, stream=None) -> LockTurnDesigns:
+    """:func:`lock_turn_designs`, cached on disk as ``.npz``
+    (``<cache_dir>/lock_turn/<sha256>.npz``, key :func:`lock_turn_designs_key`,
+    written atomically; an unreadable or mismatching file is recomputed).
+
+    Parameters
+    ----------
+    airframe, offsets, V0, gamma0_deg, dt
+        As :func:`lock_turn_designs`.
+    cache_dir : str or Path, optional
+        Cache root; default :func:`ftc_mc.design.cache.default_cache_dir`.
+    stream : file, optional
+        When the designs are computed (not in the cache), a line saying so
+        before and one with the time taken after.
+
+    Returns
+    -------
+    LockTurnDesigns
+    """
+    offsets = np.asarray(offsets, dtype=float)
+    key = lock_turn_designs_key(airframe, offsets, V0, gamma0_deg, dt)
+    folder = Path(cache_dir) if cache_dir is not None else default_cache_dir()
+    path = folder / "lock_turn" / f"{key}.npz"
+    fields = [f.name for f in dataclasses.fields(LockTurnDesigns)]
+    if path.exists():
+        try:
+            with np.load(path, allow_pickle=False) as z:
+                if str(z["key"]) == key:
+                    return LockTurnDesigns(**{f: np.ascontiguousarray(z[f]) for f in fields})
+        except (OSError, ValueError, KeyError):
+            pass  # corrupt or foreign file: recompute below
+    if stream is not None:
+        print(f"ftc-mc: designing the lock-turn controllers ({offsets.size} lock positions "
+              "per elevon; cached afterwards)", file=stream, flush=True)
+    t0 = time.perf_counter()
+    d = lock_turn_designs(airframe, offsets, V0, gamma0_deg, dt)
+    if stream is not None:
+        print(f"ftc-mc: lock-turn controllers designed in {time.perf_counter() - t0:.1f} s",
+              file=stream, flush=True)
+    write_atomic(path, lambda f: np.savez(f, key=np.array(key),
+                                          **{n: getattr(d, n) for n in fields}))
+    return d
+
+
 __all__ = ["TURN_RIGID", "LOCK_TOLERANCE", "healthy", "turn_states", "DesignBox",
            "DesignWeights", "TurnWeights", "DesignPoint", "design_point",
-           "LockTurnDesign", "lock_turn_lqr"]
+           "LockTurnDesign", "lock_turn_lqr", "LOCK_TURN_TABLE_VERSION", "LockTurnDesigns",
+           "SIDES", "lock_turn_designs", "lock_turn_designs_key", "cached_lock_turn_designs"]

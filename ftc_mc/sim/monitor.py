@@ -23,15 +23,22 @@ Imported only on the 6-DOF path (by :func:`ftc_mc.sim.truth.sixdof_truth_plant`)
 
 from __future__ import annotations
 
+import sys
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..conventions import LONGITUDINAL
-from ..core.sixdof.layout import (LAYOUT, MONITOR_DIRECTIONS, MONITOR_GUST_STATES,
+from ..core.sixdof.layout import (COMMAND, LAYOUT, MONITOR_DIRECTIONS, MONITOR_GUST_STATES,
                                   MONITOR_LATERAL, MONITOR_PARAMS, MONITOR_STATES, OUTPUT,
                                   STATE, WIND)
+from ..core.sixdof.lockturn import LockTurnTable
 from ..core.sixdof.monitor import SideMonitor
+
+
+MEASURED = LONGITUDINAL.outputs + MONITOR_LATERAL
+"""The monitor's measured outputs in its order (``CAS`` and ``Va`` both the
+6-DOF airspeed): the 12 longitudinal ones, then the lateral loop's."""
 
 
 @dataclass(frozen=True)
@@ -57,6 +64,11 @@ class MonitorSpec:
         Dryden level of the gust states (``none``: no gust states).
     altitude_m : float
         Altitude of the Dryden scale lengths [m].
+    turn_offsets : tuple of float
+        Lock offsets from trim [rad] of the lock-turn table; empty: no design
+        flies it.
+    turn_measured : bool
+        The lock-turn law feeds back the measured states (else the estimate).
     """
 
     threshold: float
@@ -71,9 +83,11 @@ class MonitorSpec:
     reset_var: np.ndarray
     design_turbulence: str = "none"
     altitude_m: float = 100.0
+    turn_offsets: tuple = ()
+    turn_measured: bool = True
 
 
-def monitor_spec(cfg, fm, det) -> MonitorSpec | None:
+def monitor_spec(cfg, fm, det, lock_turn: bool = False) -> MonitorSpec | None:
     """The side monitor of a campaign or scenario config, or None when it is off.
 
     Parameters
@@ -84,6 +98,9 @@ def monitor_spec(cfg, fm, det) -> MonitorSpec | None:
     det : Detection
         The paper's detection (its ``reset_var``: ``[b0_T, b0_elevons, b1_T,
         b1_L, b1_R]``).
+    lock_turn : bool
+        A design flies ``controller: lock_turn``: the spec carries the lock-turn
+        table's offsets (``monitor.turn_offsets_deg``, ``turn_step_deg``).
     """
     from .truth import lateral_noise
 
@@ -101,7 +118,9 @@ def monitor_spec(cfg, fm, det) -> MonitorSpec | None:
         snap=cfg.steps(mc.estimate_after_s),
         q_x=float(fm.q_diag[0]), q_b=float(fm.q_diag[LONGITUDINAL.n_x]),
         r_lon=r_lon, r_lat=lateral_noise(np.sqrt(r_lon)) ** 2, reset_var=reset,
-        design_turbulence=mc.design_turbulence, altitude_m=float(cfg.plant.altitude_m))
+        design_turbulence=mc.design_turbulence, altitude_m=float(cfg.plant.altitude_m),
+        turn_offsets=tuple(np.radians(mc.turn_offsets())) if lock_turn else (),
+        turn_measured=mc.turn_feedback == "measured")
 
 
 def gust_block(six, spec: MonitorSpec, span: float):
@@ -126,8 +145,64 @@ def gust_block(six, spec: MonitorSpec, span: float):
             block_diag(lon.P0, lat.P0))
 
 
+def lock_turn_table(six, u0: np.ndarray, offsets=(), airframe=None, measured: bool = True,
+                    progress: bool = True) -> LockTurnTable:
+    """The kernels' :class:`LockTurnTable` (empty, ``x`` of shape ``(2, 0, 10)``,
+    when ``offsets`` is).
+
+    The designs come from :func:`ftc_mc.design.lock_turn.cached_lock_turn_designs`
+    at the 6-DOF trim's airspeed and air-path angle and the model's period;
+    states become deviations from the 6-DOF trim on the monitor's rows
+    (``layout.MONITOR_STATES``), commands deviations from the longitudinal trim.
+
+    Parameters
+    ----------
+    six : SixDofPlant
+        The 6-DOF model and trim.
+    u0 : ndarray, shape (3,)
+        The longitudinal trim commands (absolute).
+    offsets : sequence of float
+        Lock offsets from trim [rad], uniform and ascending.
+    airframe : Airframe
+        Needed when ``offsets`` is not empty.
+    measured : bool
+        Feed back the measured outputs of the states the sensors measure
+        (``monitor.turn_feedback: measured``); else the monitor's estimate.
+    progress : bool
+        Say on stderr when the designs are computed, not loaded from the cache,
+        and how long that took.
+    """
+    from ..design.lock_turn import SIDES, cached_lock_turn_designs, healthy, turn_states
+
+    nf = len(turn_states("left"))
+    rows = np.array([[MONITOR_STATES.index(n) for n in turn_states(side)] for side in SIDES],
+                    dtype=np.int64)
+    cmd = np.array([[COMMAND["throttle"], COMMAND[healthy(side)]] for side in SIDES],
+                   dtype=np.int64)
+    locked = np.array([COMMAND[side] for side in SIDES], dtype=np.int64)
+    seen = [n for n in MEASURED] if measured else []
+    meas = np.array([[seen.index(n) if n in seen else -1 for n in turn_states(side)]
+                     for side in SIDES], dtype=np.int64)
+    off = np.asarray(offsets, dtype=float)
+    if off.size == 0:
+        z = np.zeros
+        return LockTurnTable(lo=z(2), step=1.0, x=z((2, 0, nf)), u=z((2, 0, len(COMMAND))),
+                             K=z((2, 0, 2, nf)), k=z((2, 0, 2)), rows=rows, meas=meas,
+                             cmd=cmd, locked=locked)
+    d = cached_lock_turn_designs(airframe, off, float(six.trim.V0),
+                                 float(np.degrees(six.trim.gamma0)), six.dt,
+                                 stream=sys.stderr if progress else None)
+    idx = np.array([[STATE[n] for n in turn_states(side)] for side in SIDES])
+    x = np.stack([d.x[s][:, idx[s]] - six.trim.x0[idx[s]] for s in range(2)])
+    c = np.ascontiguousarray
+    return LockTurnTable(lo=c(d.lock[:, 0]), step=float(off[1] - off[0]) if off.size > 1
+                         else 1.0, x=c(x), u=c(d.cmd - np.asarray(u0, dtype=float)),
+                         K=c(d.K), k=c(d.k), rows=rows, meas=meas, cmd=cmd, locked=locked)
+
+
 def side_monitor(six, u_ff: np.ndarray, u_lower, u_upper, lon_out: np.ndarray,
-                 spec: MonitorSpec | None, span: float = 0.0) -> SideMonitor:
+                 spec: MonitorSpec | None, span: float = 0.0,
+                 airframe=None) -> SideMonitor:
     """The kernels' :class:`SideMonitor` (off, with empty arrays, if ``spec`` is None).
 
     Parameters
@@ -144,6 +219,8 @@ def side_monitor(six, u_ff: np.ndarray, u_lower, u_upper, lon_out: np.ndarray,
     spec : MonitorSpec or None
     span : float
         Wing span [m] (the lateral Dryden model of a gust-aware monitor).
+    airframe : Airframe, optional
+        For the lock-turn table (``spec.turn_offsets`` not empty).
     """
     nu = len(LAYOUT.commands)
     if spec is None:
@@ -151,7 +228,7 @@ def side_monitor(six, u_ff: np.ndarray, u_lower, u_upper, lon_out: np.ndarray,
         return SideMonitor(on=0, A=z((0, 0)), B=z((0, nu)), C=z((0, 0)), u0=z(nu),
                            u_ff=z(nu), lo=z(nu), hi=z(nu), P0=z((0, 0)), Q=z((0, 0)), r=z(0),
                            reset_var=z(2 * nu), threshold=np.inf, window=1, min_window=1,
-                           startup=0, snap=0)
+                           startup=0, snap=0, turn=lock_turn_table(six, six.u0 - u_ff))
     states = np.array([STATE[n] for n in MONITOR_STATES])
     outs = np.concatenate([lon_out, [OUTPUT[n] for n in MONITOR_LATERAL]]).astype(np.int64)
     nx, npar = len(states), len(MONITOR_PARAMS)
@@ -186,4 +263,5 @@ def side_monitor(six, u_ff: np.ndarray, u_lower, u_upper, lon_out: np.ndarray,
         u_ff=c(u_ff, dtype=np.float64), lo=c(u_lower), hi=c(u_upper), P0=c(P0), Q=c(Q),
         r=c(np.concatenate([spec.r_lon, spec.r_lat])), reset_var=c(spec.reset_var),
         threshold=float(spec.threshold), window=int(spec.window),
-        min_window=int(spec.min_window), startup=int(spec.startup), snap=int(spec.snap))
+        min_window=int(spec.min_window), startup=int(spec.startup), snap=int(spec.snap),
+        turn=lock_turn_table(six, u0, spec.turn_offsets, airframe, spec.turn_measured))

@@ -37,7 +37,7 @@ from .estimator import (EstimatorSettings, belief_settings, detection, filter_mo
                         initial_covariance)
 from .truth import lateral_noise, sixdof_truth_plant, truth_plant
 
-CONTROLLER_KINDS = {"nominal": 0, "reconfiguring": 1}
+CONTROLLER_KINDS = {"nominal": 0, "reconfiguring": 1, "lock_turn": 2}
 """``Reconfig.kind`` of each controller kind (``controller.kind``, a design's
 ``controller``)."""
 
@@ -246,7 +246,8 @@ def build_setup(cfg: Config | ScenarioConfig) -> SimSetup:
 
         truth, gust, gust_lat = sixdof_truth_plant(
             plant, pc.kind, pc.substeps, pc.turbulence, pc.altitude_m,
-            monitor=monitor_spec(cfg, fm, detection(plant, EstimatorSettings())))
+            monitor=monitor_spec(cfg, fm, detection(plant, EstimatorSettings()),
+                                 lock_turn=cfg.flies_lock_turn(runs)))
         lat_std = lateral_noise(r_std)
         gust_lat_chol = None if gust_lat is None else gust_lat.P0_chol
     else:

@@ -147,7 +147,7 @@ def sixdof_truth_plant(plant: LinearPlant, kind: str = "nonlinear", substeps: in
         K_lat=c(lat.K[0], dtype=np.float64), a_act=elevon_lag(af.tau_elevon, plant.dt),
         lon_state=lon_state, lon_out=lon_out, lat_out=lat_out,
         monitor=side_monitor(six, six.u0 - plant.u0, plant.u_lower, plant.u_upper, lon_out,
-                             monitor, af.b))
+                             monitor, af.b, af))
     return pl, gust, gust_lat
 
 

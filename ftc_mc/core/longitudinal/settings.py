@@ -312,6 +312,8 @@ LaneState = namedtuple("LaneState", [
     "mP",       # (n_m, n_m, L) its covariance
     "mbuf",     # (W_m, 3, L) its GLR window of each direction's projection (ring)
     "mcount",   # (L,) int64 projections in that window
+    "mside",    # (L,) int64 the first elevon it named: 0 none, else its block code (2, 3)
+    "mpos",     # (L,) that elevon's estimated absolute position [rad] (core/sixdof/lockturn.py)
     # the extended filter's Jacobians about the lane's estimate (FilterModel.relin > 0;
     # the trim matrices otherwise, never read)
     "JA",       # (9, 9, L)  d x_{k+1} / d x_k of the one-period airframe map

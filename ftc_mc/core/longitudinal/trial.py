@@ -164,6 +164,8 @@ def init_state(inp, st, rec):
         st.last_k[l] = NO_SIGNAL
         st.last_block[l] = 0
         st.mcount[l] = 0
+        st.mside[l] = 0
+        st.mpos[l] = 0.0
         rec.side_k[l] = -1
         rec.side_block[l] = 0
         rec.side_pre[l] = 0
@@ -196,6 +198,7 @@ def new_state(L, n, window, n_x, n_lat, n_glat, n_m, window_m):
                      mx=np.zeros((n_m, L)), mP=np.zeros((n_m, n_m, L)),
                      mbuf=np.zeros((window_m, N_DIRECTIONS, L)),
                      mcount=np.zeros(L, dtype=np.int64),
+                     mside=np.zeros(L, dtype=np.int64), mpos=np.zeros(L),
                      JA=np.zeros((N_X, N_X, L)), JB=np.zeros((N_X, N_U, L)),
                      JW=np.zeros((N_X, N_WIND, L)), JC=np.zeros((N_Z, N_X, L)),
                      JHW=np.zeros((N_Z, N_WIND, L)))

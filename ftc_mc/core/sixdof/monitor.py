@@ -88,9 +88,23 @@ SideMonitor = namedtuple("SideMonitor", [
     "startup",    # steps from the start before a decision may be made
     "snap",       # steps after the first decision at or after the switch at which the
                   # estimate is recorded (TrialRecord.mon_b)
+    "turn",       # LockTurnTable: the lock-turn designs a lock_turn design flies once
+                  # the monitor names an elevon (core/sixdof/lockturn.py)
 ])
 """Kernel settings of the side monitor (module docstring); built by
 :func:`ftc_mc.sim.monitor.side_monitor`."""
+
+
+@kernel(inline="always")
+def lock_position(mon, x, ns, nu, st, work):
+    """``st.mpos``: the estimated absolute position ``b0 + (1 - b1)(u + u0)``
+    of the elevon each lane's monitor named first (``st.mside``; lanes without
+    one are left alone)."""
+    for l in range(x.shape[1]):
+        b = st.mside[l]
+        if b > 0:
+            a = b - 1
+            st.mpos[l] = x[ns + a, l] + (1.0 - x[ns + nu + a, l]) * (work.u[a, l] + mon.u0[a])
 
 
 @kernel
@@ -109,7 +123,8 @@ def sixdof_monitor(plant, scheme, flight, k, st, work, rec):
         Step.
     st : LaneState
         ``mx`` (n, L), ``mP`` (n, n, L) (set at step 0: zero and ``P0``),
-        the GLR window ``mbuf`` and ``mcount``, updated in place; ``lat``
+        the GLR window ``mbuf`` and ``mcount``, the first elevon named
+        ``mside`` and its position estimate ``mpos``, updated in place; ``lat``
         the lateral loop's measurements of ``k + 1``.
     work : TrialWork
         ``u`` the commands sent over the step, ``z`` the 12 longitudinal
@@ -294,6 +309,8 @@ def sixdof_monitor(plant, scheme, flight, k, st, work, rec):
                 P[pidx, j, l] = 0.0
                 P[j, pidx, l] = 0.0
             P[pidx, pidx, l] = mon.reset_var[pidx - ns]
+        if b > 1 and st.mside[l] == 0:  # the first elevon named (lockturn.py)
+            st.mside[l] = b
         if st.alive[l]:
             rec.side_n[l] += 1
             if kn >= flight.timing.k_fault:
@@ -303,6 +320,7 @@ def sixdof_monitor(plant, scheme, flight, k, st, work, rec):
             else:
                 rec.side_pre[l] += 1
     glr_restart(block, st.mcount)
+    lock_position(mon, x, ns, nu, st, work)
     for l in range(L):
         if st.alive[l] and (rec.side_k[l] < 0 or kn <= rec.side_k[l] + mon.snap):
             for i in range(2 * nu):

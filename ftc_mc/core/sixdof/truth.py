@@ -13,7 +13,10 @@ heading hold), whose only command is differential.
 One step ``k -> k+1`` on every lane, with the longitudinal commands ``u_k``
 (``TrialWork.u``, deviations from the longitudinal trim ``u0``):
 
-1. **Lateral loop.** ``da = -K_lat lat_k``, ``lat_k`` the loop's measured
+1. **Lateral loop.** (A ``controller: lock_turn`` design's lane whose side
+   monitor has named an elevon flies the lock-turn law of
+   :mod:`ftc_mc.core.sixdof.lockturn` instead: ``u`` is replaced, no
+   ``da``.)  ``da = -K_lat lat_k``, ``lat_k`` the loop's measured
    state (``LaneState.lat``: bank, side velocity, roll and yaw rates and
    heading measured at ``k``, and its model of the commanded elevon
    positions).  The commands become ``u + u_ff + [0, da, -da]``, each
@@ -58,6 +61,7 @@ from ..jit import kernel
 from ..longitudinal.plant import actuator_effect, gust_lanes, schedule_entry, sensor_fault
 from .layout import (N_OUTPUT, N_STATE, N_WIND, OUTPUT, STATE, U_LEFT, U_RIGHT, W_P, W_Q,
                      W_R, W_U, W_V, W_W, X_PHI, X_PSI, Y_ALPHA, Y_VA)
+from .lockturn import LOCK_TURN, lock_turn_law
 from .plant import N_WORK, outputs, propagate
 
 SIXDOF_NONLINEAR, SIXDOF_LINEAR = 2, 3
@@ -194,13 +198,19 @@ def sixdof_truth(plant, scheme, flight, inp, k, st, work, rec):
     L = st.x.shape[1]
     u = work.u
     a = pl.a_act
+    turn = pl.monitor.turn
+    turning = scheme.reconfig.kind == LOCK_TURN and turn.x.shape[1] > 0
     for l in range(L):
-        da = 0.0
-        for j in range(N_LAT):
-            da -= pl.K_lat[j] * st.lat[j, l]
-        for i in range(N_U):
-            ui = u[i, l] + pl.u_ff[i] + _ELEVON_SIGN[i] * da
-            u[i, l] = min(ctl.hi_dev[i], max(ctl.lo_dev[i], ui))
+        if turning and st.mside[l] > 0:
+            lock_turn_law(turn, st.mside[l] - 2, st.mpos[l], st.mx, work.z, st.lat, l, u0,
+                          ctl.lo_dev, ctl.hi_dev, u)
+        else:
+            da = 0.0
+            for j in range(N_LAT):
+                da -= pl.K_lat[j] * st.lat[j, l]
+            for i in range(N_U):
+                ui = u[i, l] + pl.u_ff[i] + _ELEVON_SIGN[i] * da
+                u[i, l] = min(ctl.hi_dev[i], max(ctl.lo_dev[i], ui))
         st.lat[LAT_LEFT, l] = a * st.lat[LAT_LEFT, l] + (1.0 - a) * (u[U_LEFT, l]
                                                                       - pl.u_ff[U_LEFT])
         st.lat[LAT_RIGHT, l] = a * st.lat[LAT_RIGHT, l] + (1.0 - a) * (u[U_RIGHT, l]

@@ -1,0 +1,115 @@
+"""Flying on with one elevon: the lock-turn law scheduled on the side monitor (issue 26, item 4).
+
+A design with ``controller: lock_turn`` flies the paper's reconfiguring loop
+until the side monitor (:mod:`ftc_mc.core.sixdof.monitor`) names an elevon.
+From that step on the lane flies the lock-turn controller of that side
+(:mod:`ftc_mc.design.lock_turn`): a discounted LQR on the throttle and the
+healthy elevon about the steady turn closest to the nominal glide that the
+lock allows; the lateral autopilot (wings level, heading hold) is off, and the
+paper's controllers keep running unheard.  The first elevon the monitor names
+is kept: a later decision (the monitor's linear model about wings-level flight
+describes a banked turn less well) does not switch sides.
+
+**Schedule.**  The designs form a table over lock positions on a uniform grid
+per side (``LockTurnTable.lo``, ``step``).  Each step, the law is interpolated
+linearly between the two designs around the monitor's current estimate of the
+lock position ``p = b0 + (1 - b1)(u + u0)`` (``LaneState.mpos``; clamped to
+the grid's ends), entry by entry: the design state ``x*`` and commands ``u*``,
+the gain ``K`` and the bias ``k`` of Theorem 4.1.
+
+**Law** (:func:`lock_turn_law`), on ``x_hat``: the ten fed-back states (bank,
+pitch, body velocities and rates, the throttle and the healthy elevon), each
+read from its sensor where one measures it and ``monitor.turn_feedback`` is
+``measured`` (``LockTurnTable.meas``), else from the monitor's estimate (its
+rows ``LockTurnTable.rows``; the actuators always).  The monitor's model is
+linear about wings-level flight, and in the steep turns of locks far from
+trim its estimate drifts from the truth (``docs/airframes.md``)::
+
+    [throttle, healthy] = u* - K (x_hat - x*) - k,   clipped to the command limits
+
+and the locked elevon is commanded to ``p`` (it does not move; the monitor's
+position estimate stays that of its model).  Commands and ``u*`` are
+deviations from the longitudinal trim ``u0``, ``x*`` from the 6-DOF trim, as
+the kernels hold them.
+
+Plain-NumPy twin: ``tests/naive_sixdof.py::lock_turn_law_ref``.
+"""
+
+from __future__ import annotations
+
+from collections import namedtuple
+
+from ..jit import kernel
+
+LOCK_TURN = 2
+"""``Reconfig.kind`` of a ``controller: lock_turn`` design (after 0 nominal and
+1 reconfiguring, which it runs until the monitor names an elevon)."""
+
+LockTurnTable = namedtuple("LockTurnTable", [
+    "lo",    # (2,) absolute lock position [rad] of each side's first grid point (left, right)
+    "step",  # grid step [rad]
+    "x",     # (2, n, n_f) design state on the fed-back rows, less the 6-DOF trim
+    "u",     # (2, n, 3) design commands less the longitudinal trim u0
+    "K",     # (2, n, 2, n_f) gains on (throttle, healthy elevon)
+    "k",     # (2, n, 2) Theorem 4.1's constant term
+    "rows",  # (2, n_f) int64: the monitor's row of each fed-back state
+    "meas",  # (2, n_f) int64: its measured output (the monitor's order), or -1: estimated
+    "cmd",   # (2, 2) int64: command index of the throttle and the healthy elevon
+    "locked",  # (2,) int64: command index of the locked elevon
+])
+"""The lock-turn designs of both sides over a grid of lock positions (module
+docstring); ``x`` of shape ``(2, 0, n_f)`` when no design flies it.  Built by
+:func:`ftc_mc.sim.monitor.lock_turn_table`."""
+
+
+@kernel(inline="always")
+def lock_turn_law(tab, s, p, mx, z, lat, l, u0, lo_dev, hi_dev, u):
+    """Commands of lane ``l`` under the lock-turn law of side ``s`` (0 left,
+    1 right) at the estimated lock position ``p`` [rad] (module docstring).
+
+    Parameters
+    ----------
+    tab : LockTurnTable
+    s : int
+        Side: 0 left, 1 right.
+    p : float
+        Estimated absolute lock position [rad].
+    mx : ndarray, shape (n_m, L)
+        The side monitor's estimate.
+    z, lat : ndarray, shapes (12, L), (>= 5, L)
+        The measurements at this step, less the 6-DOF trim outputs: the 12
+        longitudinal ones and the lateral loop's (the monitor's outputs, in order).
+    l : int
+        Lane.
+    u0 : ndarray, shape (3,)
+        The longitudinal trim commands (absolute).
+    lo_dev, hi_dev : ndarray, shape (3,)
+        Command limits less ``u0``.
+    u : ndarray, shape (3, L)
+        Commands less ``u0``; column ``l`` is written.
+    """
+    n = tab.x.shape[1]
+    nf = tab.x.shape[2]
+    nz = z.shape[0]
+    f = (p - tab.lo[s]) / tab.step
+    f = min(float(n - 1), max(0.0, f))
+    i = min(int(f), max(n - 2, 0))
+    w = f - i
+    j1 = min(i + 1, n - 1)
+    for c in range(2):
+        a = tab.cmd[s, c]
+        v = (1.0 - w) * (tab.u[s, i, a] - tab.k[s, i, c]) + w * (tab.u[s, j1, a]
+                                                                  - tab.k[s, j1, c])
+        for r in range(nf):
+            o = tab.meas[s, r]
+            if o < 0:
+                xr = mx[tab.rows[s, r], l]
+            elif o < nz:
+                xr = z[o, l]
+            else:
+                xr = lat[o - nz, l]
+            dev = xr - ((1.0 - w) * tab.x[s, i, r] + w * tab.x[s, j1, r])
+            v -= ((1.0 - w) * tab.K[s, i, c, r] + w * tab.K[s, j1, c, r]) * dev
+        u[a, l] = min(hi_dev[a], max(lo_dev[a], v))
+    a = tab.locked[s]
+    u[a, l] = min(hi_dev[a], max(lo_dev[a], p - u0[a]))
