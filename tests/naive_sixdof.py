@@ -341,15 +341,25 @@ class SideMonitorRef:
             self.b = np.concatenate([X[ns:], X[ns:ns + nu] + (1 - X[ns + nu:]) * (u + mon.u0)])
 
 
-def lock_turn_law_ref(tab, s, p, xhat, u0, lo_dev, hi_dev):
+def lock_turn_law_ref(tab, s, p, xhat, lo_dev, hi_dev):
     """The lock-turn law of one lane (``ftc_mc/core/sixdof/lockturn.py``),
     written from that module's docstring: every table entry interpolated with
     ``np.interp`` over the side's lock grid at the position ``p`` (clamped to
     its ends), ``u* - K (x_hat - x*) - k`` on the throttle and the healthy
-    elevon, the locked elevon at ``p``, each clipped.  ``xhat`` (n_f,) the
-    fed-back states.  Returns the commands (3,) less ``u0``."""
+    elevon, the locked elevon at its trim command ``hold``, each clipped;
+    the trim commands ``hold`` instead where neither grid point bracketing
+    ``p`` is steady.
+    ``xhat`` (n_f,) the fed-back states.  Returns the commands (3,) less the
+    longitudinal trim."""
     n = tab.x.shape[1]
     grid = tab.lo[s] + tab.step * np.arange(n)
+    out = np.zeros(3)
+    out[tab.locked[s]] = tab.hold[tab.locked[s]]
+    i = min(int(np.searchsorted(grid, np.clip(p, grid[0], grid[-1]), side="right")) - 1,
+            n - 2)  # the bracketing pair i, i + 1 (the last two beyond the end)
+    if not tab.steady[s, [i, i + 1]].any():  # no steady flight either side: trim held
+        out[tab.cmd[s]] = tab.hold[tab.cmd[s]]
+        return np.clip(out, lo_dev, hi_dev)
 
     def at(a):  # entry-wise interpolation of a (n, ...) table
         flat = a.reshape(n, -1)
@@ -357,7 +367,5 @@ def lock_turn_law_ref(tab, s, p, xhat, u0, lo_dev, hi_dev):
                         ).reshape(a.shape[1:])
 
     x, u, K, k = at(tab.x[s]), at(tab.u[s]), at(tab.K[s]), at(tab.k[s])
-    out = np.zeros(3)
     out[tab.cmd[s]] = u[tab.cmd[s]] - K @ (xhat - x) - k
-    out[tab.locked[s]] = p - u0[tab.locked[s]]
     return np.clip(out, lo_dev, hi_dev)

@@ -40,21 +40,22 @@ def test_law_matches_its_twin(measured):
     empty = build_empty_table(measured)
     tab = empty._replace(lo=np.array([-0.1, -0.12]), step=0.05,
                          x=rng.normal(0, 0.1, (2, n, nf)), u=rng.normal(0, 0.1, (2, n, 3)),
-                         K=rng.normal(0, 1.0, (2, n, 2, nf)), k=rng.normal(0, 0.05, (2, n, 2)))
+                         K=rng.normal(0, 1.0, (2, n, 2, nf)), k=rng.normal(0, 0.05, (2, n, 2)),
+                         steady=np.array([[0.0, 1, 1, 1, 0], [1.0, 1, 1, 0, 0]]),
+                         hold=np.array([0.01, -0.02, 0.03]))
     mx = rng.normal(0, 0.2, (20, L))
     z = rng.normal(0, 0.2, (12, L))
     lat = rng.normal(0, 0.2, (7, L))
-    u0 = np.array([0.4, 0.05, 0.05])
     lo, hi = np.array([-0.4, -0.5, -0.5]), np.array([0.6, 0.5, 0.5])
     for s in (0, 1):
         for p in (-0.3, -0.1, -0.07, 0.0, 0.0999, 0.1, 0.5):
             u = np.zeros((3, L))
             for l in range(L):
-                lock_turn_law(tab, s, p, mx, z, lat, l, u0, lo, hi, u)
+                lock_turn_law(tab, s, p, mx, z, lat, l, lo, hi, u)
                 meas = np.concatenate([z[:, l], lat[:5, l]])
                 xhat = np.where(tab.meas[s] >= 0, meas[np.maximum(tab.meas[s], 0)],
                                 mx[tab.rows[s], l])
-                want = lock_turn_law_ref(tab, s, p, xhat, u0, lo, hi)
+                want = lock_turn_law_ref(tab, s, p, xhat, lo, hi)
                 np.testing.assert_allclose(u[:, l], want, rtol=1e-12, atol=1e-14)
     # the measured sources are the sensors of the same states
     if measured:

@@ -188,7 +188,7 @@ def lock_turn_table(six, u0: np.ndarray, offsets=(), airframe=None, measured: bo
         z = np.zeros
         return LockTurnTable(lo=z(2), step=1.0, x=z((2, 0, nf)), u=z((2, 0, len(COMMAND))),
                              K=z((2, 0, 2, nf)), k=z((2, 0, 2)), rows=rows, meas=meas,
-                             cmd=cmd, locked=locked)
+                             cmd=cmd, locked=locked, steady=z((2, 0)), hold=z(len(COMMAND)))
     d = cached_lock_turn_designs(airframe, off, float(six.trim.V0),
                                  float(np.degrees(six.trim.gamma0)), six.dt,
                                  stream=sys.stderr if progress else None)
@@ -197,7 +197,9 @@ def lock_turn_table(six, u0: np.ndarray, offsets=(), airframe=None, measured: bo
     c = np.ascontiguousarray
     return LockTurnTable(lo=c(d.lock[:, 0]), step=float(off[1] - off[0]) if off.size > 1
                          else 1.0, x=c(x), u=c(d.cmd - np.asarray(u0, dtype=float)),
-                         K=c(d.K), k=c(d.k), rows=rows, meas=meas, cmd=cmd, locked=locked)
+                         K=c(d.K), k=c(d.k), rows=rows, meas=meas, cmd=cmd, locked=locked,
+                         steady=c(d.steady, dtype=np.float64),
+                         hold=c(six.u0 - np.asarray(u0, dtype=float)))
 
 
 def side_monitor(six, u_ff: np.ndarray, u_lower, u_upper, lon_out: np.ndarray,

@@ -21,7 +21,8 @@ described where it is defined:
    6-DOF family's :func:`ftc_mc.core.sixdof.truth.sixdof_truth`), then
    :func:`ftc_mc.core.longitudinal.stages.record_cost` -- tracking and command costs,
    then :func:`side_monitor` -- on the 6-DOF plant its side monitor
-   (:func:`ftc_mc.core.sixdof.monitor.sixdof_monitor`), which records and does not act;
+   (:func:`ftc_mc.core.sixdof.monitor.sixdof_monitor`), which records, and which a
+   ``lock_turn`` design's truth stage reads (``core/sixdof/lockturn.py``);
 3. :func:`ftc_mc.core.longitudinal.stages.filter_update` -- the filter with ``u_k``, ``z_{k+1}``;
 4. :func:`ftc_mc.core.longitudinal.stages.check_validity`;
 5. :func:`ftc_mc.core.longitudinal.stages.handle_resets` -- resets, excitation requests

@@ -17,6 +17,15 @@ lock position ``p = b0 + (1 - b1)(u + u0)`` (``LaneState.mpos``; clamped to
 the grid's ends), entry by entry: the design state ``x*`` and commands ``u*``,
 the gain ``K`` and the bias ``k`` of Theorem 4.1.
 
+**No steady flight.**  Where neither grid point bracketing ``p`` (the last
+two beyond the grid's end) has a steady flight of its own in the design box
+(``LockTurnTable.steady``: their designs are about the nearest lock that has
+one, with Theorem 4.1's bias), the throttle and the healthy elevon hold the
+6-DOF trim commands instead (``LockTurnTable.hold``): the oracle study
+(``scripts/study_lock_turn.py``) found that holding them keeps such locks in
+the envelope longer than the biased designs (+3 deg from trim: 12.7 s against
+6.8 s; ``docs/airframes.md`` has the campaign's figures).
+
 **Law** (:func:`lock_turn_law`), on ``x_hat``: the ten fed-back states (bank,
 pitch, body velocities and rates, the throttle and the healthy elevon), each
 read from its sensor where one measures it and ``monitor.turn_feedback`` is
@@ -27,8 +36,11 @@ trim its estimate drifts from the truth (``docs/airframes.md``)::
 
     [throttle, healthy] = u* - K (x_hat - x*) - k,   clipped to the command limits
 
-and the locked elevon is commanded to ``p`` (it does not move; the monitor's
-position estimate stays that of its model).  Commands and ``u*`` are
+and the locked elevon is commanded to its trim position (``hold``): a locked
+elevon does not move whatever its command, and an elevon the monitor named
+wrongly (an engine change misread) stays where the nominal glide needs it,
+instead of following the estimate of a lock it does not have (commanding it
+to ``p`` let that estimate run away in the 6-DOF paper scenario).  Commands and ``u*`` are
 deviations from the longitudinal trim ``u0``, ``x*`` from the 6-DOF trim, as
 the kernels hold them.
 
@@ -56,6 +68,9 @@ LockTurnTable = namedtuple("LockTurnTable", [
     "meas",  # (2, n_f) int64: its measured output (the monitor's order), or -1: estimated
     "cmd",   # (2, 2) int64: command index of the throttle and the healthy elevon
     "locked",  # (2,) int64: command index of the locked elevon
+    "steady",  # (2, n) 1.0: the lock has its own steady flight in the design box; 0.0: not
+    "hold",    # (3,) the 6-DOF trim commands less u0: the locked elevon's command, and
+               # the others' where neither lock bracketing the estimate is steady
 ])
 """The lock-turn designs of both sides over a grid of lock positions (module
 docstring); ``x`` of shape ``(2, 0, n_f)`` when no design flies it.  Built by
@@ -63,7 +78,7 @@ docstring); ``x`` of shape ``(2, 0, n_f)`` when no design flies it.  Built by
 
 
 @kernel(inline="always")
-def lock_turn_law(tab, s, p, mx, z, lat, l, u0, lo_dev, hi_dev, u):
+def lock_turn_law(tab, s, p, mx, z, lat, l, lo_dev, hi_dev, u):
     """Commands of lane ``l`` under the lock-turn law of side ``s`` (0 left,
     1 right) at the estimated lock position ``p`` [rad] (module docstring).
 
@@ -81,21 +96,34 @@ def lock_turn_law(tab, s, p, mx, z, lat, l, u0, lo_dev, hi_dev, u):
         longitudinal ones and the lateral loop's (the monitor's outputs, in order).
     l : int
         Lane.
-    u0 : ndarray, shape (3,)
-        The longitudinal trim commands (absolute).
     lo_dev, hi_dev : ndarray, shape (3,)
         Command limits less ``u0``.
     u : ndarray, shape (3, L)
         Commands less ``u0``; column ``l`` is written.
     """
     n = tab.x.shape[1]
-    nf = tab.x.shape[2]
-    nz = z.shape[0]
     f = (p - tab.lo[s]) / tab.step
     f = min(float(n - 1), max(0.0, f))
     i = min(int(f), max(n - 2, 0))
     w = f - i
     j1 = min(i + 1, n - 1)
+    if tab.steady[s, i] == 0.0 and tab.steady[s, j1] == 0.0:  # hold the trim commands
+        for c in range(2):
+            a = tab.cmd[s, c]
+            u[a, l] = min(hi_dev[a], max(lo_dev[a], tab.hold[a]))
+    else:
+        turn_law(tab, s, i, j1, w, mx, z, lat, l, lo_dev, hi_dev, u)
+    a = tab.locked[s]
+    u[a, l] = min(hi_dev[a], max(lo_dev[a], tab.hold[a]))
+
+
+@kernel(inline="always")
+def turn_law(tab, s, i, j1, w, mx, z, lat, l, lo_dev, hi_dev, u):
+    """The throttle and healthy elevon commands of lane ``l``: the designs ``i``
+    and ``j1`` of side ``s`` interpolated with weight ``w`` on ``j1``
+    (:func:`lock_turn_law`)."""
+    nf = tab.x.shape[2]
+    nz = z.shape[0]
     for c in range(2):
         a = tab.cmd[s, c]
         v = (1.0 - w) * (tab.u[s, i, a] - tab.k[s, i, c]) + w * (tab.u[s, j1, a]
@@ -111,5 +139,3 @@ def lock_turn_law(tab, s, p, mx, z, lat, l, u0, lo_dev, hi_dev, u):
             dev = xr - ((1.0 - w) * tab.x[s, i, r] + w * tab.x[s, j1, r])
             v -= ((1.0 - w) * tab.K[s, i, c, r] + w * tab.K[s, j1, c, r]) * dev
         u[a, l] = min(hi_dev[a], max(lo_dev[a], v))
-    a = tab.locked[s]
-    u[a, l] = min(hi_dev[a], max(lo_dev[a], p - u0[a]))

@@ -4,9 +4,11 @@ On the 6-DOF plant the paper's scheme keeps its longitudinal filter, which sees
 a locked elevon only through pitch (``docs/airframes.md``).  Beside it, the
 flight computer runs this monitor on the sensors it has: an augmented Kalman
 filter of the 6-DOF linear model with a fault of each actuator, and a windowed
-GLR test per fault direction that names the actuator.  It does not act on the
-controllers: it records its decisions and estimates, so that a campaign
-measures how well roll tells left from right, and how soon.
+GLR test per fault direction that names the actuator.  It records its
+decisions and estimates, so that a campaign measures how well roll tells left
+from right, and how soon; it keeps the first elevon it names and that
+elevon's position estimate (``LaneState.mside``, ``mpos``), on which a
+``controller: lock_turn`` design flies on (:mod:`ftc_mc.core.sixdof.lockturn`).
 
 **Filter** (the paper's eqs. 4-11 on the 6-DOF model, per actuator).  The
 estimate is ``X = [x (14), b0 (3), b1 (3)]``: the 6-DOF states but the

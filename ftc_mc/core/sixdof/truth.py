@@ -202,7 +202,7 @@ def sixdof_truth(plant, scheme, flight, inp, k, st, work, rec):
     turning = scheme.reconfig.kind == LOCK_TURN and turn.x.shape[1] > 0
     for l in range(L):
         if turning and st.mside[l] > 0:
-            lock_turn_law(turn, st.mside[l] - 2, st.mpos[l], st.mx, work.z, st.lat, l, u0,
+            lock_turn_law(turn, st.mside[l] - 2, st.mpos[l], st.mx, work.z, st.lat, l,
                           ctl.lo_dev, ctl.hi_dev, u)
         else:
             da = 0.0
