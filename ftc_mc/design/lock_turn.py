@@ -51,6 +51,12 @@ The law (:meth:`LockTurnDesign.command`), on the true state (the oracle)::
     [throttle, healthy] = u* - K (x_turn - x_turn*) - k,   clipped to the limits
 
 with the locked elevon's command its lock position.
+
+5. **Table** (:func:`cached_lock_turn_designs`): the designs of both sides
+   over a uniform grid of lock offsets, computed once per airframe and cached
+   on disk; the ``lock_turn`` controller of the trial loop flies them,
+   interpolated on the side monitor's lock estimate, with measurements in
+   place of the oracle's true state (:mod:`ftc_mc.core.sixdof.lockturn`).
 """
 
 from __future__ import annotations
