@@ -70,6 +70,7 @@ from pathlib import Path
 
 import numpy as np
 import scipy.optimize
+from threadpoolctl import threadpool_limits
 
 from ..core.sixdof.layout import COMMAND, OUTPUT, STATE
 from ..model.airframe import Airframe
@@ -492,7 +493,7 @@ def lock_turn_lqr(airframe: Airframe, side: str, lock: float, dt: float = 0.1,
                           u_upper=np.array(airframe.command_upper, dtype=float))
 
 
-LOCK_TURN_TABLE_VERSION = "1"
+LOCK_TURN_TABLE_VERSION = "2"
 """Bumped when :func:`lock_turn_designs` changes what it computes (cache key)."""
 
 
@@ -550,8 +551,21 @@ def lock_turn_designs(airframe: Airframe, offsets, V0: float = 20.0,
     Returns
     -------
     LockTurnDesigns
+
+    Notes
+    -----
+    The designs are computed on one BLAS thread (``threadpoolctl``): the
+    design points' SLSQP solutions move by up to 1.6e-7 (the gains by 5e-8)
+    between one and two OpenBLAS threads, and the table must be the same to
+    the bit on every machine, as the trials flown on it are.
     """
     offsets = np.asarray(offsets, dtype=float)
+    with threadpool_limits(limits=1, user_api="blas"):
+        return _designs(airframe, offsets, V0, gamma0_deg, dt)
+
+
+def _designs(airframe, offsets, V0, gamma0_deg, dt) -> LockTurnDesigns:
+    """:func:`lock_turn_designs` on the threads in force."""
     n = offsets.size
     trim_cmd = trim6(airframe, V0, gamma0_deg).u0
     lock = np.empty((2, n))
