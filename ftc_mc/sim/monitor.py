@@ -145,8 +145,8 @@ def gust_block(six, spec: MonitorSpec, span: float):
             block_diag(lon.P0, lat.P0))
 
 
-def lock_turn_table(six, u0: np.ndarray, offsets=(), airframe=None, measured: bool = True,
-                    progress: bool = True) -> LockTurnTable:
+def lock_turn_table(six, u0: np.ndarray, offsets=(), airframe=None,
+                    measured: bool = True) -> LockTurnTable:
     """The kernels' :class:`LockTurnTable` (empty, ``x`` of shape ``(2, 0, 10)``,
     when ``offsets`` is).
 
@@ -168,9 +168,9 @@ def lock_turn_table(six, u0: np.ndarray, offsets=(), airframe=None, measured: bo
     measured : bool
         Feed back the measured outputs of the states the sensors measure
         (``monitor.turn_feedback: measured``); else the monitor's estimate.
-    progress : bool
-        Say on stderr when the designs are computed, not loaded from the cache,
-        and how long that took.
+
+    Designs the cache does not hold are computed with a notice on stderr and
+    their duration.
     """
     from ..design.lock_turn import SIDES, cached_lock_turn_designs, healthy, turn_states
 
@@ -180,7 +180,7 @@ def lock_turn_table(six, u0: np.ndarray, offsets=(), airframe=None, measured: bo
     cmd = np.array([[COMMAND["throttle"], COMMAND[healthy(side)]] for side in SIDES],
                    dtype=np.int64)
     locked = np.array([COMMAND[side] for side in SIDES], dtype=np.int64)
-    seen = [n for n in MEASURED] if measured else []
+    seen = list(MEASURED) if measured else []
     meas = np.array([[seen.index(n) if n in seen else -1 for n in turn_states(side)]
                      for side in SIDES], dtype=np.int64)
     off = np.asarray(offsets, dtype=float)
@@ -191,7 +191,7 @@ def lock_turn_table(six, u0: np.ndarray, offsets=(), airframe=None, measured: bo
                              cmd=cmd, locked=locked, steady=z((2, 0)), hold=z(len(COMMAND)))
     d = cached_lock_turn_designs(airframe, off, float(six.trim.V0),
                                  float(np.degrees(six.trim.gamma0)), six.dt,
-                                 stream=sys.stderr if progress else None)
+                                 stream=sys.stderr)
     idx = np.array([[STATE[n] for n in turn_states(side)] for side in SIDES])
     x = np.stack([d.x[s][:, idx[s]] - six.trim.x0[idx[s]] for s in range(2)])
     c = np.ascontiguousarray

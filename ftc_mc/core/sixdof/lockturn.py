@@ -40,9 +40,9 @@ and the locked elevon is commanded to its trim position (``hold``): a locked
 elevon does not move whatever its command, and an elevon the monitor named
 wrongly (an engine change misread) stays where the nominal glide needs it,
 instead of following the estimate of a lock it does not have (commanding it
-to ``p`` let that estimate run away in the 6-DOF paper scenario).  Commands and ``u*`` are
-deviations from the longitudinal trim ``u0``, ``x*`` from the 6-DOF trim, as
-the kernels hold them.
+to ``p`` let that estimate run away in the 6-DOF paper scenario).  Commands
+and ``u*`` are deviations from the longitudinal trim ``u0``, ``x*`` from the
+6-DOF trim, as the kernels hold them.
 
 Plain-NumPy twin: ``tests/naive_sixdof.py::lock_turn_law_ref``.
 """

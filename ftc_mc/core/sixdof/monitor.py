@@ -98,15 +98,20 @@ SideMonitor = namedtuple("SideMonitor", [
 
 
 @kernel(inline="always")
+def position(mon, x, ns, nu, a, l, work):
+    """Lane ``l``'s estimated absolute position of actuator ``a``,
+    ``b0 + (1 - b1)(u + u0)``: what eq. (2) makes of the command sent."""
+    return x[ns + a, l] + (1.0 - x[ns + nu + a, l]) * (work.u[a, l] + mon.u0[a])
+
+
+@kernel(inline="always")
 def lock_position(mon, x, ns, nu, st, work):
-    """``st.mpos``: the estimated absolute position ``b0 + (1 - b1)(u + u0)``
-    of the elevon each lane's monitor named first (``st.mside``; lanes without
-    one are left alone)."""
+    """``st.mpos``: the estimated :func:`position` of the elevon each lane's
+    monitor named first (``st.mside``; lanes without one are left alone)."""
     for l in range(x.shape[1]):
         b = st.mside[l]
         if b > 0:
-            a = b - 1
-            st.mpos[l] = x[ns + a, l] + (1.0 - x[ns + nu + a, l]) * (work.u[a, l] + mon.u0[a])
+            st.mpos[l] = position(mon, x, ns, nu, b - 1, l, work)
 
 
 @kernel
@@ -328,5 +333,4 @@ def sixdof_monitor(plant, scheme, flight, k, st, work, rec):
             for i in range(2 * nu):
                 rec.mon_b[i, l] = x[ns + i, l]
             for a in range(nu):
-                rec.mon_b[2 * nu + a, l] = x[ns + a, l] + (1.0 - x[ns + nu + a, l]) * (
-                    work.u[a, l] + mon.u0[a])
+                rec.mon_b[2 * nu + a, l] = position(mon, x, ns, nu, a, l, work)
