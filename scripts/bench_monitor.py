@@ -15,6 +15,10 @@ three repeats after a warm-up call (which compiles or loads the kernels).
 Usage::
 
     .venv/bin/python scripts/bench_monitor.py [--lanes 128] [--steps 400]
+        [--prediction linear|nonlinear]
+
+``--prediction nonlinear`` times the monitor that predicts with the airframe's
+equations (``monitor.prediction``; 5 RK4 sub-steps), on the same data.
 
 The last line is ``paper_filter_steps_per_s=<a> monitor_steps_per_s=<b>
 ratio=<b/a>``.
@@ -65,10 +69,11 @@ def monitor_data(mon, n_steps, L, seed=0):
     return U, Z
 
 
-def bench_monitor(L, n_steps):
+def bench_monitor(L, n_steps, prediction="linear"):
     """Best monitor filter steps per second, and the first call's time."""
     cfg = api.campaign_config({"campaign": {"transitions": ["elevon_lock"]},
-                               "plant": {"kind": "linear", "dof": 6}})
+                               "plant": {"kind": "linear", "dof": 6},
+                               "monitor": {"prediction": prediction}})
     setup = build_setup(cfg)
     mon = setup.truth.monitor
     scheme = setup.scheme("paper")
@@ -104,16 +109,18 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--lanes", type=int, default=128)
     ap.add_argument("--steps", type=int, default=400)
+    ap.add_argument("--prediction", choices=("linear", "nonlinear"), default="linear")
     args = ap.parse_args()
     plant = bench_core.build_plant()
     es = bench_core.EstimatorSettings()
     fm, det = bench_core.filter_model(plant, es), bench_core.detection(plant, es)
     P0 = bench_core.initial_covariance(fm, det)
     paper, first_p, _ = bench_core.bench_batch(fm, det, P0, plant, args.lanes, args.steps)
-    mon, first_m = bench_monitor(args.lanes, args.steps)
+    mon, first_m = bench_monitor(args.lanes, args.steps, args.prediction)
     print(f"a  paper filter (filter_step_lanes), L={args.lanes}: {paper:.3e} steps/s "
           f"(first call {first_p:.1f} s)")
-    print(f"b  side monitor (sixdof_monitor), L={args.lanes}: {mon:.3e} steps/s "
+    print(f"b  side monitor (sixdof_monitor, {args.prediction} prediction), L={args.lanes}: "
+          f"{mon:.3e} steps/s "
           f"(first call {first_m:.1f} s)")
     print(f"paper_filter_steps_per_s={paper:.3e} monitor_steps_per_s={mon:.3e} "
           f"ratio={mon / paper:.3f}")

@@ -264,10 +264,18 @@ class SideMonitorRef:
     ``side_pre``, ``side_n``, ``b`` (9,) hold the lane's state and record,
     ``side`` the first elevon named (its block code) and ``pos`` its
     estimated position ``b0 + (1 - b1)(u + u0)`` (``core/sixdof/lockturn.py``).
+
+    With ``mon.nonlinear`` the prediction flies the airframe's equations
+    (``ftc_mc.model.sixdof.derivatives``, classical RK4 written here,
+    ``mon.n_sub`` steps, commands ``b0 + (1 - b1)(u + u0)``) from ``x0 + X``,
+    the gust states linear, and each innovation is ``z - h(X_pred) - c (X -
+    X_pred)`` with ``h`` the airframe's outputs less the trim's
+    (``ftc_mc.model.sixdof.outputs``); ``plant`` the truth (``p``, ``x0``,
+    ``y0``, ``dt``).
     """
 
-    def __init__(self, mon, k_fault):
-        self.mon, self.kf = mon, k_fault
+    def __init__(self, mon, k_fault, plant=None):
+        self.mon, self.kf, self.plant = mon, k_fault, plant
         n = mon.P0.shape[0]
         self.X, self.P = np.zeros(n), np.zeros((n, n))
         self.hist = []  # direction projections since the last restart, oldest first
@@ -290,6 +298,9 @@ class SideMonitorRef:
         F[:ns, ns + nu:] = mon.B @ np.diag(g)
         X = F @ self.X
         X[:ns] += mon.B @ (u - mon.u_ff)
+        off = np.zeros(mon.C.shape[0])
+        if mon.nonlinear:
+            X[:ns], off = self._nonlinear(u)
         P = F @ self.P @ F.T + mon.Q
         S = np.zeros((n, nu))
         S[:ns] = mon.B
@@ -298,7 +309,7 @@ class SideMonitorRef:
             c = np.zeros(n)
             c[:ns] = mon.C[r]
             s = c @ P @ c + mon.r[r]
-            innov = z[r] - c @ X
+            innov = z[r] - c @ X - off[r]
             mu = (c @ S) / np.sqrt(s)
             num += mu * innov / np.sqrt(s)
             den += mu ** 2
@@ -339,6 +350,51 @@ class SideMonitorRef:
             self.pos = self.X[ns + a] + (1 - self.X[ns + nu + a]) * (u[a] + mon.u0[a])
         if alive and (self.side_k < 0 or kn <= self.side_k + mon.snap):
             self.b = np.concatenate([X[ns:], X[ns:ns + nu] + (1 - X[ns + nu:]) * (u + mon.u0)])
+
+
+    def _nonlinear(self, u):
+        """The nonlinear prediction of the monitor's states (ns,) and each
+        measurement's ``h(X_pred) - C X_pred`` (m,)."""
+        mon, pl = self.mon, self.plant
+        ns, nu = mon.B.shape
+        nx = len(mon.states)
+        cmd = self.X[ns:ns + nu] + (1 - self.X[ns + nu:]) * (u + mon.u0)
+        pred = np.zeros(ns)
+        pred[:nx] = (fly_equations(pl, mon.states, self.X[:nx], cmd, mon.n_sub)
+                     + mon.A[:nx, nx:] @ self.X[nx:ns])
+        pred[nx:] = mon.A[nx:, nx:] @ self.X[nx:ns]
+        off = equation_outputs(pl, mon.states, mon.outs, pred[:nx]) - mon.C[:, :nx] @ pred[:nx]
+        return pred, off
+
+
+def fly_equations(pl, states, x_dev, cmd, n_sub):
+    """One period ``pl.dt`` of the 6-DOF airframe's equations
+    (``ftc_mc.model.sixdof.derivatives``, classical RK4 in ``n_sub`` steps,
+    still air) from the trim ``pl.x0`` plus ``x_dev`` on the rows ``states``,
+    under the absolute commands ``cmd``; returns the deviation on those rows."""
+    from ftc_mc.model.sixdof import derivatives
+
+    x = pl.x0.copy()
+    x[states] += x_dev
+    h = pl.dt / n_sub
+    for _ in range(n_sub):
+        k1 = derivatives(x, cmd, pl.p)
+        k2 = derivatives(x + h / 2 * k1, cmd, pl.p)
+        k3 = derivatives(x + h / 2 * k2, cmd, pl.p)
+        k4 = derivatives(x + h * k3, cmd, pl.p)
+        x = x + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+    return x[states] - pl.x0[states]
+
+
+def equation_outputs(pl, states, outs, x_dev):
+    """The airframe's outputs ``outs`` less the trim's
+    (``ftc_mc.model.sixdof.outputs``, still air) at the trim plus ``x_dev`` on
+    the rows ``states``."""
+    from ftc_mc.model.sixdof import outputs
+
+    x = pl.x0.copy()
+    x[states] += x_dev
+    return outputs(x, pl.p)[outs] - pl.y0[outs]
 
 
 def lock_turn_law_ref(tab, s, p, xhat, lo_dev, hi_dev):

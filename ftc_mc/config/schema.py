@@ -335,13 +335,24 @@ class MonitorConfig(_Strict):
     enabled: bool = True
     """Fly the side monitor beside every design on the 6-DOF plant
     (``ftc_mc/core/sixdof/monitor.py``): an augmented filter of the 6-DOF
-    linear model with a fault of each actuator and a windowed GLR per
+    model with a fault of each actuator and a windowed GLR per
     actuator; it records its decisions, and acts only in a design with
     ``controller: lock_turn``.  Ignored on the longitudinal plants."""
     design_turbulence: Literal[TURBULENCE_LEVELS] = "none"
     """Dryden level the monitor's filter models (``none``: no gust states; else
     the 8 states of the longitudinal and lateral Dryden models at that level,
     as a ``gust_aware`` design adds the longitudinal ones)."""
+    prediction: Literal["auto", "linear", "nonlinear"] = "auto"
+    """What predicts the monitor's states and measurements: ``linear``, the
+    6-DOF linear model at trim; ``nonlinear``, the airframe's equations (an
+    extended filter, covariance with the trim Jacobians), which keep the
+    propeller's torque and the moments off the trim airspeed that the linear
+    model reads as a differential elevon; ``auto``, the truth plant's kind."""
+    substeps: Annotated[int, NoBool, Field(ge=1, le=100)] = 5
+    """RK4 sub-steps per control period of the nonlinear prediction (5 at dt =
+    0.1 s: on the X8, from states far off trim, the body rates one period on
+    are within 3e-4 rad/s of 100 sub-steps', where 2 leave 4e-2; its roll mode
+    is -38.5 rad/s)."""
     threshold: Pos = 30.0
     """GLR threshold on each actuator's statistic (chi-square, 1 degree of
     freedom, per tested change under no fault)."""

@@ -2,7 +2,8 @@
 
 The monitor's model is the discrete 6-DOF linear model of the truth plant
 (:func:`ftc_mc.model.sixdof.build_sixdof_plant`) on the states of
-``layout.MONITOR_STATES``; its noise follows the paper's filter:
+``layout.MONITOR_STATES`` (its Jacobians, and its prediction unless the
+airframe's equations predict); its noise follows the paper's filter:
 
 * ``Q``: ``sigma_qx^2 dt`` on every state and ``sigma_qb^2 dt`` on every fault
   parameter (the paper's ``Q^x``, ``Q^b``, estimator section of the config);
@@ -16,7 +17,10 @@ The monitor's model is the discrete 6-DOF linear model of the truth plant
   their ``Q`` block ``B_d B_d^T`` and ``P0`` block their stationary covariance,
   as the truth's gusts start;
 * reset variances: the paper's per block (section 3.2.2), the elevon block's
-  ``b0`` variance for each elevon's ``b0``.
+  ``b0`` variance for each elevon's ``b0``;
+* prediction (``monitor.prediction``): the linear model, or the airframe's
+  equations with ``monitor.substeps`` RK4 steps per period (``auto``: the
+  truth plant's kind).
 
 Imported only on the 6-DOF path (by :func:`ftc_mc.sim.truth.sixdof_truth_plant`).
 """
@@ -69,6 +73,11 @@ class MonitorSpec:
         flies it.
     turn_measured : bool
         The lock-turn law feeds back the measured states (else the estimate).
+    nonlinear : bool
+        The airframe's equations predict (``monitor.prediction``, resolved
+        against the truth plant's kind).
+    substeps : int
+        RK4 sub-steps of that prediction per period.
     """
 
     threshold: float
@@ -85,6 +94,8 @@ class MonitorSpec:
     altitude_m: float = 100.0
     turn_offsets: tuple = ()
     turn_measured: bool = True
+    nonlinear: bool = False
+    substeps: int = 5
 
 
 def monitor_spec(cfg, fm, det, lock_turn: bool = False) -> MonitorSpec | None:
@@ -120,7 +131,10 @@ def monitor_spec(cfg, fm, det, lock_turn: bool = False) -> MonitorSpec | None:
         r_lon=r_lon, r_lat=lateral_noise(np.sqrt(r_lon)) ** 2, reset_var=reset,
         design_turbulence=mc.design_turbulence, altitude_m=float(cfg.plant.altitude_m),
         turn_offsets=tuple(np.radians(mc.turn_offsets())) if lock_turn else (),
-        turn_measured=mc.turn_feedback == "measured")
+        turn_measured=mc.turn_feedback == "measured",
+        nonlinear=(mc.prediction == "nonlinear" or
+                   (mc.prediction == "auto" and cfg.plant.kind == "nonlinear")),
+        substeps=int(mc.substeps))
 
 
 def gust_block(six, spec: MonitorSpec, span: float):
@@ -230,7 +244,9 @@ def side_monitor(six, u_ff: np.ndarray, u_lower, u_upper, lon_out: np.ndarray,
         return SideMonitor(on=0, A=z((0, 0)), B=z((0, nu)), C=z((0, 0)), u0=z(nu),
                            u_ff=z(nu), lo=z(nu), hi=z(nu), P0=z((0, 0)), Q=z((0, 0)), r=z(0),
                            reset_var=z(2 * nu), threshold=np.inf, window=1, min_window=1,
-                           startup=0, snap=0, turn=lock_turn_table(six, six.u0 - u_ff))
+                           startup=0, snap=0, turn=lock_turn_table(six, six.u0 - u_ff),
+                           nonlinear=0, states=z(0, dtype=np.int64),
+                           outs=z(0, dtype=np.int64), n_sub=1)
     states = np.array([STATE[n] for n in MONITOR_STATES])
     outs = np.concatenate([lon_out, [OUTPUT[n] for n in MONITOR_LATERAL]]).astype(np.int64)
     nx, npar = len(states), len(MONITOR_PARAMS)
@@ -266,4 +282,6 @@ def side_monitor(six, u_ff: np.ndarray, u_lower, u_upper, lon_out: np.ndarray,
         r=c(np.concatenate([spec.r_lon, spec.r_lat])), reset_var=c(spec.reset_var),
         threshold=float(spec.threshold), window=int(spec.window),
         min_window=int(spec.min_window), startup=int(spec.startup), snap=int(spec.snap),
-        turn=lock_turn_table(six, u0, spec.turn_offsets, airframe, spec.turn_measured))
+        turn=lock_turn_table(six, u0, spec.turn_offsets, airframe, spec.turn_measured),
+        nonlinear=int(spec.nonlinear), states=c(states, dtype=np.int64), outs=outs,
+        n_sub=int(spec.substeps))

@@ -3,8 +3,9 @@
 On the 6-DOF plant the paper's scheme keeps its longitudinal filter, which sees
 a locked elevon only through pitch (``docs/airframes.md``).  Beside it, the
 flight computer runs this monitor on the sensors it has: an augmented Kalman
-filter of the 6-DOF linear model with a fault of each actuator, and a windowed
-GLR test per fault direction that names the actuator.  It records its
+filter of the 6-DOF model (linear, or the airframe's equations) with a fault
+of each actuator, and a windowed GLR test per fault direction that names the
+actuator.  It records its
 decisions and estimates, so that a campaign measures how well roll tells left
 from right, and how soon; it keeps the first elevon it names and that
 elevon's position estimate (``LaneState.mside``, ``mpos``), on which a
@@ -35,6 +36,17 @@ deviation from the 6-DOF trim, with their sensors' noise ``R``.  Predict
 measurement in order, ``P`` kept exactly symmetric; then the projection:
 ``b1`` clipped to [0, 1], ``b0`` to the command range about the trim.
 
+**Nonlinear prediction** (``monitor.prediction: nonlinear``, the default on
+the nonlinear plant; an extended Kalman filter with the trim Jacobians, as the
+longitudinal ``prediction: nonlinear``).  The states are predicted by flying
+the airframe's equations over the period from ``x0 + x`` under the commands
+``b0 + (1 - b1)(u + u0)`` (:func:`nonlinear_prediction`; the gust states
+stay linear), and each innovation is ``z_r - h_r(x_pred) - c_r (x - x_pred)``
+with ``h`` the airframe's outputs (:func:`nonlinear_offsets`): the linear
+model misses the propeller's torque, quadratic in the throttle, and the
+moments off the trim airspeed, and reads them as a differential elevon
+(``docs/airframes.md``).  ``F``, ``C`` and the directions stay the trim's.
+
 **Directions.**  A fault of actuator ``j`` starting during step ``k`` moves
 the prediction by ``B_j delta`` (``b0``; a loss moves it along the same
 column).  The sequential updates see it as mean shifts ``m_jr delta`` of the
@@ -60,7 +72,7 @@ position ``b0 + (1 - b1)(u + u0)``, what eq. (2) makes of the command.  Under a
 lock that is the lock position whatever the split between ``b0`` and ``b1``,
 which only a varying command separates.
 
-Plain-NumPy twin: ``tests/naive_sixdof.py::side_monitor_ref``.
+Plain-NumPy twin: ``tests/naive_sixdof.py::SideMonitorRef``.
 """
 
 from __future__ import annotations
@@ -71,6 +83,8 @@ import numpy as np
 
 from ..jit import kernel
 from ..shared.glr import glr_lanes, glr_restart
+from .layout import N_OUTPUT, N_STATE, N_WIND
+from .plant import N_WORK, outputs, propagate
 
 SideMonitor = namedtuple("SideMonitor", [
     "on",         # 1: the monitor runs; 0: off (every array below may be empty)
@@ -92,6 +106,11 @@ SideMonitor = namedtuple("SideMonitor", [
                   # estimate is recorded (TrialRecord.mon_b)
     "turn",       # LockTurnTable: the lock-turn designs a lock_turn design flies once
                   # the monitor names an elevon (core/sixdof/lockturn.py)
+    "nonlinear",  # 1: the airframe's equations predict the states and the measurements
+                  # (flight.plant's p, x0, y0, dt); 0: the linear model A, B, C
+    "states",     # (14,) int64: the 6-DOF state of each of the monitor's (gust states not)
+    "outs",       # (m,) int64: the 6-DOF output of each measurement
+    "n_sub",      # RK4 sub-steps of the nonlinear prediction over one period
 ])
 """Kernel settings of the side monitor (module docstring); built by
 :func:`ftc_mc.sim.monitor.side_monitor`."""
@@ -112,6 +131,73 @@ def lock_position(mon, x, ns, nu, st, work):
         b = st.mside[l]
         if b > 0:
             st.mpos[l] = position(mon, x, ns, nu, b - 1, l, work)
+
+
+@kernel
+def nonlinear_prediction(mon, pl, x, ns, nu, work, xn):
+    """The nonlinear prediction of the states (``monitor.prediction:
+    nonlinear``), written over ``xn`` (ns, L).
+
+    Each lane's state ``x0 + x`` flies one period of the airframe's equations
+    (:func:`~ftc_mc.core.sixdof.plant.propagate`, ``mon.n_sub`` RK4 steps, no
+    wind) under the commands eq. (2) makes of the estimate,
+    ``b0 + (1 - b1)(u + u0)`` (:func:`position`); the gust states and their
+    effect stay linear (``A``'s gust columns and rows, the gust states' ``B``
+    rows are zero).  ``pl`` the
+    :class:`~ftc_mc.core.sixdof.truth.SixDofTruth` (``p``, ``x0``, ``dt``)."""
+    L = x.shape[1]
+    nx = mon.states.shape[0]
+    x6 = np.empty(N_STATE)
+    cmd = np.empty(nu)
+    wd = np.zeros(N_WIND)
+    rk = np.empty((N_WORK, N_STATE))
+    for l in range(L):
+        for i in range(N_STATE):
+            x6[i] = pl.x0[i]
+        for i in range(nx):
+            x6[mon.states[i]] += x[i, l]
+        for a in range(nu):
+            cmd[a] = position(mon, x, ns, nu, a, l, work)
+        propagate(x6, cmd, pl.p, wd, pl.dt, mon.n_sub, rk)
+        for i in range(nx):
+            j = mon.states[i]
+            acc = x6[j] - pl.x0[j]
+            for c in range(nx, ns):
+                acc += mon.A[i, c] * x[c, l]
+            xn[i, l] = acc
+        for i in range(nx, ns):
+            acc = 0.0
+            for c in range(nx, ns):
+                acc += mon.A[i, c] * x[c, l]
+            xn[i, l] = acc
+
+
+@kernel
+def nonlinear_offsets(mon, pl, x, ns):
+    """``h(x) - C x`` (m, L) at each lane's predicted estimate ``x``: the
+    airframe's outputs (:func:`~ftc_mc.core.sixdof.plant.outputs`, no wind)
+    less the trim's, on the measured rows, less their linear model; the gust
+    states' feed-through is linear and cancels."""
+    L = x.shape[1]
+    nx = mon.states.shape[0]
+    m = mon.C.shape[0]
+    x6 = np.empty(N_STATE)
+    wd = np.zeros(N_WIND)
+    y = np.empty(N_OUTPUT)
+    off = np.empty((m, L))
+    for l in range(L):
+        for i in range(N_STATE):
+            x6[i] = pl.x0[i]
+        for i in range(nx):
+            x6[mon.states[i]] += x[i, l]
+        outputs(x6, pl.p, wd, y)
+        for r in range(m):
+            o = mon.outs[r]
+            acc = y[o] - pl.y0[o]
+            for j in range(nx):
+                acc -= mon.C[r, j] * x[j, l]
+            off[r, l] = acc
+    return off
 
 
 @kernel
@@ -165,18 +251,21 @@ def sixdof_monitor(plant, scheme, flight, k, st, work, rec):
         for l in range(L):
             g[a, l] = -(work.u[a, l] + mon.u0[a])
     xn = np.zeros((ns, L))
-    for i in range(ns):
-        for c in range(ns):
-            f = mon.A[i, c]
-            if f != 0.0:
-                for l in range(L):
-                    xn[i, l] += f * x[c, l]
-        for a in range(nu):
-            f = mon.B[i, a]
-            if f != 0.0:
-                for l in range(L):
-                    xn[i, l] += f * (work.u[a, l] - mon.u_ff[a] + x[ns + a, l]
-                                     + g[a, l] * x[ns + nu + a, l])
+    if mon.nonlinear:
+        nonlinear_prediction(mon, flight.plant, x, ns, nu, work, xn)
+    else:
+        for i in range(ns):
+            for c in range(ns):
+                f = mon.A[i, c]
+                if f != 0.0:
+                    for l in range(L):
+                        xn[i, l] += f * x[c, l]
+            for a in range(nu):
+                f = mon.B[i, a]
+                if f != 0.0:
+                    for l in range(L):
+                        xn[i, l] += f * (work.u[a, l] - mon.u_ff[a] + x[ns + a, l]
+                                         + g[a, l] * x[ns + nu + a, l])
     for i in range(ns):
         for l in range(L):
             x[i, l] = xn[i, l]
@@ -235,6 +324,10 @@ def sixdof_monitor(plant, scheme, flight, k, st, work, rec):
     sv = np.empty(L)
     gain = np.empty(L)
     cs = np.empty((nd, L))
+    if mon.nonlinear:  # each row's h(x_pred) - C x_pred; innovation z - h(x_pred) - C (x - x_pred)
+        off = nonlinear_offsets(mon, flight.plant, x, ns)
+    else:
+        off = np.zeros((0, L))
     for r in range(m):
         for i in range(n):
             for l in range(L):
@@ -248,6 +341,9 @@ def sixdof_monitor(plant, scheme, flight, k, st, work, rec):
         for l in range(L):
             sv[l] = mon.r[r]
             gain[l] = work.z[r, l] if r < nz else st.lat[r - nz, l]
+        if mon.nonlinear:
+            for l in range(L):
+                gain[l] -= off[r, l]
         for d in range(nd):
             for l in range(L):
                 cs[d, l] = 0.0
