@@ -268,6 +268,18 @@ def test_nonlinear_prediction_reads_an_engine_unlock_as_the_engine():
     assert named["nonlinear"] == 0 and named["linear"] >= 5, named
 
 
+def test_prediction_auto_follows_the_truth_plant():
+    """``monitor.prediction: auto`` predicts with the linear model on the
+    linear plant and with the airframe's equations on the nonlinear one;
+    ``linear`` and ``nonlinear`` hold on either."""
+    for kind, prediction, want in (("linear", "auto", 0), ("nonlinear", "auto", 1),
+                                   ("nonlinear", "linear", 0), ("linear", "nonlinear", 1)):
+        cfg = monitor_config(kind)
+        cfg["monitor"] = {"prediction": prediction, "substeps": 3}
+        mon = build_setup(api.campaign_config(cfg)).truth.monitor
+        assert (mon.nonlinear, mon.n_sub) == (want, 3), (kind, prediction)
+
+
 def test_monitor_off_and_on_the_longitudinal_plant():
     """``monitor.enabled: false`` leaves the monitor's columns out, and the
     other columns equal to the bit; a longitudinal run has none either."""

@@ -352,7 +352,7 @@ class MonitorConfig(_Strict):
     """RK4 sub-steps per control period of the nonlinear prediction (5 at dt =
     0.1 s: on the X8, from states far off trim, the body rates one period on
     are within 3e-4 rad/s of 100 sub-steps', where 2 leave 4e-2; its roll mode
-    is -38.5 rad/s)."""
+    is -38.5 1/s)."""
     threshold: Pos = 30.0
     """GLR threshold on each actuator's statistic (chi-square, 1 degree of
     freedom, per tested change under no fault)."""

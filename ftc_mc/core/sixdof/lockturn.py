@@ -7,8 +7,8 @@ From that step on the lane flies the lock-turn controller of that side
 healthy elevon about the steady turn closest to the nominal glide that the
 lock allows; the lateral autopilot (wings level, heading hold) is off, and the
 paper's controllers keep running unheard.  The first elevon the monitor names
-is kept: a later decision (the monitor's linear model about wings-level flight
-describes a banked turn less well) does not switch sides.
+is kept: a later decision (the monitor's Jacobians about wings-level flight
+describe a banked turn less well) does not switch sides.
 
 **Schedule.**  The designs form a table over lock positions on a uniform grid
 per side (``LockTurnTable.lo``, ``step``).  Each step, the law is interpolated
