@@ -133,6 +133,16 @@ def lock_position(mon, x, ns, nu, st, work):
             st.mpos[l] = position(mon, x, ns, nu, b - 1, l, work)
 
 
+@kernel(inline="always")
+def absolute_state(mon, pl, x, l, x6):
+    """Lane ``l``'s 6-DOF state ``x0 + x`` (absolute, the cross-track position
+    at trim), written over ``x6`` (15,), from the monitor's estimate ``x``."""
+    for i in range(x6.shape[0]):
+        x6[i] = pl.x0[i]
+    for i in range(mon.states.shape[0]):
+        x6[mon.states[i]] += x[i, l]
+
+
 @kernel
 def nonlinear_prediction(mon, pl, x, ns, nu, work, xn):
     """The nonlinear prediction of the states (``monitor.prediction:
@@ -152,10 +162,7 @@ def nonlinear_prediction(mon, pl, x, ns, nu, work, xn):
     wd = np.zeros(N_WIND)
     rk = np.empty((N_WORK, N_STATE))
     for l in range(L):
-        for i in range(N_STATE):
-            x6[i] = pl.x0[i]
-        for i in range(nx):
-            x6[mon.states[i]] += x[i, l]
+        absolute_state(mon, pl, x, l, x6)
         for a in range(nu):
             cmd[a] = position(mon, x, ns, nu, a, l, work)
         propagate(x6, cmd, pl.p, wd, pl.dt, mon.n_sub, rk)
@@ -186,10 +193,7 @@ def nonlinear_offsets(mon, pl, x, ns):
     y = np.empty(N_OUTPUT)
     off = np.empty((m, L))
     for l in range(L):
-        for i in range(N_STATE):
-            x6[i] = pl.x0[i]
-        for i in range(nx):
-            x6[mon.states[i]] += x[i, l]
+        absolute_state(mon, pl, x, l, x6)
         outputs(x6, pl.p, wd, y)
         for r in range(m):
             o = mon.outs[r]
