@@ -195,26 +195,35 @@ def test_monitor_filter_equals_filterpy(setup):
         np.testing.assert_allclose(st.mP[:, :, l], kf.P, rtol=1e-7, atol=1e-12)
 
 
-def test_direction_projections_are_standard_normal_without_fault(setup):
+def test_direction_projections_are_standard_normal_without_fault(setup, request):
     """On data from the monitor's own model with no fault, each direction's
     projection (the GLR's input, read from the window ``mbuf``) is standard
     normal: over 8 lanes x 150 steps x 3 directions its mean lies within 4
     standard errors of 0 and its mean square inside the chi-square (1 degree
-    of freedom) 99.99 % interval."""
+    of freedom) 99.99 % interval.  With gust states and the nonlinear prediction
+    it fails (35 steps, expected: a known limit, below)."""
     from scipy.stats import chi2
 
     mon = setup.truth.monitor._replace(threshold=np.inf, startup=0)
+    n_steps, transient = 150, 20
     if mon.nonlinear and mon.A.shape[0] > len(MONITOR_STATES):
-        pytest.skip("the open-loop wing flying its equations in moderate gusts leaves the "
-                    "trim's neighbourhood (its Dutch roll is unstable) within the 15 s")
+        # A known limit (docs/airframes.md, scripts/study_monitor_consistency.py):
+        # at the excursions of moderate gusts (bank RMS about 10 deg) the trim
+        # Jacobians misstate the covariance, mean square about 20 on the throttle
+        # direction. Strict, so that a fix shows. 3.5 s: the open-loop wing (its
+        # Dutch roll unstable) leaves the equations' range within the 15 s.
+        request.applymarker(pytest.mark.xfail(
+            strict=True, raises=AssertionError,
+            reason="the trim Jacobians of the nonlinear prediction do not hold at the "
+                   "excursions of moderate gusts"))
+        n_steps, transient = 35, 15
     rng = np.random.default_rng(21)
-    n_steps = 150
     u, z = flown_data(setup, mon, n_steps, rng, [None] * L)
     st, rec = lanes(setup, mon)
     d = []
     for k in range(n_steps):
         run_kernel(setup, mon, st, rec, u, z, k)
-        if k >= 20:  # past the filter's transient from P0
+        if k >= transient:  # past the filter's transient from P0
             d.append(st.mbuf[k % mon.window].copy())
     d = np.array(d)
     assert d.shape[1] == 3
