@@ -38,6 +38,16 @@ until the side monitor names an elevon, then the lock-turn controller of that
 side (``ftc_mc/core/sixdof/lockturn.py``; docs/airframes.md)."""
 
 
+SIXDOF_ROBUST = {**ROBUST_MODERATE, "controller": "lock_turn"}
+"""The 6-DOF design for moderate turbulence: ``robust``'s filter, test and
+thresholds, and the lock-turn controller once the side monitor names an elevon."""
+
+MONITOR_MODERATE = {"design_turbulence": "moderate", "state_noise_scale": 100.0}
+"""The side monitor for the nonlinear 6-DOF plant in moderate turbulence: its
+gust states (``prediction: auto`` then flies the extended filter) and room in its
+process noise for the second-order gust terms (docs/airframes.md)."""
+
+
 SENSOR_AWARE = {"sensor_biases": ["q", "n_x", "n_z"], "settle_s": 3.0, "signature": "swapped"}
 """The sensor-aware design of ``configs/sensor_aware.yaml`` (issue 14): the paper's
 filter and Table 1 (swapped) with the biases of the residuals' sensors; chosen
@@ -130,8 +140,21 @@ def campaign_configs() -> dict:
              "paper's Table 1 (paper, swapped), the robust design and sixdof (the paper's "
              "loop until the side monitor names an elevon, then the lock-turn controller "
              "of the other elevon and the throttle; issue 26) side by side, with the "
-             "lateral autopilot beside the paper's loop; add --turbulence moderate for "
-             "gusts", omit=six)
+             "lateral autopilot beside the paper's loop; in gusts, "
+             "configs/sixdof_moderate.yaml", omit=six)
+    cfg = Config.model_validate({
+        "campaign": {"transitions": list(TRANSITION_TABLE), "signature": "paper",
+                     "designs": ["robust", "sixdof", "sixdof_robust"]},
+        "plant": {"kind": "nonlinear", "dof": 6, "turbulence": "moderate"},
+        "monitor": MONITOR_MODERATE,
+        "designs": {"robust": ROBUST_MODERATE, "sixdof": SIXDOF,
+                    "sixdof_robust": SIXDOF_ROBUST}})
+    files["sixdof_moderate.yaml"] = render_yaml(
+        cfg, "ftc-mc run configs/sixdof_moderate.yaml -- the 6-DOF flying wing in moderate "
+             "turbulence (issue 26): the twelve rows, the paper's design (paper), the robust "
+             "design, sixdof, and sixdof_robust (robust's filter and GLR test until the side "
+             "monitor names an elevon, then the lock-turn controller) on the same trials; "
+             "the side monitor models the gusts (the extended filter)", omit=six)
     cfg = Config.model_validate({
         "campaign": {"transitions": ["elevon_lock", "right_elevon_lock"],
                      "signature": "paper", "designs": ["paper_nominal", "sixdof"]},

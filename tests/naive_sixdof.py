@@ -15,6 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from ftc_mc.core.sixdof.layout import LAYOUT
+from ftc_mc.core.sixdof.monitor import EXTENDED
 
 
 def _named(values, names):
@@ -299,15 +300,18 @@ class SideMonitorRef:
         X = F @ self.X
         X[:ns] += mon.B @ (u - mon.u_ff)
         off = np.zeros(mon.C.shape[0])
-        if mon.nonlinear:
+        Cm = mon.C
+        if mon.nonlinear == EXTENDED:
+            F, X, Cm, off = self._extended(u)
+        elif mon.nonlinear:
             X[:ns], off = self._nonlinear(u)
         P = F @ self.P @ F.T + mon.Q
         S = np.zeros((n, nu))
-        S[:ns] = mon.B
+        S[:ns] = F[:ns, ns:ns + nu]
         num, den = np.zeros(nu), np.zeros(nu)
         for r in range(mon.C.shape[0]):
             c = np.zeros(n)
-            c[:ns] = mon.C[r]
+            c[:ns] = Cm[r]
             s = c @ P @ c + mon.r[r]
             innov = z[r] - c @ X - off[r]
             mu = (c @ S) / np.sqrt(s)
@@ -352,6 +356,51 @@ class SideMonitorRef:
             self.b = np.concatenate([X[ns:], X[ns:ns + nu] + (1 - X[ns + nu:]) * (u + mon.u0)])
 
 
+    def _extended(self, u):
+        """The extended filter's ``F`` (n, n), prediction ``X_pred`` (n,),
+        output Jacobian ``C`` (m, ns) and ``h(X_pred) - C X_pred`` (m,): the
+        equations with the gust states' wind ``mon.wind g`` held over the
+        period, their Jacobians by forward differences of step
+        ``JACOBIAN_STEP`` at the estimate."""
+        from ftc_mc.core.sixdof.monitor import JACOBIAN_STEP as eps
+
+        mon, pl = self.mon, self.plant
+        ns, nu = mon.B.shape
+        nx = len(mon.states)
+        n = ns + 2 * nu
+        X = self.X
+        cmd = X[ns:ns + nu] + (1 - X[ns + nu:]) * (u + mon.u0)
+        wind = mon.wind @ X[nx:ns]
+
+        def fly(xr, c, w):
+            return rk4_ref(_on_trim(pl, mon.states, xr), c, pl.p, w, pl.dt,
+                           mon.n_sub)[mon.states] - pl.x0[mon.states]
+
+        def out(xr, w):
+            return outputs_ref(_on_trim(pl, mon.states, xr), pl.p, w)[mon.outs] - pl.y0[mon.outs]
+
+        def forward(f, x0):
+            f0 = f(x0)
+            return np.stack([(f(x0 + eps * e) - f0) / eps for e in np.eye(x0.size)], axis=1)
+
+        xr = X[:nx]
+        F = np.eye(n)
+        F[:nx, :nx] = forward(lambda v: fly(v, cmd, wind), xr)
+        Bl = forward(lambda c: fly(xr, c, wind), cmd)
+        F[:nx, ns:ns + nu] = Bl
+        F[:nx, ns + nu:] = Bl @ np.diag(-(u + mon.u0))
+        F[:nx, nx:ns] = forward(lambda w: fly(xr, cmd, w), wind) @ mon.wind
+        F[nx:ns, :nx] = 0.0
+        F[nx:ns, nx:ns] = mon.A[nx:, nx:]
+        Xp = X.copy()
+        Xp[:nx] = fly(xr, cmd, wind)
+        Xp[nx:ns] = mon.A[nx:, nx:] @ X[nx:ns]
+        wp = mon.wind @ Xp[nx:ns]
+        C = np.zeros((mon.C.shape[0], ns))
+        C[:, :nx] = forward(lambda v: out(v, wp), Xp[:nx])
+        C[:, nx:] = forward(lambda w: out(Xp[:nx], w), wp) @ mon.wind
+        return F, Xp, C, out(Xp[:nx], wp) - C @ Xp[:ns]
+
     def _nonlinear(self, u):
         """The nonlinear prediction of the monitor's states (ns,) and each
         measurement's ``h(X_pred) - C X_pred`` (m,)."""
@@ -367,34 +416,39 @@ class SideMonitorRef:
         return pred, off
 
 
-def fly_equations(pl, states, x_dev, cmd, n_sub):
-    """One period ``pl.dt`` of the 6-DOF airframe's equations
-    (``ftc_mc.model.sixdof.derivatives``, classical RK4 in ``n_sub`` steps,
-    still air) from the trim ``pl.x0`` plus ``x_dev`` on the rows ``states``,
-    under the absolute commands ``cmd``; returns the deviation on those rows."""
-    from ftc_mc.model.sixdof import derivatives
-
+def _on_trim(pl, states, x_dev):
+    """The absolute 6-DOF state: the trim ``pl.x0`` plus ``x_dev`` on the rows ``states``."""
     x = pl.x0.copy()
     x[states] += x_dev
+    return x
+
+
+def fly_equations(pl, states, x_dev, cmd, n_sub, wind=None):
+    """One period ``pl.dt`` of the 6-DOF airframe's equations
+    (``ftc_mc.model.sixdof.derivatives``, classical RK4 in ``n_sub`` steps,
+    the ``wind`` (6,) held, default still air) from the trim ``pl.x0`` plus
+    ``x_dev`` on the rows ``states``, under the absolute commands ``cmd``;
+    returns the deviation on those rows."""
+    from ftc_mc.model.sixdof import derivatives
+
+    x = _on_trim(pl, states, x_dev)
     h = pl.dt / n_sub
     for _ in range(n_sub):
-        k1 = derivatives(x, cmd, pl.p)
-        k2 = derivatives(x + h / 2 * k1, cmd, pl.p)
-        k3 = derivatives(x + h / 2 * k2, cmd, pl.p)
-        k4 = derivatives(x + h * k3, cmd, pl.p)
+        k1 = derivatives(x, cmd, pl.p, wind)
+        k2 = derivatives(x + h / 2 * k1, cmd, pl.p, wind)
+        k3 = derivatives(x + h / 2 * k2, cmd, pl.p, wind)
+        k4 = derivatives(x + h * k3, cmd, pl.p, wind)
         x = x + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
     return x[states] - pl.x0[states]
 
 
-def equation_outputs(pl, states, outs, x_dev):
+def equation_outputs(pl, states, outs, x_dev, wind=None):
     """The airframe's outputs ``outs`` less the trim's
-    (``ftc_mc.model.sixdof.outputs``, still air) at the trim plus ``x_dev`` on
-    the rows ``states``."""
+    (``ftc_mc.model.sixdof.outputs``, in the ``wind`` (6,), default still air)
+    at the trim plus ``x_dev`` on the rows ``states``."""
     from ftc_mc.model.sixdof import outputs
 
-    x = pl.x0.copy()
-    x[states] += x_dev
-    return outputs(x, pl.p)[outs] - pl.y0[outs]
+    return outputs(_on_trim(pl, states, x_dev), pl.p, wind)[outs] - pl.y0[outs]
 
 
 def lock_turn_law_ref(tab, s, p, xhat, lo_dev, hi_dev):

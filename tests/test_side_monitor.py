@@ -16,7 +16,7 @@ from ftc_mc.core.longitudinal.workspace import new_trial_work
 from ftc_mc.core.shared.paths import SIXDOF_PLANT
 from ftc_mc.core.sixdof.layout import (MONITOR_DIRECTIONS, MONITOR_GUST_STATES, MONITOR_PARAMS,
                                        MONITOR_STATES)
-from ftc_mc.core.sixdof.monitor import sixdof_monitor
+from ftc_mc.core.sixdof.monitor import EXTENDED, sixdof_monitor
 from ftc_mc.core.sixdof.truth import N_LAT
 from ftc_mc.sim.lanes import new_record
 from ftc_mc.sim.setup import build_setup
@@ -35,10 +35,12 @@ def monitor_config(kind="linear", **campaign):
 
 
 @pytest.fixture(scope="module", params=[("none", "linear"), ("moderate", "linear"),
-                                        ("none", "nonlinear"), ("moderate", "nonlinear")])
+                                        ("none", "nonlinear"), ("moderate", "nonlinear"),
+                                        ("none", "extended"), ("moderate", "extended")])
 def setup(request):
     """A 6-DOF setup whose monitor models no gusts, or the moderate Dryden
-    ones; its prediction linear or the airframe's equations."""
+    ones; its prediction linear, the airframe's equations, or the extended
+    filter."""
     turbulence, prediction = request.param
     cfg = monitor_config()
     cfg["monitor"] = {"design_turbulence": turbulence, "prediction": prediction}
@@ -65,7 +67,8 @@ def lanes(setup, mon):
 def flown_data(setup, mon, n_steps, rng, faults):
     """Commands and the 17 measurements of lanes flying the monitor's own
     model with its noise (the linear one, or the airframe's equations when
-    the monitor predicts with them, its gust states linear), each lane's
+    the monitor predicts with them, its gust states linear, or their wind
+    through the equations for the extended filter), each lane's
     actuator ``faults[l]`` (or None) offset by 0.1 rad (throttle 0.1) from the
     switch on."""
     ns, nu = mon.B.shape
@@ -82,7 +85,16 @@ def flown_data(setup, mon, n_steps, rng, faults):
                 if a is not None:
                     d[a, l] = 0.1
         w = psd_sqrt(mon.Q[:ns, :ns]) @ rng.standard_normal((ns, L))
-        if mon.nonlinear:
+        if mon.nonlinear == EXTENDED:
+            xn = mon.A @ x  # the gust rows; the others fly the equations in their wind
+            for l in range(L):
+                xn[:nx, l] = fly_equations(pl, mon.states, x[:nx, l],
+                                           mon.u0 + u[k, :, l] + d[:, l], mon.n_sub,
+                                           mon.wind @ x[nx:, l])
+            x = xn + w
+            y = np.stack([equation_outputs(pl, mon.states, mon.outs, x[:nx, l],
+                                           mon.wind @ x[nx:, l]) for l in range(L)], axis=1)
+        elif mon.nonlinear:
             xn = mon.A @ x  # the gust rows; the others fly the equations
             for l in range(L):
                 xn[:nx, l] = (fly_equations(pl, mon.states, x[:nx, l],
@@ -140,20 +152,24 @@ def test_monitor_matches_its_twin(setup):
     u, z = flown_data(setup, mon, n_steps, rng, faults)
     st, rec = lanes(setup, mon)
     refs = [SideMonitorRef(mon, setup.tim.k_fault, setup.truth) for _ in range(L)]
+    # relative errors in the norm: the order of the sums differs; the extended
+    # filter's forward differences (step 1e-6) turn the rounding of two
+    # implementations of the equations (1e-16) into 1e-10 in its Jacobians,
+    # 1e-7 in the estimate after 2 s of the open-loop wing in gusts
+    tol = 1e-6 if mon.nonlinear == EXTENDED else 1e-10
     for k in range(n_steps):
         run_kernel(setup, mon, st, rec, u, z, k)
         for l, ref in enumerate(refs):
             ref.step(k, u[k, :, l], z[k, :, l], bool(st.alive[l]))
-            # relative errors in the norm: the order of the sums differs
             for got, want, what in ((st.mx[:, l], ref.X, "X"), (st.mP[:, :, l], ref.P, "P")):
                 err = np.linalg.norm(got - want) / np.linalg.norm(want)
-                assert err < 1e-10, f"{what}, step {k}, lane {l}: {err:.1e}"
+                assert err < tol, f"{what}, step {k}, lane {l}: {err:.1e}"
     for l, ref in enumerate(refs):
         assert (rec.side_k[l], rec.side_block[l], rec.side_pre[l], rec.side_n[l]) == (
             ref.side_k, ref.side_block, ref.side_pre, ref.side_n), l
-        np.testing.assert_allclose(rec.mon_b[:, l], ref.b, rtol=1e-9, atol=1e-12)
+        np.testing.assert_allclose(rec.mon_b[:, l], ref.b, rtol=10 * tol, atol=1e-12)
         assert st.mside[l] == ref.side, l
-        np.testing.assert_allclose(st.mpos[l], ref.pos, rtol=1e-9, atol=1e-12)
+        np.testing.assert_allclose(st.mpos[l], ref.pos, rtol=10 * tol, atol=1e-12)
     # the stopped lane recorded nothing; without gusts in the data, the faulted
     # live lanes decided, on their own actuator
     assert rec.side_k[-1] == -1 and not rec.mon_b[:, -1].any()
@@ -200,22 +216,25 @@ def test_direction_projections_are_standard_normal_without_fault(setup, request)
     projection (the GLR's input, read from the window ``mbuf``) is standard
     normal: over 8 lanes x 150 steps x 3 directions its mean lies within 4
     standard errors of 0 and its mean square inside the chi-square (1 degree
-    of freedom) 99.99 % interval.  With gust states and the nonlinear prediction
-    it fails (35 steps, expected: a known limit, below)."""
+    of freedom) 99.99 % interval.  With gust states and the airframe's
+    equations predicting it fails (35 steps, expected: known limits, below)."""
     from scipy.stats import chi2
 
     mon = setup.truth.monitor._replace(threshold=np.inf, startup=0)
     n_steps, transient = 150, 20
     if mon.nonlinear and mon.A.shape[0] > len(MONITOR_STATES):
-        # A known limit (docs/airframes.md, scripts/study_monitor_consistency.py):
+        # Known limits (docs/airframes.md, scripts/study_monitor_consistency.py):
         # at the excursions of moderate gusts (bank RMS about 10 deg) the trim
-        # Jacobians misstate the covariance, mean square about 20 on the throttle
-        # direction. Strict, so that a fix shows. 3.5 s: the open-loop wing (its
-        # Dutch roll unstable) leaves the equations' range within the 15 s.
+        # Jacobians misstate the covariance (mean square about 8 here on the
+        # throttle direction); the extended filter's, taken at each estimate,
+        # still miss the second-order effect of the uncertain gusts' wind (about
+        # 4). Strict, so that a fix shows. 3.5 s: the open-loop wing (its Dutch
+        # roll unstable) leaves the equations' range within the 15 s.
         request.applymarker(pytest.mark.xfail(
             strict=True, raises=AssertionError,
             reason="the trim Jacobians of the nonlinear prediction do not hold at the "
-                   "excursions of moderate gusts"))
+                   "excursions of moderate gusts" if mon.nonlinear != EXTENDED else
+                   "the extended filter's linearisation of the gusts' wind"))
         n_steps, transient = 35, 15
     rng = np.random.default_rng(21)
     u, z = flown_data(setup, mon, n_steps, rng, [None] * L)
@@ -279,14 +298,34 @@ def test_nonlinear_prediction_reads_an_engine_unlock_as_the_engine():
 
 def test_prediction_auto_follows_the_truth_plant():
     """``monitor.prediction: auto`` predicts with the linear model on the
-    linear plant and with the airframe's equations on the nonlinear one;
-    ``linear`` and ``nonlinear`` hold on either."""
-    for kind, prediction, want in (("linear", "auto", 0), ("nonlinear", "auto", 1),
-                                   ("nonlinear", "linear", 0), ("linear", "nonlinear", 1)):
+    linear plant and with the airframe's equations on the nonlinear one, the
+    extended filter when the monitor has gust states; ``linear``,
+    ``nonlinear`` and ``extended`` hold on either."""
+    for kind, prediction, gusts, want in (
+            ("linear", "auto", "none", 0), ("nonlinear", "auto", "none", 1),
+            ("linear", "auto", "moderate", 0), ("nonlinear", "auto", "light", EXTENDED),
+            ("nonlinear", "linear", "moderate", 0), ("linear", "nonlinear", "none", 1),
+            ("nonlinear", "nonlinear", "moderate", 1), ("linear", "extended", "none", EXTENDED)):
         cfg = monitor_config(kind)
-        cfg["monitor"] = {"prediction": prediction, "substeps": 3}
+        cfg["monitor"] = {"prediction": prediction, "substeps": 3, "design_turbulence": gusts}
         mon = build_setup(api.campaign_config(cfg)).truth.monitor
-        assert (mon.nonlinear, mon.n_sub) == (want, 3), (kind, prediction)
+        assert (mon.nonlinear, mon.n_sub) == (want, 3), (kind, prediction, gusts)
+
+
+def test_state_noise_scale_scales_only_the_6dof_states():
+    """``monitor.state_noise_scale`` multiplies ``Q`` and ``P0`` on the 6-DOF
+    states and leaves the gust states' and the fault parameters' alone."""
+    mons = []
+    for scale in (1.0, 100.0):
+        cfg = monitor_config("nonlinear")
+        cfg["monitor"] = {"design_turbulence": "moderate", "state_noise_scale": scale}
+        mons.append(build_setup(api.campaign_config(cfg)).truth.monitor)
+    nx = len(MONITOR_STATES)
+    for a in ("Q", "P0"):
+        one, hundred = getattr(mons[0], a), getattr(mons[1], a)
+        np.testing.assert_array_equal(hundred[:nx, :nx], 100.0 * one[:nx, :nx])
+        np.testing.assert_array_equal(hundred[nx:, nx:], one[nx:, nx:])
+        assert np.diag(one)[:nx].min() > 0.0
 
 
 def test_monitor_off_and_on_the_longitudinal_plant():
@@ -308,7 +347,8 @@ def test_monitor_off_and_on_the_longitudinal_plant():
     ("min_window_s", 3.0, "min_window_s: must not exceed window_s"),
     ("window_s", 1.25, "monitor.window_s: must be a positive multiple of model.dt_s"),
     ("threshold", -1.0, "monitor.threshold"),
-    ("prediction", "extended", "monitor.prediction"),
+    ("prediction", "quadratic", "monitor.prediction"),
+    ("state_noise_scale", 0.5, "monitor.state_noise_scale"),
     ("substeps", 0, "monitor.substeps"),
 ])
 def test_bad_monitor_config_is_one_line(tmp_path, field, value, message):

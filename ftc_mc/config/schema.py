@@ -342,17 +342,29 @@ class MonitorConfig(_Strict):
     """Dryden level the monitor's filter models (``none``: no gust states; else
     the 8 states of the longitudinal and lateral Dryden models at that level,
     as a ``gust_aware`` design adds the longitudinal ones)."""
-    prediction: Literal["auto", "linear", "nonlinear"] = "auto"
+    prediction: Literal["auto", "linear", "nonlinear", "extended"] = "auto"
     """What predicts the monitor's states and measurements: ``linear``, the
     6-DOF linear model at trim; ``nonlinear``, the airframe's equations (an
     extended filter, covariance with the trim Jacobians), which keep the
     propeller's torque and the moments off the trim airspeed that the linear
-    model reads as a differential elevon; ``auto``, the truth plant's kind."""
+    model reads as a differential elevon; ``extended``, the airframe's
+    equations with the gust states' wind flown through them, and the
+    Jacobians taken about each lane's estimate at every step (in turbulence,
+    where the trim's do not hold; several times slower); ``auto``, ``linear``
+    on the linear plant, on the nonlinear one ``nonlinear``, or ``extended``
+    when ``design_turbulence`` gives the monitor gust states."""
     substeps: Annotated[int, NoBool, Field(ge=1, le=100)] = 5
     """RK4 sub-steps per control period of the nonlinear prediction (5 at dt =
     0.1 s: on the X8, from states far off trim, the body rates one period on
     are within 3e-4 rad/s of 100 sub-steps', where 2 leave 4e-2; its roll mode
     is -38.5 1/s)."""
+    state_noise_scale: Annotated[float, NoBool, Field(ge=1.0, le=1e6, allow_inf_nan=False)] = 1.0
+    """Multiplies the process noise variance of the monitor's 6-DOF states
+    (``estimator.sigma_qx^2 dt``; not the gust states' or the fault
+    parameters'): room for what its model leaves out, such as the extended
+    filter's second-order gust terms.  In moderate turbulence on the
+    nonlinear plant, 100 cuts its false decisions from about 1,300 to about 6
+    per hour (docs/airframes.md)."""
     threshold: Pos = 30.0
     """GLR threshold on each actuator's statistic (chi-square, 1 degree of
     freedom, per tested change under no fault)."""

@@ -19,8 +19,11 @@ airframe's equations predict); its noise follows the paper's filter:
 * reset variances: the paper's per block (section 3.2.2), the elevon block's
   ``b0`` variance for each elevon's ``b0``;
 * prediction (``monitor.prediction``): the linear model, or the airframe's
-  equations with ``monitor.substeps`` RK4 steps per period (``auto``: the
-  truth plant's kind).
+  equations with ``monitor.substeps`` RK4 steps per period, or those equations
+  with the gust states' wind and Jacobians per lane (``extended``; ``wind``
+  maps the gust states to the wind); ``auto``: the linear model on the linear
+  plant, on the nonlinear one the equations, extended with gust states;
+* ``monitor.state_noise_scale`` multiplies ``Q`` (and so ``P0``) on the 6-DOF states.
 
 Imported only on the 6-DOF path (by :func:`ftc_mc.sim.truth.sixdof_truth_plant`).
 """
@@ -37,7 +40,7 @@ from ..core.sixdof.layout import (COMMAND, LAYOUT, MONITOR_DIRECTIONS, MONITOR_G
                                   MONITOR_LATERAL, MONITOR_PARAMS, MONITOR_STATES, OUTPUT,
                                   STATE, WIND)
 from ..core.sixdof.lockturn import LockTurnTable
-from ..core.sixdof.monitor import SideMonitor
+from ..core.sixdof.monitor import EXTENDED, SideMonitor
 
 
 MEASURED = LONGITUDINAL.outputs + MONITOR_LATERAL
@@ -78,6 +81,10 @@ class MonitorSpec:
         against the truth plant's kind).
     substeps : int
         RK4 sub-steps of that prediction per period.
+    extended : bool
+        ``monitor.prediction: extended`` (``nonlinear`` is then True too).
+    state_noise_scale : float
+        Multiplies the process noise variance ``q_x`` of the 6-DOF states.
     """
 
     threshold: float
@@ -96,6 +103,8 @@ class MonitorSpec:
     turn_measured: bool = True
     nonlinear: bool = False
     substeps: int = 5
+    extended: bool = False
+    state_noise_scale: float = 1.0
 
 
 def monitor_spec(cfg, fm, det, lock_turn: bool = False) -> MonitorSpec | None:
@@ -132,16 +141,21 @@ def monitor_spec(cfg, fm, det, lock_turn: bool = False) -> MonitorSpec | None:
         design_turbulence=mc.design_turbulence, altitude_m=float(cfg.plant.altitude_m),
         turn_offsets=tuple(np.radians(mc.turn_offsets())) if lock_turn else (),
         turn_measured=mc.turn_feedback == "measured",
-        nonlinear=(mc.prediction == "nonlinear" or
+        nonlinear=(mc.prediction in ("nonlinear", "extended") or
                    (mc.prediction == "auto" and cfg.plant.kind == "nonlinear")),
-        substeps=int(mc.substeps))
+        substeps=int(mc.substeps),
+        extended=(mc.prediction == "extended" or
+                  (mc.prediction == "auto" and cfg.plant.kind == "nonlinear"
+                   and mc.design_turbulence != "none")),
+        state_noise_scale=float(mc.state_noise_scale))
 
 
 def gust_block(six, spec: MonitorSpec, span: float):
-    """The gust states of a gust-aware monitor: ``(G, Dg, Ad, Qg, Pg)`` with
+    """The gust states of a gust-aware monitor: ``(G, Dg, Ad, Qg, Pg, W)`` with
     ``G = B_w C_d`` (15, 8) their effect on the 6-DOF states, ``Dg = D_w C_d``
     (19, 8) on the outputs, their transition ``Ad`` and noise ``Qg = B_d B_d^T``
-    (8, 8) and stationary covariance ``Pg``; the longitudinal Dryden model's
+    (8, 8), stationary covariance ``Pg`` and wind ``W = C_d`` (6, 8, rows in
+    the order of ``layout.LAYOUT.wind``); the longitudinal Dryden model's
     four states first (``u_g, w_g, q_g``), then the lateral one's
     (``v_g, p_g, r_g``), at ``spec.design_turbulence``."""
     from scipy.linalg import block_diag
@@ -153,10 +167,13 @@ def gust_block(six, spec: MonitorSpec, span: float):
     lat = dryden_lateral_model(spec.design_turbulence, V=V, altitude_m=spec.altitude_m,
                                dt=six.dt, span=span)
     cols = [WIND[n] for n in ("u_g", "w_g", "q_g")], [WIND[n] for n in ("v_g", "p_g", "r_g")]
+    W = np.zeros((len(WIND), lon.Cd.shape[1] + lat.Cd.shape[1]))
+    W[cols[0], :lon.Cd.shape[1]] = lon.Cd
+    W[cols[1], lon.Cd.shape[1]:] = lat.Cd
     G = np.hstack([six.Bw[:, cols[0]] @ lon.Cd, six.Bw[:, cols[1]] @ lat.Cd])
     Dg = np.hstack([six.Dw[:, cols[0]] @ lon.Cd, six.Dw[:, cols[1]] @ lat.Cd])
     return (G, Dg, block_diag(lon.Ad, lat.Ad), block_diag(lon.Bd @ lon.Bd.T, lat.Bd @ lat.Bd.T),
-            block_diag(lon.P0, lat.P0))
+            block_diag(lon.P0, lat.P0), W)
 
 
 def lock_turn_table(six, u0: np.ndarray, offsets=(), airframe=None,
@@ -246,18 +263,19 @@ def side_monitor(six, u_ff: np.ndarray, u_lower, u_upper, lon_out: np.ndarray,
                            reset_var=z(2 * nu), threshold=np.inf, window=1, min_window=1,
                            startup=0, snap=0, turn=lock_turn_table(six, six.u0 - u_ff),
                            nonlinear=0, states=z(0, dtype=np.int64),
-                           outs=z(0, dtype=np.int64), n_sub=1)
+                           outs=z(0, dtype=np.int64), n_sub=1, wind=z((len(WIND), 0)))
     states = np.array([STATE[n] for n in MONITOR_STATES])
     outs = np.concatenate([lon_out, [OUTPUT[n] for n in MONITOR_LATERAL]]).astype(np.int64)
     nx, npar = len(states), len(MONITOR_PARAMS)
     A = six.A[np.ix_(states, states)]
     B = six.B[states]
     C = six.C[np.ix_(outs, states)]
-    q = np.concatenate([np.full(nx, spec.q_x), np.full(npar, spec.q_b)])
+    q = np.concatenate([np.full(nx, spec.q_x * spec.state_noise_scale), np.full(npar, spec.q_b)])
+    W = np.zeros((len(WIND), 0))
     P0 = np.diag(np.concatenate([10.0 * q[:nx], spec.reset_var]))
     Q = np.diag(q)
     if spec.design_turbulence != "none":  # the gust states after the 6-DOF ones
-        G, Dg, Ad, Qg, Pg = gust_block(six, spec, span)
+        G, Dg, Ad, Qg, Pg, W = gust_block(six, spec, span)
         ng = len(MONITOR_GUST_STATES)
         assert G.shape[1] == ng
         A = np.block([[A, G[states]], [np.zeros((ng, nx)), Ad]])
@@ -283,5 +301,5 @@ def side_monitor(six, u_ff: np.ndarray, u_lower, u_upper, lon_out: np.ndarray,
         threshold=float(spec.threshold), window=int(spec.window),
         min_window=int(spec.min_window), startup=int(spec.startup), snap=int(spec.snap),
         turn=lock_turn_table(six, u0, spec.turn_offsets, airframe, spec.turn_measured),
-        nonlinear=int(spec.nonlinear), states=c(states, dtype=np.int64), outs=outs,
-        n_sub=int(spec.substeps))
+        nonlinear=EXTENDED if spec.extended else int(spec.nonlinear),
+        states=c(states, dtype=np.int64), outs=outs, n_sub=int(spec.substeps), wind=c(W))

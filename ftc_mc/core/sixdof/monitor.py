@@ -37,7 +37,7 @@ measurement in order, ``P`` kept exactly symmetric; then the projection:
 ``b1`` clipped to [0, 1], ``b0`` to the command range about the trim.
 
 **Nonlinear prediction** (``monitor.prediction: nonlinear``, the default on
-the nonlinear plant; an extended Kalman filter with the trim Jacobians, as the
+the nonlinear plant without gust states; an extended Kalman filter with the trim Jacobians, as the
 longitudinal ``prediction: nonlinear``).  The states are predicted by flying
 the airframe's equations over the period from ``x0 + x`` under the commands
 ``b0 + (1 - b1)(u + u0)`` (:func:`nonlinear_prediction`; the gust states
@@ -46,6 +46,16 @@ with ``h`` the airframe's outputs (:func:`nonlinear_offsets`): the linear
 model misses the propeller's torque, quadratic in the throttle, and the
 moments off the trim airspeed, and reads them as a differential elevon
 (``docs/airframes.md``).  ``F``, ``C`` and the directions stay the trim's.
+
+**Extended filter** (``monitor.prediction: extended``, the default on the
+nonlinear plant with gust states; :func:`extended_filter`).  As the nonlinear
+prediction, but the gust states' wind ``mon.wind g`` is flown through the
+equations and the outputs, as the truth flies its gusts, and ``F``, ``C``
+and the directions are the Jacobians at each lane's estimate, taken anew at
+every step by forward differences.  In moderate turbulence the trim's do not
+hold at the excursions the gusts cause (bank RMS about 10 deg): on its own
+model's data the nonlinear prediction's throttle projection has about 20
+times its variance (``scripts/study_monitor_consistency.py``).
 
 **Directions.**  A fault of actuator ``j`` starting during step ``k`` moves
 the prediction by ``B_j delta`` (``b0``; a loss moves it along the same
@@ -107,13 +117,23 @@ SideMonitor = namedtuple("SideMonitor", [
     "turn",       # LockTurnTable: the lock-turn designs a lock_turn design flies once
                   # the monitor names an elevon (core/sixdof/lockturn.py)
     "nonlinear",  # 1: the airframe's equations predict the states and the measurements
-                  # (flight.plant's p, x0, y0, dt); 0: the linear model A, B, C
+                  # (flight.plant's p, x0, y0, dt); 0: the linear model A, B, C;
+                  # EXTENDED: the equations with the gusts' wind, Jacobians per lane
     "states",     # (14,) int64: the 6-DOF state of each of the monitor's (gust states not)
     "outs",       # (m,) int64: the 6-DOF output of each measurement
     "n_sub",      # RK4 sub-steps of the nonlinear prediction over one period
+    "wind",       # (6, ng) the wind [u_g, v_g, w_g, p_g, q_g, r_g] of the gust states
+                  # (C_d of both Dryden models, by name; ng = 0 without them)
 ])
 """Kernel settings of the side monitor (module docstring); built by
 :func:`ftc_mc.sim.monitor.side_monitor`."""
+
+EXTENDED = 2
+"""``SideMonitor.nonlinear`` of the extended filter (``monitor.prediction: extended``)."""
+
+JACOBIAN_STEP = 1e-6
+"""Forward-difference step of the extended filter's Jacobians (states in their
+units: m, rad, m/s, rad/s; commands; wind in m/s and rad/s)."""
 
 
 @kernel(inline="always")
@@ -204,6 +224,230 @@ def nonlinear_offsets(mon, pl, x, ns):
     return off
 
 
+@kernel(inline="always")
+def gust_wind(mon, x, nx, wd):
+    """The wind (6,) of the gust states ``x[nx:nx + ng]`` of one lane's estimate, over ``wd``."""
+    for i in range(wd.shape[0]):
+        acc = 0.0
+        for j in range(mon.wind.shape[1]):
+            acc += mon.wind[i, j] * x[nx + j]
+        wd[i] = acc
+
+
+@kernel
+def extended_filter(mon, pl, x, P, work, st, num, den):
+    """Predict and update every lane with the extended filter
+    (``monitor.prediction: extended``), one lane at a time, dense; writes the
+    direction sums ``num``, ``den`` (3, L) as the other predictions do.
+
+    Each lane's state ``x0 + x`` flies the airframe's equations over the
+    period (:func:`~ftc_mc.core.sixdof.plant.propagate`, ``mon.n_sub`` RK4
+    steps) under the commands ``b0 + (1 - b1)(u + u0)`` and the wind of its
+    gust states (``mon.wind``), held over the period; the gust states follow
+    their Dryden models (``A``'s gust block).  The Jacobians of that map with
+    respect to the states, the commands and the wind, and those of the
+    outputs (:func:`~ftc_mc.core.sixdof.plant.outputs`, at the predicted
+    state and wind) with respect to the states and the wind, are taken at the
+    lane's estimate by forward differences of step :data:`JACOBIAN_STEP`;
+    they replace the trim's ``A``, ``B``, ``C`` in ``F P F^T + Q``, in the
+    gains and in the direction signatures.  Each innovation is
+    ``z_r - h_r(X_pred) - c_r (X - X_pred)``.
+    """
+    L = x.shape[1]
+    n = x.shape[0]
+    ns = mon.A.shape[0]
+    nu = mon.B.shape[1]
+    nx = mon.states.shape[0]
+    ng = ns - nx
+    m = mon.C.shape[0]
+    nz = work.z.shape[0]
+    nw = mon.wind.shape[0]
+    eps = JACOBIAN_STEP
+    x6 = np.empty(N_STATE)
+    xb = np.empty(N_STATE)
+    f0 = np.empty(N_STATE)
+    cmd = np.empty(nu)
+    cb = np.empty(nu)
+    wd = np.zeros(N_WIND)
+    wb = np.zeros(N_WIND)
+    y0 = np.empty(N_OUTPUT)
+    yb = np.empty(N_OUTPUT)
+    rk = np.empty((N_WORK, N_STATE))
+    xl = np.empty(n)
+    xp = np.empty(n)
+    F = np.zeros((n, n))
+    C = np.zeros((m, ns))
+    Jw = np.empty((nx, N_WIND))
+    Hw = np.empty((m, N_WIND))
+    FP = np.empty((n, n))
+    Pl = np.empty((n, n))
+    pc = np.empty(n)
+    sig = np.empty((nu, n))
+    cs = np.empty(nu)
+    hp = np.empty(m)
+    for l in range(L):
+        for i in range(n):
+            xl[i] = x[i, l]
+        for a in range(nu):
+            cmd[a] = xl[ns + a] + (1.0 - xl[ns + nu + a]) * (work.u[a, l] + mon.u0[a])
+        gust_wind(mon, xl, nx, wd)
+        for i in range(N_STATE):
+            x6[i] = pl.x0[i]
+        for i in range(nx):
+            x6[mon.states[i]] += xl[i]
+        # the prediction and its Jacobians in the states, the commands and the wind
+        for i in range(N_STATE):
+            f0[i] = x6[i]
+        propagate(f0, cmd, pl.p, wd, pl.dt, mon.n_sub, rk)
+        for i in range(n):
+            for j in range(n):
+                F[i, j] = 0.0
+        for c in range(nx):
+            for i in range(N_STATE):
+                xb[i] = x6[i]
+            xb[mon.states[c]] += eps
+            propagate(xb, cmd, pl.p, wd, pl.dt, mon.n_sub, rk)
+            for i in range(nx):
+                j = mon.states[i]
+                F[i, c] = (xb[j] - f0[j]) / eps
+        for a in range(nu):
+            for i in range(N_STATE):
+                xb[i] = x6[i]
+            for b in range(nu):
+                cb[b] = cmd[b]
+            cb[a] += eps
+            propagate(xb, cb, pl.p, wd, pl.dt, mon.n_sub, rk)
+            g = -(work.u[a, l] + mon.u0[a])
+            for i in range(nx):
+                j = mon.states[i]
+                d = (xb[j] - f0[j]) / eps
+                F[i, ns + a] = d
+                F[i, ns + nu + a] = d * g
+        if ng > 0:
+            for w in range(nw):
+                for i in range(N_STATE):
+                    xb[i] = x6[i]
+                for b in range(nw):
+                    wb[b] = wd[b]
+                wb[w] += eps
+                propagate(xb, cmd, pl.p, wb, pl.dt, mon.n_sub, rk)
+                for i in range(nx):
+                    j = mon.states[i]
+                    Jw[i, w] = (xb[j] - f0[j]) / eps
+            for i in range(nx):
+                for c in range(ng):
+                    acc = 0.0
+                    for w in range(nw):
+                        acc += Jw[i, w] * mon.wind[w, c]
+                    F[i, nx + c] = acc
+            for i in range(nx, ns):
+                for c in range(nx, ns):
+                    F[i, c] = mon.A[i, c]
+        for i in range(ns, n):
+            F[i, i] = 1.0
+        for i in range(nx):
+            xp[i] = f0[mon.states[i]] - pl.x0[mon.states[i]]
+        for i in range(nx, ns):
+            acc = 0.0
+            for c in range(nx, ns):
+                acc += mon.A[i, c] * xl[c]
+            xp[i] = acc
+        for i in range(ns, n):
+            xp[i] = xl[i]
+        # P = F P F^T + Q
+        for i in range(n):
+            for j in range(n):
+                Pl[i, j] = P[i, j, l]
+        for i in range(n):
+            for j in range(n):
+                acc = 0.0
+                for c in range(n):
+                    f = F[i, c]
+                    if f != 0.0:
+                        acc += f * Pl[c, j]
+                FP[i, j] = acc
+        for i in range(n):
+            for j in range(i, n):
+                acc = mon.Q[i, j]
+                for c in range(n):
+                    f = F[j, c]
+                    if f != 0.0:
+                        acc += FP[i, c] * f
+                Pl[i, j] = acc
+                Pl[j, i] = acc
+        # the outputs at the prediction and their Jacobians in the states and the wind
+        for i in range(N_STATE):
+            x6[i] = pl.x0[i]
+        for i in range(nx):
+            x6[mon.states[i]] += xp[i]
+        gust_wind(mon, xp, nx, wd)
+        outputs(x6, pl.p, wd, y0)
+        for r in range(m):
+            hp[r] = y0[mon.outs[r]] - pl.y0[mon.outs[r]]
+        for c in range(nx):
+            for i in range(N_STATE):
+                xb[i] = x6[i]
+            xb[mon.states[c]] += eps
+            outputs(xb, pl.p, wd, yb)
+            for r in range(m):
+                C[r, c] = (yb[mon.outs[r]] - y0[mon.outs[r]]) / eps
+        if ng > 0:
+            for w in range(nw):
+                for b in range(nw):
+                    wb[b] = wd[b]
+                wb[w] += eps
+                outputs(x6, pl.p, wb, yb)
+                for r in range(m):
+                    Hw[r, w] = (yb[mon.outs[r]] - y0[mon.outs[r]]) / eps
+            for r in range(m):
+                for c in range(ng):
+                    acc = 0.0
+                    for w in range(nw):
+                        acc += Hw[r, w] * mon.wind[w, c]
+                    C[r, nx + c] = acc
+        # sequential scalar updates, the direction signatures carried beside
+        for d in range(nu):
+            for i in range(n):
+                sig[d, i] = F[i, ns + d] if i < ns else 0.0
+        for i in range(n):
+            xl[i] = xp[i]
+        for r in range(m):
+            sv = mon.r[r]
+            nu_r = (work.z[r, l] if r < nz else st.lat[r - nz, l]) - hp[r]
+            for i in range(n):
+                acc = 0.0
+                for j in range(ns):
+                    acc += C[r, j] * Pl[i, j]
+                pc[i] = acc
+            for j in range(ns):
+                sv += C[r, j] * pc[j]
+                nu_r -= C[r, j] * (xl[j] - xp[j])
+            rs = 1.0 / np.sqrt(sv)
+            for d in range(nu):
+                acc = 0.0
+                for j in range(ns):
+                    acc += C[r, j] * sig[d, j]
+                mu = acc * rs
+                num[d, l] += mu * nu_r * rs
+                den[d, l] += mu * mu
+                cs[d] = acc / sv
+            for d in range(nu):
+                for i in range(n):
+                    sig[d, i] -= pc[i] * cs[d]
+            gk = nu_r / sv
+            for i in range(n):
+                xl[i] += pc[i] * gk
+            for i in range(n):
+                for j in range(i, n):
+                    v = Pl[i, j] - pc[i] * pc[j] / sv
+                    Pl[i, j] = v
+                    Pl[j, i] = v
+        for i in range(n):
+            x[i, l] = xl[i]
+            for j in range(n):
+                P[i, j, l] = Pl[i, j]
+
+
 @kernel
 def sixdof_monitor(plant, scheme, flight, k, st, work, rec):
     """Advance the side monitor of every lane over step ``k -> k+1``.
@@ -248,141 +492,145 @@ def sixdof_monitor(plant, scheme, flight, k, st, work, rec):
                 x[i, l] = 0.0
                 for j in range(n):
                     P[i, j, l] = mon.P0[i, j]
-    # predict (eq. 5): X = F X + [B (u - u_ff); 0], F = [[A, B, B G], [0, I, 0], [0, 0, I]]
-    # with G = diag(g), g = -(u + u0) per lane; every loop runs over the lanes innermost
-    g = np.empty((nu, L))
-    for a in range(nu):
-        for l in range(L):
-            g[a, l] = -(work.u[a, l] + mon.u0[a])
-    xn = np.zeros((ns, L))
-    if mon.nonlinear:
-        nonlinear_prediction(mon, flight.plant, x, ns, nu, work, xn)
+    num = np.zeros((nd, L))
+    den = np.zeros((nd, L))
+    if mon.nonlinear == EXTENDED:
+        extended_filter(mon, flight.plant, x, P, work, st, num, den)
     else:
+        # predict (eq. 5): X = F X + [B (u - u_ff); 0], F = [[A, B, B G], [0, I, 0], [0, 0, I]]
+        # with G = diag(g), g = -(u + u0) per lane; every loop runs over the lanes innermost
+        g = np.empty((nu, L))
+        for a in range(nu):
+            for l in range(L):
+                g[a, l] = -(work.u[a, l] + mon.u0[a])
+        xn = np.zeros((ns, L))
+        if mon.nonlinear:
+            nonlinear_prediction(mon, flight.plant, x, ns, nu, work, xn)
+        else:
+            for i in range(ns):
+                for c in range(ns):
+                    f = mon.A[i, c]
+                    if f != 0.0:
+                        for l in range(L):
+                            xn[i, l] += f * x[c, l]
+                for a in range(nu):
+                    f = mon.B[i, a]
+                    if f != 0.0:
+                        for l in range(L):
+                            xn[i, l] += f * (work.u[a, l] - mon.u_ff[a] + x[ns + a, l]
+                                             + g[a, l] * x[ns + nu + a, l])
+        for i in range(ns):
+            for l in range(L):
+                x[i, l] = xn[i, l]
+        T = np.zeros((ns, n, L))  # the rows of F P that differ from P's
         for i in range(ns):
             for c in range(ns):
                 f = mon.A[i, c]
                 if f != 0.0:
-                    for l in range(L):
-                        xn[i, l] += f * x[c, l]
+                    for j in range(n):
+                        for l in range(L):
+                            T[i, j, l] += f * P[c, j, l]
             for a in range(nu):
                 f = mon.B[i, a]
                 if f != 0.0:
-                    for l in range(L):
-                        xn[i, l] += f * (work.u[a, l] - mon.u_ff[a] + x[ns + a, l]
-                                         + g[a, l] * x[ns + nu + a, l])
-    for i in range(ns):
-        for l in range(L):
-            x[i, l] = xn[i, l]
-    T = np.zeros((ns, n, L))  # the rows of F P that differ from P's
-    for i in range(ns):
-        for c in range(ns):
-            f = mon.A[i, c]
-            if f != 0.0:
-                for j in range(n):
-                    for l in range(L):
-                        T[i, j, l] += f * P[c, j, l]
-        for a in range(nu):
-            f = mon.B[i, a]
-            if f != 0.0:
-                for j in range(n):
-                    for l in range(L):
-                        T[i, j, l] += f * (P[ns + a, j, l] + g[a, l] * P[ns + nu + a, j, l])
-    acc = np.empty(L)
-    for i in range(n):
-        for j in range(i, n):
-            if j < ns:  # (F P F^T)[i, j] = sum_c (F P)[i, c] F[j, c]
-                for l in range(L):
-                    acc[l] = 0.0
-                for c in range(ns):
-                    f = mon.A[j, c]
-                    if f != 0.0:  # i <= j < ns: T holds row i
+                    for j in range(n):
                         for l in range(L):
-                            acc[l] += f * T[i, c, l]
-                for a in range(nu):
-                    f = mon.B[j, a]
-                    if f != 0.0:
-                        for l in range(L):
-                            acc[l] += f * (T[i, ns + a, l] + g[a, l] * T[i, ns + nu + a, l])
-            elif i < ns:
-                for l in range(L):
-                    acc[l] = T[i, j, l]
-            else:
-                for l in range(L):
-                    acc[l] = P[i, j, l]
-            q = mon.Q[i, j]
-            for l in range(L):
-                P[i, j, l] = acc[l] + q  # the lower triangle is copied below
-    for i in range(n):
-        for j in range(i + 1, n):
-            for l in range(L):
-                P[j, i, l] = P[i, j, l]
-    # sequential scalar updates (eqs. 6-8), the direction signatures carried beside
-    sig = np.zeros((nd, n, L))
-    for d in range(nd):
-        for i in range(ns):
-            for l in range(L):
-                sig[d, i, l] = mon.B[i, d]
-    num = np.zeros((nd, L))
-    den = np.zeros((nd, L))
-    pc = np.empty((n, L))
-    sv = np.empty(L)
-    gain = np.empty(L)
-    cs = np.empty((nd, L))
-    if mon.nonlinear:  # each row's h(x_pred) - C x_pred; innovation z - h(x_pred) - C (x - x_pred)
-        off = nonlinear_offsets(mon, flight.plant, x, ns)
-    else:
-        off = np.zeros((0, L))
-    for r in range(m):
-        for i in range(n):
-            for l in range(L):
-                pc[i, l] = 0.0
-        for j in range(ns):
-            c = mon.C[r, j]
-            if c != 0.0:
-                for i in range(n):
-                    for l in range(L):
-                        pc[i, l] += c * P[i, j, l]
-        for l in range(L):
-            sv[l] = mon.r[r]
-            gain[l] = work.z[r, l] if r < nz else st.lat[r - nz, l]
-        if mon.nonlinear:
-            for l in range(L):
-                gain[l] -= off[r, l]
-        for d in range(nd):
-            for l in range(L):
-                cs[d, l] = 0.0
-        for j in range(ns):
-            c = mon.C[r, j]
-            if c != 0.0:
-                for l in range(L):
-                    sv[l] += c * pc[j, l]
-                    gain[l] -= c * x[j, l]
-                for d in range(nd):
-                    for l in range(L):
-                        cs[d, l] += c * sig[d, j, l]
-        # gain: the innovation nu_r, then nu_r / S
-        for d in range(nd):
-            for l in range(L):
-                rs = 1.0 / np.sqrt(sv[l])
-                mu = cs[d, l] * rs
-                num[d, l] += mu * gain[l] * rs
-                den[d, l] += mu * mu
-                cs[d, l] /= sv[l]
-        for l in range(L):
-            gain[l] /= sv[l]
-        for d in range(nd):
-            for i in range(n):
-                for l in range(L):
-                    sig[d, i, l] -= pc[i, l] * cs[d, l]
-        for i in range(n):
-            for l in range(L):
-                x[i, l] += pc[i, l] * gain[l]
+                            T[i, j, l] += f * (P[ns + a, j, l] + g[a, l] * P[ns + nu + a, j, l])
+        acc = np.empty(L)
         for i in range(n):
             for j in range(i, n):
+                if j < ns:  # (F P F^T)[i, j] = sum_c (F P)[i, c] F[j, c]
+                    for l in range(L):
+                        acc[l] = 0.0
+                    for c in range(ns):
+                        f = mon.A[j, c]
+                        if f != 0.0:  # i <= j < ns: T holds row i
+                            for l in range(L):
+                                acc[l] += f * T[i, c, l]
+                    for a in range(nu):
+                        f = mon.B[j, a]
+                        if f != 0.0:
+                            for l in range(L):
+                                acc[l] += f * (T[i, ns + a, l] + g[a, l] * T[i, ns + nu + a, l])
+                elif i < ns:
+                    for l in range(L):
+                        acc[l] = T[i, j, l]
+                else:
+                    for l in range(L):
+                        acc[l] = P[i, j, l]
+                q = mon.Q[i, j]
                 for l in range(L):
-                    v = P[i, j, l] - pc[i, l] * pc[j, l] / sv[l]
-                    P[i, j, l] = v
-                    P[j, i, l] = v
+                    P[i, j, l] = acc[l] + q  # the lower triangle is copied below
+        for i in range(n):
+            for j in range(i + 1, n):
+                for l in range(L):
+                    P[j, i, l] = P[i, j, l]
+        # sequential scalar updates (eqs. 6-8), the direction signatures carried beside
+        sig = np.zeros((nd, n, L))
+        for d in range(nd):
+            for i in range(ns):
+                for l in range(L):
+                    sig[d, i, l] = mon.B[i, d]
+        pc = np.empty((n, L))
+        sv = np.empty(L)
+        gain = np.empty(L)
+        cs = np.empty((nd, L))
+        # each row's h(x_pred) - C x_pred; innovation z - h(x_pred) - C (x - x_pred)
+        if mon.nonlinear:
+            off = nonlinear_offsets(mon, flight.plant, x, ns)
+        else:
+            off = np.zeros((0, L))
+        for r in range(m):
+            for i in range(n):
+                for l in range(L):
+                    pc[i, l] = 0.0
+            for j in range(ns):
+                c = mon.C[r, j]
+                if c != 0.0:
+                    for i in range(n):
+                        for l in range(L):
+                            pc[i, l] += c * P[i, j, l]
+            for l in range(L):
+                sv[l] = mon.r[r]
+                gain[l] = work.z[r, l] if r < nz else st.lat[r - nz, l]
+            if mon.nonlinear:
+                for l in range(L):
+                    gain[l] -= off[r, l]
+            for d in range(nd):
+                for l in range(L):
+                    cs[d, l] = 0.0
+            for j in range(ns):
+                c = mon.C[r, j]
+                if c != 0.0:
+                    for l in range(L):
+                        sv[l] += c * pc[j, l]
+                        gain[l] -= c * x[j, l]
+                    for d in range(nd):
+                        for l in range(L):
+                            cs[d, l] += c * sig[d, j, l]
+            # gain: the innovation nu_r, then nu_r / S
+            for d in range(nd):
+                for l in range(L):
+                    rs = 1.0 / np.sqrt(sv[l])
+                    mu = cs[d, l] * rs
+                    num[d, l] += mu * gain[l] * rs
+                    den[d, l] += mu * mu
+                    cs[d, l] /= sv[l]
+            for l in range(L):
+                gain[l] /= sv[l]
+            for d in range(nd):
+                for i in range(n):
+                    for l in range(L):
+                        sig[d, i, l] -= pc[i, l] * cs[d, l]
+            for i in range(n):
+                for l in range(L):
+                    x[i, l] += pc[i, l] * gain[l]
+            for i in range(n):
+                for j in range(i, n):
+                    for l in range(L):
+                        v = P[i, j, l] - pc[i, l] * pc[j, l] / sv[l]
+                        P[i, j, l] = v
+                        P[j, i, l] = v
     for l in range(L):
         for a in range(nu):
             b0 = x[ns + a, l]
