@@ -27,7 +27,8 @@ Monitors (the filter of the module docstring; only the projections, no test):
 * ``relin``: the Jacobians re-linearised about each lane's estimate at every
   step (central differences of the equations and outputs), gusts linear;
 * ``relin-wind``: re-linearised, and the gust states' wind flown through the
-  equations and the outputs, as the truth does;
+  equations and the outputs, as the truth does (what ``monitor.prediction:
+  extended`` builds, there with forward differences);
 * ``trim-wind``: trim Jacobians, wind through the equations.
 
 Prints one line per combination: the mean square of each direction's
@@ -37,7 +38,10 @@ largest magnitude (``nan``: the filter diverged).
 Usage::
 
     .venv/bin/python scripts/study_monitor_consistency.py [--lanes 7] [--steps 50]
-        [--seeds 2] [--skip 20]
+        [--seeds 2] [--skip 20] [--gust-scale 1] [--state-noise-scale 1]
+
+The figures in docs/airframes.md: ``--steps 35 --skip 15 --seeds 4``, with
+``--gust-scale 0.3`` and ``--state-noise-scale 10`` or ``100`` beside.
 """
 
 from __future__ import annotations
@@ -155,8 +159,9 @@ def jacobian(f, x0, eps=1e-6):
     return J
 
 
-def monitor_projections(model, u, z, variant):
-    """One lane's direction projections (steps, 3) under ``variant``."""
+def monitor_projections(model, u, z, variant, state_noise_scale=1.0):
+    """One lane's direction projections (steps, 3) under ``variant``, the
+    monitor's process noise on the 6-DOF states times ``state_noise_scale``."""
     mon, nx = model.mon, model.nx
     ns, nu = mon.B.shape
     n = ns + 2 * nu
@@ -164,6 +169,8 @@ def monitor_projections(model, u, z, variant):
     wind_through = variant.endswith("wind")
     still = np.zeros(len(LAYOUT.wind))
     X, P = np.zeros(n), mon.P0.copy()
+    Q = mon.Q.copy()
+    Q[:nx, :nx] *= state_noise_scale
     proj = np.zeros((u.shape[0], nu))
     for k in range(u.shape[0]):
         xr, g = X[:nx], X[nx:ns]
@@ -189,7 +196,7 @@ def monitor_projections(model, u, z, variant):
             if wind_through:
                 C[:, nx:] = jacobian(lambda w: model.out(Xp[:nx], w), wind_p) @ model.Cw
         h = model.out(Xp[:nx], wind_p) + (0.0 if wind_through else mon.C[:, nx:] @ Xp[nx:ns])
-        P = F @ P @ F.T + mon.Q
+        P = F @ P @ F.T + Q
         S = np.zeros((n, nu))
         S[:ns] = B
         num, den = np.zeros(nu), np.zeros(nu)
@@ -243,6 +250,9 @@ def main():
     ap.add_argument("--skip", type=int, default=20, help="steps of the filter's transient")
     ap.add_argument("--gust-scale", type=float, default=1.0,
                     help="the data's gust noise against the monitor's (moderate) model")
+    ap.add_argument("--state-noise-scale", type=float, default=1.0,
+                    help="the monitors' process noise variance on the 6-DOF states, "
+                         "times (not the data's)")
     a = ap.parse_args()
     setup, mon = build()
     model = Model(setup, mon)
@@ -268,8 +278,8 @@ def main():
         with np.errstate(all="ignore"):
             for u, z in data[how]:
                 for l in range(a.lanes):
-                    d.append(monitor_projections(model, u[:, :, l], z[:, :, l],
-                                                 variant)[a.skip:])
+                    d.append(monitor_projections(model, u[:, :, l], z[:, :, l], variant,
+                                                 a.state_noise_scale)[a.skip:])
         d = np.concatenate(d)
         ms = (d ** 2).mean(axis=0)
         print(f"data={how:5s} monitor={variant:10s} mean_square="

@@ -302,38 +302,34 @@ def extended_filter(mon, pl, x, P, work, st, num, den):
         for i in range(n):
             for j in range(n):
                 F[i, j] = 0.0
-        for c in range(nx):
-            for i in range(N_STATE):
-                xb[i] = x6[i]
-            xb[mon.states[c]] += eps
-            propagate(xb, cmd, pl.p, wd, pl.dt, mon.n_sub, rk)
-            for i in range(nx):
-                j = mon.states[i]
-                F[i, c] = (xb[j] - f0[j]) / eps
-        for a in range(nu):
+        # one column per state, command and wind component: fly the period
+        # from the estimate with that one perturbed by eps
+        for col in range(nx + nu + (nw if ng > 0 else 0)):
             for i in range(N_STATE):
                 xb[i] = x6[i]
             for b in range(nu):
                 cb[b] = cmd[b]
-            cb[a] += eps
-            propagate(xb, cb, pl.p, wd, pl.dt, mon.n_sub, rk)
-            g = -(work.u[a, l] + mon.u0[a])
+            for b in range(nw):
+                wb[b] = wd[b]
+            if col < nx:
+                xb[mon.states[col]] += eps
+            elif col < nx + nu:
+                cb[col - nx] += eps
+            else:
+                wb[col - nx - nu] += eps
+            propagate(xb, cb, pl.p, wb, pl.dt, mon.n_sub, rk)
             for i in range(nx):
                 j = mon.states[i]
                 d = (xb[j] - f0[j]) / eps
-                F[i, ns + a] = d
-                F[i, ns + nu + a] = d * g
+                if col < nx:
+                    F[i, col] = d
+                elif col < nx + nu:
+                    a = col - nx
+                    F[i, ns + a] = d
+                    F[i, ns + nu + a] = -d * (work.u[a, l] + mon.u0[a])
+                else:
+                    Jw[i, col - nx - nu] = d
         if ng > 0:
-            for w in range(nw):
-                for i in range(N_STATE):
-                    xb[i] = x6[i]
-                for b in range(nw):
-                    wb[b] = wd[b]
-                wb[w] += eps
-                propagate(xb, cmd, pl.p, wb, pl.dt, mon.n_sub, rk)
-                for i in range(nx):
-                    j = mon.states[i]
-                    Jw[i, w] = (xb[j] - f0[j]) / eps
             for i in range(nx):
                 for c in range(ng):
                     acc = 0.0
