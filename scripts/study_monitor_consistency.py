@@ -21,9 +21,9 @@ states driven by their own noise), flown one of two ways:
 
 Monitors (the filter of the module docstring; only the projections, no test):
 
-* ``shipped``: trim Jacobians ``A``, ``B``, ``C`` for the covariance, the gains
-  and the directions, gusts linear (checked equal to the kernel
-  ``sixdof_monitor`` on the first data set);
+* ``nonlinear``: the ``monitor.prediction: nonlinear`` filter: trim Jacobians
+  ``A``, ``B``, ``C`` for the covariance, the gains and the directions, gusts
+  linear (checked equal to the kernel ``sixdof_monitor`` on the first data set);
 * ``relin``: the Jacobians re-linearised about each lane's estimate at every
   step (central differences of the equations and outputs), gusts linear;
 * ``relin-wind``: re-linearised, and the gust states' wind flown through the
@@ -63,7 +63,7 @@ from ftc_mc.model.sixdof import derivatives, outputs
 from ftc_mc.sim.lanes import new_record
 from ftc_mc.sim.setup import build_setup
 
-COMBINATIONS = (("own", "shipped"), ("own", "relin"), ("truth", "shipped"),
+COMBINATIONS = (("own", "nonlinear"), ("own", "relin"), ("truth", "nonlinear"),
                 ("truth", "trim-wind"), ("truth", "relin"), ("truth", "relin-wind"))
 
 
@@ -266,9 +266,9 @@ def main():
               f"{np.sqrt((z[:, 1] ** 2).mean()):.2f} m/s (deviations from trim)")
     u, z = data["own"][0]
     ref = kernel_projections(setup, mon, u, z)
-    mine = np.stack([monitor_projections(model, u[:, :, l], z[:, :, l], "shipped")
+    mine = np.stack([monitor_projections(model, u[:, :, l], z[:, :, l], "nonlinear")
                      for l in range(a.lanes)], axis=-1)
-    print(f"shipped variant against the kernel: max |difference| "
+    print(f"nonlinear variant against the kernel: max |difference| "
           f"{np.abs(mine - ref).max():.2e}")
     print(f"{a.seeds} seeds x {a.lanes} lanes x steps {a.skip}-{a.steps - 1}, "
           "mean square of each direction's projection (throttle, left, right; 1 if consistent)")

@@ -184,7 +184,9 @@ def test_monitor_filter_equals_filterpy(setup):
     against filterpy's ``KalmanFilter`` (batch update: equal to the sequential
     scalar updates for a diagonal ``R``), fault parameters clipped as eq. 6;
     the linear prediction (filterpy's filter is linear)."""
-    mon = setup.truth.monitor._replace(nonlinear=0)
+    if setup.truth.monitor.nonlinear:
+        pytest.skip("the linear filter: the same case as the linear fixtures'")
+    mon = setup.truth.monitor
     rng = np.random.default_rng(8)
     u, z = flown_data(setup, mon, 1, rng, [None] * L)
     z += 0.05 * rng.standard_normal(z.shape)  # innovations that move the fault parameters
@@ -211,6 +213,44 @@ def test_monitor_filter_equals_filterpy(setup):
         np.testing.assert_allclose(st.mP[:, :, l], kf.P, rtol=1e-7, atol=1e-12)
 
 
+def test_extended_jacobians_at_trim_are_the_trim_model():
+    """The extended filter's Jacobians, taken by the kernel at the trim (the
+    estimate's start, commands at the longitudinal trim), against the trim's
+    linear model built by ``model/sixdof.py`` (zero-order hold of the
+    continuous Jacobians, the gusts through ``B_w C_d``): the predicted
+    covariance ``F P0 F^T + Q`` of step 0, read with measurements of no weight,
+    equals the trim's within 1 % in the norm, block by block: the 6-DOF
+    states' rows against themselves, the gust states and the fault
+    parameters (the ``b0`` and ``b1`` columns with ``g = -(u + u0)``)."""
+    cfg = monitor_config("nonlinear")
+    cfg["plant"]["turbulence"] = "moderate"
+    cfg["monitor"] = {"design_turbulence": "moderate"}
+    setup = build_setup(api.campaign_config(cfg))
+    mon = setup.truth.monitor._replace(r=np.full(setup.truth.monitor.r.shape, 1e30),
+                                       startup=10)
+    assert mon.nonlinear == EXTENDED and mon.wind.shape[1] > 0
+    ns, nu = mon.B.shape
+    n = ns + 2 * nu
+    F = np.eye(n)
+    F[:ns, :ns] = mon.A
+    F[:ns, ns:ns + nu] = mon.B
+    F[:ns, ns + nu:] = -mon.B * mon.u0
+    want = F @ mon.P0 @ F.T + mon.Q
+    st, rec = lanes(setup, mon)
+    u = np.zeros((1, nu, L))
+    z = np.zeros((1, mon.C.shape[0], L))
+    run_kernel(setup, mon, st, rec, u, z, 0)
+    nx = len(MONITOR_STATES)
+    rigid = slice(0, nx)
+    for cols in (slice(0, nx), slice(nx, ns), slice(ns, n)):
+        w = want[rigid, cols]
+        # the block moves from P0: a wrong Jacobian block would show
+        assert np.linalg.norm((mon.P0 + mon.Q)[rigid, cols] - w) > 0.1 * np.linalg.norm(w)
+        for l in range(L):
+            err = np.linalg.norm(st.mP[rigid, cols, l] - w) / np.linalg.norm(w)
+            assert err < 1e-2, (cols, l, err)
+
+
 def test_direction_projections_are_standard_normal_without_fault(setup, request):
     """On data from the monitor's own model with no fault, each direction's
     projection (the GLR's input, read from the window ``mbuf``) is standard
@@ -225,11 +265,13 @@ def test_direction_projections_are_standard_normal_without_fault(setup, request)
     if mon.nonlinear and mon.A.shape[0] > len(MONITOR_STATES):
         # Known limits (docs/airframes.md, scripts/study_monitor_consistency.py):
         # at the excursions of moderate gusts (bank RMS about 10 deg) the trim
-        # Jacobians misstate the covariance (mean square about 8 here on the
-        # throttle direction); the extended filter's, taken at each estimate,
-        # still miss the second-order effect of the uncertain gusts' wind (about
-        # 4). Strict, so that a fix shows. 3.5 s: the open-loop wing (its Dutch
-        # roll unstable) leaves the equations' range within the 15 s.
+        # Jacobians misstate the covariance (mean square here about 8 over the
+        # three directions, 16 on the throttle's); the extended filter's, taken
+        # at each estimate, still miss the second-order effect of the uncertain
+        # gusts' wind (about 4, and 10 on the throttle's). Strict, so that a fix
+        # shows; a diverging filter is an error, not this failure. 3.5 s: the
+        # open-loop wing (its Dutch roll unstable) leaves the equations' range
+        # within the 15 s.
         request.applymarker(pytest.mark.xfail(
             strict=True, raises=AssertionError,
             reason="the trim Jacobians of the nonlinear prediction do not hold at the "
@@ -246,6 +288,8 @@ def test_direction_projections_are_standard_normal_without_fault(setup, request)
             d.append(st.mbuf[k % mon.window].copy())
     d = np.array(d)
     assert d.shape[1] == 3
+    if not np.isfinite(d[..., :-1]).all():
+        raise FloatingPointError("the monitor's projections are not finite")
     N = d[..., :-1].size
     assert abs(d.mean()) < 4.0 / np.sqrt(N)
     lo, hi = chi2.ppf([5e-5, 1 - 5e-5], N) / N
@@ -323,7 +367,7 @@ def test_state_noise_scale_scales_only_the_6dof_states():
     nx = len(MONITOR_STATES)
     for a in ("Q", "P0"):
         one, hundred = getattr(mons[0], a), getattr(mons[1], a)
-        np.testing.assert_array_equal(hundred[:nx, :nx], 100.0 * one[:nx, :nx])
+        np.testing.assert_allclose(hundred[:nx, :nx], 100.0 * one[:nx, :nx], rtol=1e-15)
         np.testing.assert_array_equal(hundred[nx:, nx:], one[nx:, nx:])
         assert np.diag(one)[:nx].min() > 0.0
 

@@ -344,8 +344,8 @@ class MonitorConfig(_Strict):
     as a ``gust_aware`` design adds the longitudinal ones)."""
     prediction: Literal["auto", "linear", "nonlinear", "extended"] = "auto"
     """What predicts the monitor's states and measurements: ``linear``, the
-    6-DOF linear model at trim; ``nonlinear``, the airframe's equations (an
-    extended filter, covariance with the trim Jacobians), which keep the
+    6-DOF linear model at trim; ``nonlinear``, the airframe's equations (the
+    covariance, gains and directions with the trim's Jacobians), which keep the
     propeller's torque and the moments off the trim airspeed that the linear
     model reads as a differential elevon; ``extended``, the airframe's
     equations with the gust states' wind flown through them, and the

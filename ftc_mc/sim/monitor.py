@@ -78,11 +78,12 @@ class MonitorSpec:
         The lock-turn law feeds back the measured states (else the estimate).
     nonlinear : bool
         The airframe's equations predict (``monitor.prediction``, resolved
-        against the truth plant's kind).
+        against the truth plant's kind; ``extended`` too).
     substeps : int
         RK4 sub-steps of that prediction per period.
     extended : bool
-        ``monitor.prediction: extended`` (``nonlinear`` is then True too).
+        The extended filter (``monitor.prediction: extended``, or ``auto`` on
+        the nonlinear plant with gust states; ``nonlinear`` is then True too).
     state_noise_scale : float
         Multiplies the process noise variance ``q_x`` of the 6-DOF states.
     """
