@@ -51,10 +51,11 @@ import bench_core  # noqa: E402
 from ftc_mc import api  # noqa: E402
 from ftc_mc.core.longitudinal.trial import new_state  # noqa: E402
 from ftc_mc.core.longitudinal.workspace import new_trial_work  # noqa: E402
-from ftc_mc.core.shared.paths import SIXDOF_PLANT  # noqa: E402
-from ftc_mc.core.sixdof.monitor import sixdof_monitor  # noqa: E402
+from ftc_mc.core.sixdof.monitor import (EXTENDED, sixdof_monitor,  # noqa: E402
+                                        sixdof_monitor_extended)
 from ftc_mc.core.sixdof.truth import N_LAT  # noqa: E402
 from ftc_mc.sim.lanes import new_record  # noqa: E402
+from ftc_mc.sim.paths import path_of  # noqa: E402
 from ftc_mc.sim.setup import build_setup  # noqa: E402
 
 
@@ -84,6 +85,8 @@ def bench_monitor(L, n_steps, prediction="linear"):
     U, Z = monitor_data(mon, n_steps, L)
     work = new_trial_work(L, 14)
     nz = work.z.shape[0]
+    plant = path_of(scheme, flight).plant
+    kernel = sixdof_monitor_extended if mon.nonlinear == EXTENDED else sixdof_monitor
 
     def go(n):
         st = new_state(L, 14, 1, setup.truth.x0.shape[0], N_LAT, 0, mon.P0.shape[0],
@@ -94,7 +97,7 @@ def bench_monitor(L, n_steps, prediction="linear"):
             work.u[:] = U[k]
             work.z[:] = Z[k, :nz]
             st.lat[:Z.shape[1] - nz] = Z[k, nz:]
-            sixdof_monitor(SIXDOF_PLANT, scheme, flight, k, st, work, rec)
+            kernel(plant, scheme, flight, k, st, work, rec)
         return rec
 
     t = time.perf_counter()

@@ -55,12 +55,12 @@ import numpy as np
 from ftc_mc import api
 from ftc_mc.core.longitudinal.trial import new_state
 from ftc_mc.core.longitudinal.workspace import new_trial_work
-from ftc_mc.core.shared.paths import SIXDOF_PLANT
 from ftc_mc.core.sixdof.layout import LAYOUT, MONITOR_STATES
 from ftc_mc.core.sixdof.monitor import sixdof_monitor
 from ftc_mc.core.sixdof.truth import N_LAT
 from ftc_mc.model.sixdof import derivatives, outputs
 from ftc_mc.sim.lanes import new_record
+from ftc_mc.sim.paths import path_of
 from ftc_mc.sim.setup import build_setup
 
 COMBINATIONS = (("own", "nonlinear"), ("own", "relin"), ("truth", "nonlinear"),
@@ -237,7 +237,7 @@ def kernel_projections(setup, mon, u, z):
         work.u[:] = u[k]
         work.z[:] = z[k, :nz]
         st.lat[:z.shape[1] - nz] = z[k, nz:]
-        sixdof_monitor(SIXDOF_PLANT, scheme, flight, k, st, work, rec)
+        sixdof_monitor(path_of(scheme, flight).plant, scheme, flight, k, st, work, rec)
         out[k] = st.mbuf[k % mon.window]
     return out
 

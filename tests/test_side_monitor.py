@@ -13,12 +13,12 @@ from ftc_mc import api
 from ftc_mc.campaign.side import SIDE_COLUMNS, side_markdown, side_table
 from ftc_mc.core.longitudinal.trial import new_state
 from ftc_mc.core.longitudinal.workspace import new_trial_work
-from ftc_mc.core.shared.paths import SIXDOF_PLANT
 from ftc_mc.core.sixdof.layout import (MONITOR_DIRECTIONS, MONITOR_GUST_STATES, MONITOR_PARAMS,
                                        MONITOR_STATES)
-from ftc_mc.core.sixdof.monitor import EXTENDED, sixdof_monitor
+from ftc_mc.core.sixdof.monitor import EXTENDED, sixdof_monitor, sixdof_monitor_extended
 from ftc_mc.core.sixdof.truth import N_LAT
 from ftc_mc.sim.lanes import new_record
+from ftc_mc.sim.paths import path_of
 from ftc_mc.sim.setup import build_setup
 
 from naive_sixdof import SideMonitorRef, equation_outputs, fly_equations
@@ -119,7 +119,8 @@ def run_kernel(setup, mon, st, rec, u, z, k):
     work.u[:] = u[k]
     work.z[:] = z[k, :nz]
     st.lat[:z.shape[1] - nz] = z[k, nz:]
-    sixdof_monitor(SIXDOF_PLANT, scheme, flight, k, st, work, rec)
+    kernel = sixdof_monitor_extended if mon.nonlinear == EXTENDED else sixdof_monitor
+    kernel(path_of(scheme, flight).plant, scheme, flight, k, st, work, rec)
 
 
 def test_layout_names_the_monitor(setup):

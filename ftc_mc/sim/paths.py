@@ -11,7 +11,7 @@ from __future__ import annotations
 from ..conventions import TEST_GLR
 from ..core.shared.paths import (DENSE_FILTER, EXTENDED_FILTER, GLR_TEST, LINEAR_PLANT,
                                  NOMINAL_CONTROL, NONLINEAR_PLANT, ONE_STEP_TEST, PAPER_FILTER,
-                                 RECONFIGURING, SIXDOF_PLANT, Path)
+                                 RECONFIGURING, SIXDOF_EXTENDED_PLANT, SIXDOF_PLANT, Path)
 from ..core.longitudinal.settings import Flight, Scheme
 
 
@@ -24,7 +24,8 @@ def path_of(scheme: Scheme, flight: Flight | None = None) -> Path:
     with the linear model; extended when it predicts with the airframe
     (``FilterModel.nl``); dense otherwise.  The plant is the 6-DOF family's
     for a ``SixDofTruth`` (``kind`` 2 or 3: nonlinear or linear, a run-time
-    choice inside that family's kernel).
+    choice inside that family's kernel), with the extended side monitor its
+    own path (``SIXDOF_EXTENDED_PLANT``).
     """
     fm = scheme.filter
     if fm.nl != 0:
@@ -34,7 +35,13 @@ def path_of(scheme: Scheme, flight: Flight | None = None) -> Path:
     else:
         filt = DENSE_FILTER
     kind = 0 if flight is None else flight.plant.kind
-    plant = (LINEAR_PLANT, NONLINEAR_PLANT)[kind] if kind < 2 else SIXDOF_PLANT
+    if kind < 2:
+        plant = (LINEAR_PLANT, NONLINEAR_PLANT)[kind]
+    else:
+        from ..core.sixdof.monitor import EXTENDED  # the 6-DOF path only
+
+        plant = SIXDOF_EXTENDED_PLANT if flight.plant.monitor.nonlinear == EXTENDED \
+            else SIXDOF_PLANT
     return Path(plant=plant,
                 filter=filt,
                 test=GLR_TEST if scheme.detection.test == TEST_GLR else ONE_STEP_TEST,

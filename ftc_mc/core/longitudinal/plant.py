@@ -33,7 +33,8 @@ from ...conventions import (N_U, N_X, N_Z, OUT_ALPHA, OUT_VA, SENSOR_BIAS, SENSO
 from ..shared.dryden import N_GUST_OUT, N_GUST_STATE, gust_step
 from ..jit import kernel
 from .nonlinear import outputs_nb, propagate
-from ..shared.paths import LINEAR_PLANT, NONLINEAR_PLANT, SIXDOF_PLANT, on_path
+from ..shared.paths import (LINEAR_PLANT, NONLINEAR_PLANT, SIXDOF_EXTENDED_PLANT, SIXDOF_PLANT,
+                            on_path)
 
 
 @kernel
@@ -342,7 +343,9 @@ def longitudinal_truth(plant, scheme, flight, inp, k, st, work, rec):
 
 
 @on_path("plant", {LINEAR_PLANT: longitudinal_truth, NONLINEAR_PLANT: longitudinal_truth,
-                   SIXDOF_PLANT: "ftc_mc.core.sixdof.truth:sixdof_truth"}, passes="marker")
+                   SIXDOF_PLANT: "ftc_mc.core.sixdof.truth:sixdof_truth",
+                   SIXDOF_EXTENDED_PLANT: "ftc_mc.core.sixdof.truth:sixdof_truth"},
+         passes="marker")
 def truth(path, scheme, flight, inp, k, st, work, rec):
     """Stage 2 of the path's plant family: :func:`truth_step` on the
     longitudinal plants, :func:`ftc_mc.core.sixdof.truth.sixdof_truth` on the

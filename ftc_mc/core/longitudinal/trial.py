@@ -43,7 +43,7 @@ from ..shared.dryden import N_GUST_STATE
 from .gustfilter import N_WIND
 from ..jit import kernel
 from .plant import truth
-from ..shared.paths import SIXDOF_PLANT, on_path
+from ..shared.paths import SIXDOF_EXTENDED_PLANT, SIXDOF_PLANT, on_path
 from .settings import LaneState
 from .stages import (check_validity, commands, filter_update, handle_resets,  # noqa: F401
                      is_psd, reconfigure, record_cost, record_end, record_step)
@@ -60,7 +60,9 @@ N_DIRECTIONS = N_U
 (``core/sixdof/layout.MONITOR_DIRECTIONS``)."""
 
 
-@on_path("plant", {SIXDOF_PLANT: "ftc_mc.core.sixdof.monitor:sixdof_monitor"}, passes="marker")
+@on_path("plant", {SIXDOF_PLANT: "ftc_mc.core.sixdof.monitor:sixdof_monitor",
+                   SIXDOF_EXTENDED_PLANT: "ftc_mc.core.sixdof.monitor:sixdof_monitor_extended"},
+         passes="marker")
 def side_monitor(path, scheme, flight, k, st, work, rec):
     """Stage 2b: the 6-DOF side monitor over step ``k -> k+1``
     (:func:`ftc_mc.core.sixdof.monitor.sixdof_monitor`, imported only by a

@@ -18,7 +18,10 @@ The choices:
 * ``plant``: :data:`LINEAR_PLANT` (eq. 1), :data:`NONLINEAR_PLANT` (the
   airframe's equations, RK4) or :data:`SIXDOF_PLANT` (the 6-DOF family's
   truth, :mod:`ftc_mc.core.sixdof.truth`, named by its import path so that a
-  longitudinal path never imports it);
+  longitudinal path never imports it), or :data:`SIXDOF_EXTENDED_PLANT` (the
+  same, its side monitor the extended filter,
+  :func:`ftc_mc.core.sixdof.monitor.sixdof_monitor_extended`, which the other
+  6-DOF path never compiles);
 * ``filter``: :data:`PAPER_FILTER` (the 14-state filter of eqs. 4-11, with
   the block structure of :mod:`ftc_mc.core.longitudinal.batch`), :data:`DENSE_FILTER`
   (the general filter with extra states, :mod:`ftc_mc.core.longitudinal.gustfilter`) or
@@ -69,6 +72,7 @@ def _marker(name: str):
 LinearPlant = _marker("LinearPlant")
 NonlinearPlant = _marker("NonlinearPlant")
 SixdofPlant = _marker("SixdofPlant")
+SixdofExtendedPlant = _marker("SixdofExtendedPlant")
 PaperFilter = _marker("PaperFilter")
 DenseFilter = _marker("DenseFilter")
 ExtendedFilter = _marker("ExtendedFilter")
@@ -78,12 +82,14 @@ NominalControl = _marker("NominalControl")
 Reconfiguring = _marker("Reconfiguring")
 
 LINEAR_PLANT, NONLINEAR_PLANT, SIXDOF_PLANT = LinearPlant(), NonlinearPlant(), SixdofPlant()
+SIXDOF_EXTENDED_PLANT = SixdofExtendedPlant()
 PAPER_FILTER, DENSE_FILTER, EXTENDED_FILTER = PaperFilter(), DenseFilter(), ExtendedFilter()
 ONE_STEP_TEST, GLR_TEST = OneStepTest(), GlrTest()
 NOMINAL_CONTROL, RECONFIGURING = NominalControl(), Reconfiguring()
 
 NAMES = {LinearPlant: "linear plant", NonlinearPlant: "nonlinear plant",
          SixdofPlant: "6-DOF plant",
+         SixdofExtendedPlant: "6-DOF plant with the extended side monitor",
          PaperFilter: "paper filter", DenseFilter: "dense filter",
          ExtendedFilter: "extended filter", OneStepTest: "one-step test",
          GlrTest: "GLR test", NominalControl: "nominal controller",

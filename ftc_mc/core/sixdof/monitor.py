@@ -137,10 +137,10 @@ units: m, rad, m/s, rad/s; commands; wind in m/s and rad/s)."""
 
 
 @kernel(inline="always")
-def position(mon, x, ns, nu, a, l, work):
+def position(mon, x, ns, nu, a, l, u):
     """Lane ``l``'s estimated absolute position of actuator ``a``,
     ``b0 + (1 - b1)(u + u0)``: what eq. (2) makes of the command sent."""
-    return x[ns + a, l] + (1.0 - x[ns + nu + a, l]) * (work.u[a, l] + mon.u0[a])
+    return x[ns + a, l] + (1.0 - x[ns + nu + a, l]) * (u[a, l] + mon.u0[a])
 
 
 @kernel(inline="always")
@@ -150,7 +150,7 @@ def lock_position(mon, x, ns, nu, st, work):
     for l in range(x.shape[1]):
         b = st.mside[l]
         if b > 0:
-            st.mpos[l] = position(mon, x, ns, nu, b - 1, l, work)
+            st.mpos[l] = position(mon, x, ns, nu, b - 1, l, work.u)
 
 
 @kernel(inline="always")
@@ -164,7 +164,7 @@ def absolute_state(mon, pl, x, l, x6):
 
 
 @kernel
-def nonlinear_prediction(mon, pl, x, ns, nu, work, xn):
+def nonlinear_prediction(mon, pl, x, ns, nu, u, xn):
     """The nonlinear prediction of the states (``monitor.prediction:
     nonlinear``), written over ``xn`` (ns, L).
 
@@ -184,7 +184,7 @@ def nonlinear_prediction(mon, pl, x, ns, nu, work, xn):
     for l in range(L):
         absolute_state(mon, pl, x, l, x6)
         for a in range(nu):
-            cmd[a] = position(mon, x, ns, nu, a, l, work)
+            cmd[a] = position(mon, x, ns, nu, a, l, u)
         propagate(x6, cmd, pl.p, wd, pl.dt, mon.n_sub, rk)
         for i in range(nx):
             j = mon.states[i]
@@ -235,7 +235,7 @@ def gust_wind(mon, x, nx, wd):
 
 
 @kernel
-def extended_filter(mon, pl, x, P, work, st, num, den):
+def extended_filter(mon, pl, x, P, u, z, lat, num, den):
     """Predict and update every lane with the extended filter
     (``monitor.prediction: extended``), one lane at a time, dense; writes the
     direction sums ``num``, ``den`` (3, L) as the other predictions do.
@@ -260,7 +260,7 @@ def extended_filter(mon, pl, x, P, work, st, num, den):
     nx = mon.states.shape[0]
     ng = ns - nx
     m = mon.C.shape[0]
-    nz = work.z.shape[0]
+    nz = z.shape[0]
     nw = mon.wind.shape[0]
     eps = JACOBIAN_STEP
     x6 = np.empty(N_STATE)
@@ -289,7 +289,7 @@ def extended_filter(mon, pl, x, P, work, st, num, den):
         for i in range(n):
             xl[i] = x[i, l]
         for a in range(nu):
-            cmd[a] = xl[ns + a] + (1.0 - xl[ns + nu + a]) * (work.u[a, l] + mon.u0[a])
+            cmd[a] = xl[ns + a] + (1.0 - xl[ns + nu + a]) * (u[a, l] + mon.u0[a])
         gust_wind(mon, xl, nx, wd)
         for i in range(N_STATE):
             x6[i] = pl.x0[i]
@@ -326,7 +326,7 @@ def extended_filter(mon, pl, x, P, work, st, num, den):
                 elif col < nx + nu:
                     a = col - nx
                     F[i, ns + a] = d
-                    F[i, ns + nu + a] = -d * (work.u[a, l] + mon.u0[a])
+                    F[i, ns + nu + a] = -d * (u[a, l] + mon.u0[a])
                 else:
                     Jw[i, col - nx - nu] = d
         if ng > 0:
@@ -409,7 +409,7 @@ def extended_filter(mon, pl, x, P, work, st, num, den):
             xl[i] = xp[i]
         for r in range(m):
             sv = mon.r[r]
-            nu_r = (work.z[r, l] if r < nz else st.lat[r - nz, l]) - hp[r]
+            nu_r = (z[r, l] if r < nz else lat[r - nz, l]) - hp[r]
             for i in range(n):
                 acc = 0.0
                 for j in range(ns):
@@ -444,189 +444,183 @@ def extended_filter(mon, pl, x, P, work, st, num, den):
                 P[i, j, l] = Pl[i, j]
 
 
-@kernel
-def sixdof_monitor(plant, scheme, flight, k, st, work, rec):
-    """Advance the side monitor of every lane over step ``k -> k+1``.
-
-    Parameters
-    ----------
-    plant : SixdofPlant
-        The path's plant marker (the dispatcher's calling convention).
-    scheme : Scheme
-        Unused (the stage's calling convention).
-    flight : Flight
-        ``plant.monitor`` (:class:`SideMonitor`), ``timing.k_fault``.
-    k : int
-        Step.
-    st : LaneState
-        ``mx`` (n, L), ``mP`` (n, n, L) (set at step 0: zero and ``P0``),
-        the GLR window ``mbuf`` and ``mcount``, the first elevon named
-        ``mside`` and its position estimate ``mpos``, updated in place; ``lat``
-        the lateral loop's measurements of ``k + 1``.
-    work : TrialWork
-        ``u`` the commands sent over the step, ``z`` the 12 longitudinal
-        measurements of ``k + 1``.
-    rec : TrialRecord
-        ``side_k``, ``side_block``, ``side_pre``, ``side_n`` (on live lanes), ``mon_b``
-        (module docstring).
-    """
-    mon = flight.plant.monitor
-    if mon.on == 0:
-        return
-    x = st.mx
-    P = st.mP
+@kernel(inline="always")
+def trim_filter(mon, pl, x, P, u, z, lat, num, den):
+    """Predict and update every lane with the trim's Jacobians (the linear and
+    the nonlinear predictions), lanes innermost; writes the direction sums
+    ``num``, ``den`` (3, L)."""
     n = x.shape[0]
     L = x.shape[1]
     ns = mon.A.shape[0]
     nu = mon.B.shape[1]
     m = mon.C.shape[0]
-    nz = work.z.shape[0]
+    nz = z.shape[0]
     nd = nu
+    # predict (eq. 5): X = F X + [B (u - u_ff); 0], F = [[A, B, B G], [0, I, 0], [0, 0, I]]
+    # with G = diag(g), g = -(u + u0) per lane; every loop runs over the lanes innermost
+    g = np.empty((nu, L))
+    for a in range(nu):
+        for l in range(L):
+            g[a, l] = -(u[a, l] + mon.u0[a])
+    xn = np.zeros((ns, L))
+    if mon.nonlinear:
+        nonlinear_prediction(mon, pl, x, ns, nu, u, xn)
+    else:
+        for i in range(ns):
+            for c in range(ns):
+                f = mon.A[i, c]
+                if f != 0.0:
+                    for l in range(L):
+                        xn[i, l] += f * x[c, l]
+            for a in range(nu):
+                f = mon.B[i, a]
+                if f != 0.0:
+                    for l in range(L):
+                        xn[i, l] += f * (u[a, l] - mon.u_ff[a] + x[ns + a, l]
+                                         + g[a, l] * x[ns + nu + a, l])
+    for i in range(ns):
+        for l in range(L):
+            x[i, l] = xn[i, l]
+    T = np.zeros((ns, n, L))  # the rows of F P that differ from P's
+    for i in range(ns):
+        for c in range(ns):
+            f = mon.A[i, c]
+            if f != 0.0:
+                for j in range(n):
+                    for l in range(L):
+                        T[i, j, l] += f * P[c, j, l]
+        for a in range(nu):
+            f = mon.B[i, a]
+            if f != 0.0:
+                for j in range(n):
+                    for l in range(L):
+                        T[i, j, l] += f * (P[ns + a, j, l] + g[a, l] * P[ns + nu + a, j, l])
+    acc = np.empty(L)
+    for i in range(n):
+        for j in range(i, n):
+            if j < ns:  # (F P F^T)[i, j] = sum_c (F P)[i, c] F[j, c]
+                for l in range(L):
+                    acc[l] = 0.0
+                for c in range(ns):
+                    f = mon.A[j, c]
+                    if f != 0.0:  # i <= j < ns: T holds row i
+                        for l in range(L):
+                            acc[l] += f * T[i, c, l]
+                for a in range(nu):
+                    f = mon.B[j, a]
+                    if f != 0.0:
+                        for l in range(L):
+                            acc[l] += f * (T[i, ns + a, l] + g[a, l] * T[i, ns + nu + a, l])
+            elif i < ns:
+                for l in range(L):
+                    acc[l] = T[i, j, l]
+            else:
+                for l in range(L):
+                    acc[l] = P[i, j, l]
+            q = mon.Q[i, j]
+            for l in range(L):
+                P[i, j, l] = acc[l] + q  # the lower triangle is copied below
+    for i in range(n):
+        for j in range(i + 1, n):
+            for l in range(L):
+                P[j, i, l] = P[i, j, l]
+    # sequential scalar updates (eqs. 6-8), the direction signatures carried beside
+    sig = np.zeros((nd, n, L))
+    for d in range(nd):
+        for i in range(ns):
+            for l in range(L):
+                sig[d, i, l] = mon.B[i, d]
+    pc = np.empty((n, L))
+    sv = np.empty(L)
+    gain = np.empty(L)
+    cs = np.empty((nd, L))
+    # each row's h(x_pred) - C x_pred; innovation z - h(x_pred) - C (x - x_pred)
+    if mon.nonlinear:
+        off = nonlinear_offsets(mon, pl, x, ns)
+    else:
+        off = np.zeros((0, L))
+    for r in range(m):
+        for i in range(n):
+            for l in range(L):
+                pc[i, l] = 0.0
+        for j in range(ns):
+            c = mon.C[r, j]
+            if c != 0.0:
+                for i in range(n):
+                    for l in range(L):
+                        pc[i, l] += c * P[i, j, l]
+        for l in range(L):
+            sv[l] = mon.r[r]
+            gain[l] = z[r, l] if r < nz else lat[r - nz, l]
+        if mon.nonlinear:
+            for l in range(L):
+                gain[l] -= off[r, l]
+        for d in range(nd):
+            for l in range(L):
+                cs[d, l] = 0.0
+        for j in range(ns):
+            c = mon.C[r, j]
+            if c != 0.0:
+                for l in range(L):
+                    sv[l] += c * pc[j, l]
+                    gain[l] -= c * x[j, l]
+                for d in range(nd):
+                    for l in range(L):
+                        cs[d, l] += c * sig[d, j, l]
+        # gain: the innovation nu_r, then nu_r / S
+        for d in range(nd):
+            for l in range(L):
+                rs = 1.0 / np.sqrt(sv[l])
+                mu = cs[d, l] * rs
+                num[d, l] += mu * gain[l] * rs
+                den[d, l] += mu * mu
+                cs[d, l] /= sv[l]
+        for l in range(L):
+            gain[l] /= sv[l]
+        for d in range(nd):
+            for i in range(n):
+                for l in range(L):
+                    sig[d, i, l] -= pc[i, l] * cs[d, l]
+        for i in range(n):
+            for l in range(L):
+                x[i, l] += pc[i, l] * gain[l]
+        for i in range(n):
+            for j in range(i, n):
+                for l in range(L):
+                    v = P[i, j, l] - pc[i, l] * pc[j, l] / sv[l]
+                    P[i, j, l] = v
+                    P[j, i, l] = v
+
+
+@kernel(inline="always")
+def monitor_start(mon, k, st):
+    """At step 0 every lane's estimate starts at zero with ``P0``; returns the
+    direction sums ``num``, ``den`` (3, L), zero."""
+    x = st.mx
+    P = st.mP
+    n = x.shape[0]
+    L = x.shape[1]
     if k == 0:
         for l in range(L):
             for i in range(n):
                 x[i, l] = 0.0
                 for j in range(n):
                     P[i, j, l] = mon.P0[i, j]
-    num = np.zeros((nd, L))
-    den = np.zeros((nd, L))
-    if mon.nonlinear == EXTENDED:
-        extended_filter(mon, flight.plant, x, P, work, st, num, den)
-    else:
-        # predict (eq. 5): X = F X + [B (u - u_ff); 0], F = [[A, B, B G], [0, I, 0], [0, 0, I]]
-        # with G = diag(g), g = -(u + u0) per lane; every loop runs over the lanes innermost
-        g = np.empty((nu, L))
-        for a in range(nu):
-            for l in range(L):
-                g[a, l] = -(work.u[a, l] + mon.u0[a])
-        xn = np.zeros((ns, L))
-        if mon.nonlinear:
-            nonlinear_prediction(mon, flight.plant, x, ns, nu, work, xn)
-        else:
-            for i in range(ns):
-                for c in range(ns):
-                    f = mon.A[i, c]
-                    if f != 0.0:
-                        for l in range(L):
-                            xn[i, l] += f * x[c, l]
-                for a in range(nu):
-                    f = mon.B[i, a]
-                    if f != 0.0:
-                        for l in range(L):
-                            xn[i, l] += f * (work.u[a, l] - mon.u_ff[a] + x[ns + a, l]
-                                             + g[a, l] * x[ns + nu + a, l])
-        for i in range(ns):
-            for l in range(L):
-                x[i, l] = xn[i, l]
-        T = np.zeros((ns, n, L))  # the rows of F P that differ from P's
-        for i in range(ns):
-            for c in range(ns):
-                f = mon.A[i, c]
-                if f != 0.0:
-                    for j in range(n):
-                        for l in range(L):
-                            T[i, j, l] += f * P[c, j, l]
-            for a in range(nu):
-                f = mon.B[i, a]
-                if f != 0.0:
-                    for j in range(n):
-                        for l in range(L):
-                            T[i, j, l] += f * (P[ns + a, j, l] + g[a, l] * P[ns + nu + a, j, l])
-        acc = np.empty(L)
-        for i in range(n):
-            for j in range(i, n):
-                if j < ns:  # (F P F^T)[i, j] = sum_c (F P)[i, c] F[j, c]
-                    for l in range(L):
-                        acc[l] = 0.0
-                    for c in range(ns):
-                        f = mon.A[j, c]
-                        if f != 0.0:  # i <= j < ns: T holds row i
-                            for l in range(L):
-                                acc[l] += f * T[i, c, l]
-                    for a in range(nu):
-                        f = mon.B[j, a]
-                        if f != 0.0:
-                            for l in range(L):
-                                acc[l] += f * (T[i, ns + a, l] + g[a, l] * T[i, ns + nu + a, l])
-                elif i < ns:
-                    for l in range(L):
-                        acc[l] = T[i, j, l]
-                else:
-                    for l in range(L):
-                        acc[l] = P[i, j, l]
-                q = mon.Q[i, j]
-                for l in range(L):
-                    P[i, j, l] = acc[l] + q  # the lower triangle is copied below
-        for i in range(n):
-            for j in range(i + 1, n):
-                for l in range(L):
-                    P[j, i, l] = P[i, j, l]
-        # sequential scalar updates (eqs. 6-8), the direction signatures carried beside
-        sig = np.zeros((nd, n, L))
-        for d in range(nd):
-            for i in range(ns):
-                for l in range(L):
-                    sig[d, i, l] = mon.B[i, d]
-        pc = np.empty((n, L))
-        sv = np.empty(L)
-        gain = np.empty(L)
-        cs = np.empty((nd, L))
-        # each row's h(x_pred) - C x_pred; innovation z - h(x_pred) - C (x - x_pred)
-        if mon.nonlinear:
-            off = nonlinear_offsets(mon, flight.plant, x, ns)
-        else:
-            off = np.zeros((0, L))
-        for r in range(m):
-            for i in range(n):
-                for l in range(L):
-                    pc[i, l] = 0.0
-            for j in range(ns):
-                c = mon.C[r, j]
-                if c != 0.0:
-                    for i in range(n):
-                        for l in range(L):
-                            pc[i, l] += c * P[i, j, l]
-            for l in range(L):
-                sv[l] = mon.r[r]
-                gain[l] = work.z[r, l] if r < nz else st.lat[r - nz, l]
-            if mon.nonlinear:
-                for l in range(L):
-                    gain[l] -= off[r, l]
-            for d in range(nd):
-                for l in range(L):
-                    cs[d, l] = 0.0
-            for j in range(ns):
-                c = mon.C[r, j]
-                if c != 0.0:
-                    for l in range(L):
-                        sv[l] += c * pc[j, l]
-                        gain[l] -= c * x[j, l]
-                    for d in range(nd):
-                        for l in range(L):
-                            cs[d, l] += c * sig[d, j, l]
-            # gain: the innovation nu_r, then nu_r / S
-            for d in range(nd):
-                for l in range(L):
-                    rs = 1.0 / np.sqrt(sv[l])
-                    mu = cs[d, l] * rs
-                    num[d, l] += mu * gain[l] * rs
-                    den[d, l] += mu * mu
-                    cs[d, l] /= sv[l]
-            for l in range(L):
-                gain[l] /= sv[l]
-            for d in range(nd):
-                for i in range(n):
-                    for l in range(L):
-                        sig[d, i, l] -= pc[i, l] * cs[d, l]
-            for i in range(n):
-                for l in range(L):
-                    x[i, l] += pc[i, l] * gain[l]
-            for i in range(n):
-                for j in range(i, n):
-                    for l in range(L):
-                        v = P[i, j, l] - pc[i, l] * pc[j, l] / sv[l]
-                        P[i, j, l] = v
-                        P[j, i, l] = v
+    nd = mon.B.shape[1]
+    return np.zeros((nd, L)), np.zeros((nd, L))
+
+
+@kernel(inline="always")
+def monitor_decide(mon, flight, k, st, work, rec, num, den):
+    """After the update: the projection of the fault parameters, the windowed
+    GLR of each direction, the decisions with their resets, and the record."""
+    x = st.mx
+    P = st.mP
+    n = x.shape[0]
+    L = x.shape[1]
+    ns = mon.A.shape[0]
+    nu = mon.B.shape[1]
+    nd = nu
     for l in range(L):
         for a in range(nu):
             b0 = x[ns + a, l]
@@ -677,4 +671,53 @@ def sixdof_monitor(plant, scheme, flight, k, st, work, rec):
             for i in range(2 * nu):
                 rec.mon_b[i, l] = x[ns + i, l]
             for a in range(nu):
-                rec.mon_b[2 * nu + a, l] = position(mon, x, ns, nu, a, l, work)
+                rec.mon_b[2 * nu + a, l] = position(mon, x, ns, nu, a, l, work.u)
+
+
+@kernel
+def sixdof_monitor(plant, scheme, flight, k, st, work, rec):
+    """Advance the side monitor of every lane over step ``k -> k+1``.
+
+    Parameters
+    ----------
+    plant : SixdofPlant
+        The path's plant marker (the dispatcher's calling convention).
+    scheme : Scheme
+        Unused (the stage's calling convention).
+    flight : Flight
+        ``plant.monitor`` (:class:`SideMonitor`), ``timing.k_fault``.
+    k : int
+        Step.
+    st : LaneState
+        ``mx`` (n, L), ``mP`` (n, n, L) (set at step 0: zero and ``P0``),
+        the GLR window ``mbuf`` and ``mcount``, the first elevon named
+        ``mside`` and its position estimate ``mpos``, updated in place; ``lat``
+        the lateral loop's measurements of ``k + 1``.
+    work : TrialWork
+        ``u`` the commands sent over the step, ``z`` the 12 longitudinal
+        measurements of ``k + 1``.
+    rec : TrialRecord
+        ``side_k``, ``side_block``, ``side_pre``, ``side_n`` (on live lanes), ``mon_b``
+        (module docstring).
+    """
+    mon = flight.plant.monitor
+    if mon.on == 0:
+        return
+    if mon.nonlinear == EXTENDED:
+        raise ValueError("an extended side monitor flies sixdof_monitor_extended")
+    num, den = monitor_start(mon, k, st)
+    trim_filter(mon, flight.plant, st.mx, st.mP, work.u, work.z, st.lat, num, den)
+    monitor_decide(mon, flight, k, st, work, rec, num, den)
+
+
+@kernel
+def sixdof_monitor_extended(plant, scheme, flight, k, st, work, rec):
+    """:func:`sixdof_monitor` with the extended filter (:func:`extended_filter`),
+    on the ``SIXDOF_EXTENDED_PLANT`` path (``core/shared/paths.py``): the
+    other 6-DOF path never compiles it."""
+    mon = flight.plant.monitor
+    if mon.on == 0:
+        return
+    num, den = monitor_start(mon, k, st)
+    extended_filter(mon, flight.plant, st.mx, st.mP, work.u, work.z, st.lat, num, den)
+    monitor_decide(mon, flight, k, st, work, rec, num, den)
