@@ -154,13 +154,13 @@ def lock_position(mon, x, ns, nu, st, work):
 
 
 @kernel(inline="always")
-def absolute_state(mon, pl, x, l, x6):
-    """Lane ``l``'s 6-DOF state ``x0 + x`` (absolute, the cross-track position
-    at trim), written over ``x6`` (15,), from the monitor's estimate ``x``."""
+def on_trim(mon, pl, v, x6):
+    """The 6-DOF state ``x0 + v`` (absolute) of one lane's estimate ``v`` on the
+    monitor's rows, over ``x6`` (15,)."""
     for i in range(x6.shape[0]):
         x6[i] = pl.x0[i]
     for i in range(mon.states.shape[0]):
-        x6[mon.states[i]] += x[i, l]
+        x6[mon.states[i]] += v[i]
 
 
 @kernel
@@ -182,7 +182,7 @@ def nonlinear_prediction(mon, pl, x, ns, nu, u, xn):
     wd = np.zeros(N_WIND)
     rk = np.empty((N_WORK, N_STATE))
     for l in range(L):
-        absolute_state(mon, pl, x, l, x6)
+        on_trim(mon, pl, x[:, l], x6)
         for a in range(nu):
             cmd[a] = position(mon, x, ns, nu, a, l, u)
         propagate(x6, cmd, pl.p, wd, pl.dt, mon.n_sub, rk)
@@ -213,7 +213,7 @@ def nonlinear_offsets(mon, pl, x, ns):
     y = np.empty(N_OUTPUT)
     off = np.empty((m, L))
     for l in range(L):
-        absolute_state(mon, pl, x, l, x6)
+        on_trim(mon, pl, x[:, l], x6)
         outputs(x6, pl.p, wd, y)
         for r in range(m):
             o = mon.outs[r]
@@ -232,6 +232,18 @@ def gust_wind(mon, x, nx, wd):
         for j in range(mon.wind.shape[1]):
             acc += mon.wind[i, j] * x[nx + j]
         wd[i] = acc
+
+
+@kernel(inline="always")
+def times_wind(mon, J, out, col0):
+    """``out[:, col0:col0 + ng] = J @ mon.wind``: a Jacobian in the wind (rows, 6)
+    made one in the gust states."""
+    for i in range(J.shape[0]):
+        for c in range(mon.wind.shape[1]):
+            acc = 0.0
+            for w in range(mon.wind.shape[0]):
+                acc += J[i, w] * mon.wind[w, c]
+            out[i, col0 + c] = acc
 
 
 @kernel
@@ -289,12 +301,9 @@ def extended_filter(mon, pl, x, P, u, z, lat, num, den):
         for i in range(n):
             xl[i] = x[i, l]
         for a in range(nu):
-            cmd[a] = xl[ns + a] + (1.0 - xl[ns + nu + a]) * (u[a, l] + mon.u0[a])
+            cmd[a] = position(mon, x, ns, nu, a, l, u)
         gust_wind(mon, xl, nx, wd)
-        for i in range(N_STATE):
-            x6[i] = pl.x0[i]
-        for i in range(nx):
-            x6[mon.states[i]] += xl[i]
+        on_trim(mon, pl, xl, x6)
         # the prediction and its Jacobians in the states, the commands and the wind
         for i in range(N_STATE):
             f0[i] = x6[i]
@@ -330,12 +339,7 @@ def extended_filter(mon, pl, x, P, u, z, lat, num, den):
                 else:
                     Jw[i, col - nx - nu] = d
         if ng > 0:
-            for i in range(nx):
-                for c in range(ng):
-                    acc = 0.0
-                    for w in range(nw):
-                        acc += Jw[i, w] * mon.wind[w, c]
-                    F[i, nx + c] = acc
+            times_wind(mon, Jw, F, nx)
             for i in range(nx, ns):
                 for c in range(nx, ns):
                     F[i, c] = mon.A[i, c]
@@ -372,10 +376,7 @@ def extended_filter(mon, pl, x, P, u, z, lat, num, den):
                 Pl[i, j] = acc
                 Pl[j, i] = acc
         # the outputs at the prediction and their Jacobians in the states and the wind
-        for i in range(N_STATE):
-            x6[i] = pl.x0[i]
-        for i in range(nx):
-            x6[mon.states[i]] += xp[i]
+        on_trim(mon, pl, xp, x6)
         gust_wind(mon, xp, nx, wd)
         outputs(x6, pl.p, wd, y0)
         for r in range(m):
@@ -395,12 +396,7 @@ def extended_filter(mon, pl, x, P, u, z, lat, num, den):
                 outputs(x6, pl.p, wb, yb)
                 for r in range(m):
                     Hw[r, w] = (yb[mon.outs[r]] - y0[mon.outs[r]]) / eps
-            for r in range(m):
-                for c in range(ng):
-                    acc = 0.0
-                    for w in range(nw):
-                        acc += Hw[r, w] * mon.wind[w, c]
-                    C[r, nx + c] = acc
+            times_wind(mon, Hw, C, nx)
         # sequential scalar updates, the direction signatures carried beside
         for d in range(nu):
             for i in range(n):
