@@ -169,7 +169,10 @@ LONGITUDINAL_AS_SIXDOF = {"thrust": "throttle", "elevon_left": "left",
 def sixdof_truth_ref(scheme, flight, inp, k, st, rec, u):
     """The 6-DOF truth over step ``k``, written from the module docstring of
     ``ftc_mc/core/sixdof/truth.py`` with whole vectors and names, one lane at a
-    time: the lateral loop's aileron and the summed, saturated commands; the
+    time: the lateral loop's aileron (or, with ``coupled`` on a lane flying
+    c0 or c1, the coupled law's terms on the estimate and the loop's state,
+    c1's bilinear in the thrust's estimated faults) and the
+    summed, saturated commands; the
     elevon model; eq. (2); the longitudinal and lateral Dryden gusts; RK4 (or
     the linear 6-DOF model); the longitudinal measurements, the lateral ones,
     the air data, the bank angle and the squared bank and heading.
@@ -179,7 +182,7 @@ def sixdof_truth_ref(scheme, flight, inp, k, st, rec, u):
     """
     from ftc_mc.conventions import LONGITUDINAL
     from ftc_mc.model.faults import effect
-    from naive import dryden_ref, sensor_fault_ref
+    from naive import B0_T, B1_T, C0, C1, dryden_ref, engine_gain_ref, sensor_fault_ref
 
     fm, ctl, pl = scheme.filter, scheme.controller, flight.plant
     L = st.x.shape[1]
@@ -187,10 +190,18 @@ def sixdof_truth_ref(scheme, flight, inp, k, st, rec, u):
     u = np.array(u, dtype=float, copy=True)
     lat = st.lat.copy()
     for l in range(L):
-        da = -pl.K_lat @ st.lat[:, l]
-        mix = np.zeros(3)
-        mix[LAYOUT.commands.index("left")], mix[LAYOUT.commands.index("right")] = da, -da
-        u[:, l] = np.clip(u[:, l] + pl.u_ff + mix, ctl.lo_dev, ctl.hi_dev)
+        s = np.concatenate([st.xa[:len(LONGITUDINAL.states), l], st.lat[:, l]])
+        if pl.coupled and st.cur[l] == C0:  # c0 as the coupled 6-DOF LQR
+            extra = -pl.G0 @ s
+        elif pl.coupled and st.cur[l] == C1:  # c1 as Theorem 4.1 on the 6-DOF model
+            G, g = engine_gain_ref(pl.G1, st.xa[B0_T, l], st.xa[B1_T, l])
+            extra = -G @ s - g
+        else:
+            da = -pl.K_lat @ st.lat[:, l]
+            extra = np.zeros(3)
+            extra[LAYOUT.commands.index("left")] = da
+            extra[LAYOUT.commands.index("right")] = -da
+        u[:, l] = np.clip(u[:, l] + pl.u_ff + extra, ctl.lo_dev, ctl.hi_dev)
         for row, side in ((n_meas, "left"), (n_meas + 1, "right")):
             c = LAYOUT.commands.index(side)
             lat[row, l] = pl.a_act * st.lat[row, l] + (1 - pl.a_act) * (u[c, l] - pl.u_ff[c])

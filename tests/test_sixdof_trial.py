@@ -50,14 +50,20 @@ def lateral_state(setup, rng, st, inp, k):
     return st, inp
 
 
-@pytest.mark.parametrize("kind", ["nonlinear", "linear"])
-def test_sixdof_truth_matches_its_twin(kind):
+@pytest.mark.parametrize("kind,coupling", [("nonlinear", "separate"), ("linear", "separate"),
+                                      ("nonlinear", "coupled")])
+def test_sixdof_truth_matches_its_twin(kind, coupling):
     """One truth step of every lane against ``naive_sixdof.sixdof_truth_ref``:
     random states, lateral loop states, gusts, commands at and beyond the
-    limits, faults of every kind and sensor faults."""
+    limits, faults of every kind and sensor faults; with the coupled c0 and
+    c1 (``controller.coupling: coupled``) on the lanes flying them (two
+    thirds) and the separate loops on the lanes flying c2."""
     from ftc_mc.core.sixdof.truth import sixdof_truth
 
-    setup = build_setup(api.campaign_config(sixdof_config(kind)))
+    cfg = sixdof_config(kind)
+    cfg["controller"] = {"coupling": coupling}
+    setup = build_setup(api.campaign_config(cfg))
+    assert setup.truth.coupled == (coupling == "coupled")
     rng = np.random.default_rng(11)
     scheme = setup.scheme("paper")
     flight = setup.flight
@@ -70,6 +76,8 @@ def test_sixdof_truth_matches_its_twin(kind):
     u = 0.05 * rng.standard_normal((3, L))
     u[:, 0] = [2.0, 1.0, -1.0]  # beyond the limits: saturated
     want = sixdof_truth_ref(scheme, flight, inp, k, st, rec, u)
+    sep = sixdof_truth_ref(scheme, flight._replace(plant=flight.plant._replace(coupled=0)),
+                           inp, k, st, rec, u)["u"]
     work = new_trial_work(L, inp.xa0.shape[0])
     work.u[:] = u
     sixdof_truth(SIXDOF_PLANT, scheme, flight, inp, k, st, work, rec)
@@ -79,6 +87,12 @@ def test_sixdof_truth_matches_its_twin(kind):
     for key, ref in want.items():
         np.testing.assert_allclose(got[key], ref, rtol=1e-10, atol=1e-12, err_msg=key)
     assert np.abs(work.bank).max() > 0  # a bank was flown, and compared
+    if coupling == "coupled":  # c0's and c1's lanes differ from the separate loops', c2's not
+        coupled_lanes = st.cur <= 1
+        assert coupled_lanes.any() and (~coupled_lanes).any()
+        assert np.abs(work.u[:, coupled_lanes] - sep[:, coupled_lanes]).max() > 1e-4
+        np.testing.assert_allclose(work.u[:, ~coupled_lanes], sep[:, ~coupled_lanes],
+                                   rtol=1e-10, atol=1e-12)
 
 
 def test_sixdof_campaign_is_reproducible_and_summarised(tmp_path):
@@ -96,12 +110,15 @@ def test_sixdof_campaign_is_reproducible_and_summarised(tmp_path):
     assert np.isfinite(s["bank_rms_deg"]).all()
 
 
-def test_fault_free_sixdof_flight_holds_wings_level():
+@pytest.mark.parametrize("coupling", ["separate", "coupled"])
+def test_fault_free_sixdof_flight_holds_wings_level(coupling):
     """Fault-free in still air on the 6-DOF nonlinear plant, the paper's loop
-    with the lateral autopilot flies 50 s with no exit and the bank within a
-    degree (the open-loop Dutch roll is unstable: without the lateral loop it
-    diverges in seconds, docs/airframes.md)."""
+    with the lateral autopilot (or c0 as the coupled 6-DOF LQR) flies 50 s
+    with no exit and the bank within a degree (the open-loop Dutch roll is
+    unstable: without the lateral loop it diverges in seconds,
+    docs/airframes.md)."""
     cfg = sixdof_config(turbulence="none")
+    cfg["controller"] = {"coupling": coupling, "kind": "nominal"}
     res = api.run_endurance(cfg, hours=16 * 50 / 3600, flight_s=50.0, jobs=1, progress=False)
     f = res.flights
     assert (f["status"] == "ok").all()
@@ -173,3 +190,20 @@ def test_model_save_writes_matlab_files(tmp_path, dof):
         a, b = load_linear_model(mat), load_linear_model(npz)
         np.testing.assert_array_equal(a.A, b.A)
         np.testing.assert_array_equal(a.Dw, b.Dw)
+
+
+def test_a_coupled_c0_cannot_fly_the_longitudinal_plant(tmp_path):
+    """``controller.coupling: coupled`` with ``--dof 3``: one line naming
+    the field, exit 2, nothing written."""
+    import yaml
+
+    cfg = sixdof_config(turbulence="none")
+    cfg["controller"] = {"coupling": "coupled"}
+    path = tmp_path / "c.yaml"
+    path.write_text(yaml.safe_dump(cfg))
+    out = tmp_path / "out"
+    res = CliRunner().invoke(cli, ["run", str(path), "--dof", "3", "--out", str(out)])
+    assert res.exit_code == 2, res.output
+    lines = res.output.strip().splitlines()
+    assert len(lines) == 1 and "controller.coupling" in lines[0] and "dof" in lines[0], lines
+    assert not out.exists()

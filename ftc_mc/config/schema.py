@@ -128,6 +128,14 @@ class _Sampled(_Strict):
         return any(self.controller_of(r) == "lock_turn" for r in runs)
 
 
+def _check_coupling(cfg) -> None:
+    """Coupled c0 and c1 are 6-DOF controllers: on the longitudinal plant
+    the field names the mismatch."""
+    if cfg.controller.coupling == "coupled" and cfg.plant.dof != 6:
+        raise ValueError("controller.coupling: coupled flies the 6-DOF plant "
+                         f"(plant.dof: 6), got plant.dof {cfg.plant.dof}")
+
+
 def _check_lock_turn(cfg, runs) -> None:
     """A ``lock_turn`` controller needs the 6-DOF plant and its side monitor;
     the error names the field that asks for it."""
@@ -225,6 +233,8 @@ class ControllerConfig(_Strict):
     terminal_horizon_s: Pos = 100.0
     """Simulated rest of the mission for the terminal costs J^N (eq. 46) [s]
     (100 s: the paper's mission, and about 1/(1 - alpha) steps)."""
+    coupling: Literal["separate", "coupled"] = "separate"
+    """How c0 and c1 fly the 6-DOF plant (plant.dof 6 only): ``separate``, the paper's longitudinal laws with the wings-level lateral LQR beside them; ``coupled``, c0 as one discounted LQR on the 6-DOF linear model with the sum of their weights, and c1 as Theorem 4.1's tables on that model (``ftc_mc/design/lateral.py``). On ``x8-pyfly`` the coupled laws also roll with the propeller's torque, and c1 then relies on the thrust's estimated effectiveness for it: measured in docs/airframes.md, where a locked engine that the paper's filter reads as a bias costs heading. c2 and the lock-turn law keep their own."""
 
 
 class ExcitationConfig(_Strict):
@@ -742,6 +752,7 @@ class Config(_Sampled):
                              f"({t.duration_s:g} s), got {self.controller.horizon_s:g}")
         _check_length("timing.duration_s", t.duration_s, dt)
         _check_lock_turn(self, self.campaign.runs())
+        _check_coupling(self)
         lower, upper = _check_airframe_use(self)
         for actuator, name in (("engine", "engine_lock_range"),
                                ("left_elevon", "elevon_lock_range_rad"),
@@ -888,6 +899,7 @@ class ScenarioConfig(_Sampled):
             raise ValueError(f"controller.horizon_s: must not exceed scenario.duration_s "
                              f"({sc.duration_s:g} s), got {self.controller.horizon_s:g}")
         _check_lock_turn(self, (sc.design or sc.signature,))
+        _check_coupling(self)
         lower, upper = _check_airframe_use(self)
         for i, e in enumerate(sc.schedule):
             if e.fault == "lock" and e.position != "trim":

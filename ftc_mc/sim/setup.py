@@ -247,7 +247,8 @@ def build_setup(cfg: Config | ScenarioConfig) -> SimSetup:
         truth, gust, gust_lat = sixdof_truth_plant(
             plant, pc.kind, pc.substeps, pc.turbulence, pc.altitude_m,
             monitor=monitor_spec(cfg, fm, detection(plant, EstimatorSettings()),
-                                 lock_turn=cfg.flies_lock_turn(runs)))
+                                 lock_turn=cfg.flies_lock_turn(runs)),
+            paper=(K, eng, Q, R, c.discount) if c.coupling == "coupled" else None)
         lat_std = lateral_noise(r_std)
         gust_lat_chol = None if gust_lat is None else gust_lat.P0_chol
     else:

@@ -16,7 +16,7 @@ import math
 
 import numpy as np
 
-from ..conventions import PLANT_KINDS, TURBULENCE_LEVELS
+from ..conventions import N_U, N_X, PLANT_KINDS, TURBULENCE_LEVELS
 from ..core.longitudinal.settings import TruthPlant
 from ..model.linear import LinearPlant
 from ..model.turbulence import DrydenModel, dryden_model
@@ -71,7 +71,7 @@ def truth_plant(plant: LinearPlant, kind: str = "linear", substeps: int = 10,
 
 def sixdof_truth_plant(plant: LinearPlant, kind: str = "nonlinear", substeps: int = 10,
                        turbulence: str = "none", altitude_m: float = 100.0,
-                       where: str = "model.airframe", monitor=None):
+                       where: str = "model.airframe", monitor=None, paper=None):
     """Kernel settings of the 6-DOF truth plant (``plant.dof: 6``), and its gust
     models.
 
@@ -94,6 +94,11 @@ def sixdof_truth_plant(plant: LinearPlant, kind: str = "nonlinear", substeps: in
     monitor : MonitorSpec or None
         The side monitor flown beside the scheme (:mod:`ftc_mc.sim.monitor`);
         None: off.
+    paper : tuple or None
+        ``(K0, eng, Q, R, alpha)``: the paper's c0 gain, c1 tables, weights
+        and discount, for c0 and c1 to fly the coupled 6-DOF laws
+        (``controller.coupling: coupled``, :func:`coupled_controllers`);
+        None: the separate loops.
 
     Returns
     -------
@@ -136,6 +141,7 @@ def sixdof_truth_plant(plant: LinearPlant, kind: str = "nonlinear", substeps: in
         Adl, Bdl, Cdl = (np.ascontiguousarray(a) for a in (gust_lat.Ad, gust_lat.Bd,
                                                             gust_lat.Cd))
     lon_state, lon_out, lat_out = index_maps()
+    G0, G1 = coupled_controllers(six, lat, paper)
     c = np.ascontiguousarray
     pl = SixDofTruth(
         kind=SIXDOF_LINEAR if kind == "linear" else SIXDOF_NONLINEAR,
@@ -144,11 +150,81 @@ def sixdof_truth_plant(plant: LinearPlant, kind: str = "nonlinear", substeps: in
         u0=c(six.u0, dtype=np.float64), u_ff=c(six.u0 - plant.u0, dtype=np.float64),
         A=c(six.A), B=c(six.B), C=c(six.C), Bw=c(six.Bw), Dw=c(six.Dw),
         turb=lon.turb, Ad=lon.Ad, Bd=lon.Bd, Cd=lon.Cd, Adl=Adl, Bdl=Bdl, Cdl=Cdl,
-        K_lat=c(lat.K[0], dtype=np.float64), a_act=elevon_lag(af.tau_elevon, plant.dt),
+        K_lat=c(lat.K[0], dtype=np.float64), coupled=int(paper is not None), G0=G0, G1=G1,
+        a_act=elevon_lag(af.tau_elevon, plant.dt),
         lon_state=lon_state, lon_out=lon_out, lat_out=lat_out,
         monitor=side_monitor(six, six.u0 - plant.u0, plant.u_lower, plant.u_upper, lon_out,
                              monitor, af.b, af))
     return pl, gust, gust_lat
+
+
+def kernel_gain(K: np.ndarray, K_paper: np.ndarray) -> np.ndarray:
+    """A coupled gain in the kernel's form (``SixDofTruth.G0``, ``G1``).
+
+    The kernel flies the paper's ``-K_paper xhat`` and adds ``-G s``, ``s =
+    [xhat, lat]`` (``core/sixdof/truth.py``), so that the sum is ``-K`` on the
+    estimate's longitudinal states and the lateral loop's states
+    (:data:`ftc_mc.core.sixdof.truth.LATERAL_LOOP`).  Both hold the elevons:
+    ``K``'s elevon columns are split into their mean, read from the estimate
+    (the elevator, the longitudinal filter's), and their half difference,
+    read from the loop's elevon model (the aileron, the lateral loop's), as
+    the separate loops split them.
+
+    Parameters
+    ----------
+    K : ndarray, shape (..., 3, 15)
+        Coupled gains on the 6-DOF state.
+    K_paper : ndarray, shape (..., 3, 9)
+        The paper's gains they replace, on the longitudinal states.
+
+    Returns
+    -------
+    G : ndarray, shape (..., 3, 16)
+    """
+    from ..conventions import STATE_NAMES
+    from ..core.sixdof.layout import STATE, sixdof_name
+    from ..core.sixdof.truth import LATERAL_LOOP
+
+    left, right = K[..., STATE["left"]], K[..., STATE["right"]]
+    mean, half_diff = (left + right) / 2.0, (left - right) / 2.0
+    split = {"left": half_diff, "right": -half_diff}
+    cols = [mean if sixdof_name(n) in ("left", "right") else K[..., STATE[sixdof_name(n)]]
+            for n in STATE_NAMES]
+    cols += [split[n] if n in split else K[..., STATE[n]] for n in LATERAL_LOOP]
+    G = np.stack(cols, axis=-1)
+    G[..., :len(STATE_NAMES)] -= K_paper
+    return np.ascontiguousarray(G)
+
+
+def coupled_controllers(six, lat, paper):
+    """``(G0, G1)`` of :class:`SixDofTruth`: c0 and c1 as coupled 6-DOF laws
+    less the paper's (:func:`kernel_gain`).
+
+    Parameters
+    ----------
+    six : SixDofPlant
+    lat : LateralDesign
+    paper : tuple or None
+        ``(K0, eng, Q, R, alpha)``: the paper's c0 gain, its c1 tables
+        (``EngineTables``), weights and discount; None: zeros (the separate
+        loops).
+    """
+    from ..core.shared.interp import EngineTables
+    from ..core.sixdof.truth import LATERAL_LOOP
+    from ..design.lateral import coupled_engine_tables, coupled_lqr
+
+    n = N_X + len(LATERAL_LOOP)
+    if paper is None:
+        one = np.zeros(1)
+        return np.zeros((N_U, n)), EngineTables(K=np.zeros((1, 1, N_U, n)),
+                                                k=np.zeros((1, 1, N_U)), b0_grid=one,
+                                                b1_grid=one)
+    K0, eng, Q, R, alpha = paper
+    d = coupled_lqr(six, K0, Q, R, alpha, lat)
+    t6 = coupled_engine_tables(six, d, eng.b0_grid, eng.b1_grid)
+    G1 = EngineTables(K=kernel_gain(t6.K, eng.K), k=np.ascontiguousarray(t6.k - eng.k),
+                      b0_grid=eng.b0_grid, b1_grid=eng.b1_grid)
+    return kernel_gain(d.K, K0), G1
 
 
 LATERAL_NOISE_AS = {"phi": "theta", "v": "w", "p": "q", "r": "q", "psi": "theta"}

@@ -108,6 +108,18 @@ WIND = index(LAYOUT.wind)
 PARAM = index(LAYOUT.params)
 """Parameter name -> index."""
 
+AS_SIXDOF = {"thrust": "throttle", "elevon_left": "left", "elevon_right": "right",
+             "CAS": "Va"}
+"""6-DOF names of the longitudinal family's states, commands and outputs
+(:mod:`ftc_mc.conventions`) where they differ; the others keep their names
+(``CAS`` is the airspeed)."""
+
+
+def sixdof_name(name: str) -> str:
+    """The 6-DOF state, command or output named ``name`` in the longitudinal family."""
+    return AS_SIXDOF.get(name, name)
+
+
 N_STATE = len(LAYOUT.states)
 N_RIGID = len(LAYOUT.rigid)
 N_COMMAND = len(LAYOUT.commands)

@@ -26,6 +26,16 @@ One step ``k -> k+1`` on every lane, with the longitudinal commands ``u_k``
    filter and the history see the commands sent to the actuators.  The
    elevon model advances: ``m_{k+1} = a m_k + (1 - a) (u - u_ff)``,
    ``a = exp(-dt / tau_elevon)``.
+   With ``controller.coupling: coupled`` (``SixDofTruth.coupled``) a
+   lane flying c0 or c1 takes the coupled 6-DOF law instead of ``da``:
+   c0 ``u + u_ff - G0 s``, c1 ``u + u_ff - G1(b0, b1) s - g1(b0, b1)``
+   (bilinear in the thrust's estimated ``b0, b1`` as the paper's c1, eq.
+   44), ``s = [xhat, lat]`` the filter's estimate of the 9 longitudinal
+   states and the lateral loop's state. ``G0``, ``G1`` and ``g1`` are the
+   coupled laws (:func:`ftc_mc.design.lateral.coupled_lqr`,
+   :func:`ftc_mc.design.lateral.coupled_engine_tables`) less the paper's
+   c0 and c1, which ``u`` already holds (``ftc_mc/sim/truth.py``,
+   ``coupled_gains``).
 2. **Faults.** Eq. (2) per actuator, ``e = b0 + (1 - b1) u - b1 u0``; the
    absolute command is ``u0 + e`` (a lock holds ``b0``).  A left and a right
    elevon fault are different faults here: elevator = (left + right)/2,
@@ -56,11 +66,13 @@ from collections import namedtuple
 
 import numpy as np
 
-from ...conventions import LONGITUDINAL, N_U, N_Z
+from ...conventions import (C_ENGINE, C_NOMINAL, I_B0_THRUST, I_B1_THRUST, LONGITUDINAL,
+                            N_U, N_X, N_Z)
 from ..jit import kernel
 from ..longitudinal.plant import actuator_effect, gust_lanes, schedule_entry, sensor_fault
+from ..shared.interp import engine_controller
 from .layout import (N_OUTPUT, N_STATE, N_WIND, OUTPUT, STATE, U_LEFT, U_RIGHT, W_P, W_Q,
-                     W_R, W_U, W_V, W_W, X_PHI, X_PSI, Y_ALPHA, Y_VA)
+                     W_R, W_U, W_V, W_W, X_PHI, X_PSI, Y_ALPHA, Y_VA, sixdof_name)
 from .lockturn import LOCK_TURN, lock_turn_law
 from .plant import N_WORK, outputs, propagate
 
@@ -94,6 +106,10 @@ SixDofTruth = namedtuple("SixDofTruth", [
     "Ad", "Bd", "Cd",     # longitudinal Dryden model, as TruthPlant's
     "Adl", "Bdl", "Cdl",  # (4, 4), (4, 4), (3, 4) lateral Dryden model
     "K_lat",      # (7,) lateral gain: da = -K_lat . lat  [rad]
+    "coupled",    # 1: c0 and c1 fly the coupled 6-DOF LQR (G0, G1); 0: the separate loops
+    "G0",         # (3, 16) coupled c0 minus the paper's c0, on [xhat (9), lat (7)]
+    "G1",         # EngineTables: the coupled c1 (Theorem 4.1 on the 6-DOF model) minus
+                  # the paper's c1, gains (nb0, nb1, 3, 16) on [xhat, lat] and affine terms
     "a_act",      # exp(-dt / tau_elevon): the loop's elevon model
     "lon_state",  # (9,) int64: the 6-DOF state of each longitudinal state
     "lon_out",    # (12,) int64: the 6-DOF output of each longitudinal output
@@ -114,10 +130,9 @@ def index_maps():
     longitudinal family's states and outputs, and the lateral loop's measured
     states, sit in the 6-DOF state and outputs (by name; ``CAS`` is the
     airspeed, the longitudinal actuator states are the 6-DOF ones)."""
-    rename = {"thrust": "throttle", "elevon_left": "left", "elevon_right": "right"}
-    lon_state = np.array([STATE[rename.get(n, n)] for n in LONGITUDINAL.states],
+    lon_state = np.array([STATE[sixdof_name(n)] for n in LONGITUDINAL.states],
                          dtype=np.int64)
-    lon_out = np.array([OUTPUT["Va" if n == "CAS" else n] for n in LONGITUDINAL.outputs],
+    lon_out = np.array([OUTPUT[sixdof_name(n)] for n in LONGITUDINAL.outputs],
                        dtype=np.int64)
     lat_out = np.array([OUTPUT[n] for n in LATERAL_LOOP[:N_LAT_MEASURED]], dtype=np.int64)
     return lon_state, lon_out, lat_out
@@ -200,10 +215,28 @@ def sixdof_truth(plant, scheme, flight, inp, k, st, work, rec):
     a = pl.a_act
     turn = pl.monitor.turn
     turning = scheme.reconfig.kind == LOCK_TURN and turn.x.shape[1] > 0
+    xl = np.empty(N_X + N_LAT)
+    du = np.empty(N_U)
     for l in range(L):
         if turning and st.mside[l] > 0:
             lock_turn_law(turn, st.mside[l] - 2, st.mpos[l], st.mx, work.z, st.lat, l,
                           ctl.lo_dev, ctl.hi_dev, u)
+        elif pl.coupled != 0 and st.cur[l] <= C_ENGINE:
+            for j in range(N_X):
+                xl[j] = st.xa[j, l]
+            for j in range(N_LAT):
+                xl[N_X + j] = st.lat[j, l]
+            if st.cur[l] == C_NOMINAL:
+                for i in range(N_U):
+                    acc = 0.0
+                    for j in range(N_X + N_LAT):
+                        acc -= pl.G0[i, j] * xl[j]
+                    du[i] = acc
+            else:
+                engine_controller(pl.G1, st.xa[I_B0_THRUST, l], st.xa[I_B1_THRUST, l], xl, du)
+            for i in range(N_U):
+                ui = u[i, l] + pl.u_ff[i] + du[i]
+                u[i, l] = min(ctl.hi_dev[i], max(ctl.lo_dev[i], ui))
         else:
             da = 0.0
             for j in range(N_LAT):
