@@ -252,3 +252,22 @@ def test_each_path_is_announced_on_its_own(monkeypatch):
     assert jit.announce_compile(cached, describe(dense), stream=out,
                                 needed=jit.needs_compile(cached, t_dense))
     assert "linear plant, dense filter, one-step test, reconfiguring controller" in out.getvalue()
+
+
+def test_the_notice_says_the_path_s_own_compile_time():
+    """The notice's duration follows the path's plant family: the 6-DOF paths
+    compile for longer than the longitudinal ones (``sim.compiling.EXPECTED_COMPILE``,
+    measured figures in its docstring), and every plant marker has one."""
+    from ftc_mc.core.shared import paths
+    from ftc_mc.sim.compiling import EXPECTED_COMPILE, expected_compile
+
+    assert set(EXPECTED_COMPILE) == {c for c in paths.NAMES if c.__name__.endswith("Plant")}
+    lon = Path_(LINEAR_PLANT, PAPER_FILTER, ONE_STEP_TEST, RECONFIGURING)
+    six = lon._replace(plant=paths.SIXDOF_PLANT)
+    ext = lon._replace(plant=paths.SIXDOF_EXTENDED_PLANT)
+    said = [expected_compile(p) for p in (lon, six, ext)]
+    assert said == ["1-1.5 min", "1.5-3 min", "3-4 min"]
+    assert expected_compile(None) == said[0]
+    out = io.StringIO()
+    assert jit.announce_compile(_FakeDispatcher({}), describe(six), said[1], out, needed=True)
+    assert "6-DOF plant" in out.getvalue() and "about 1.5-3 min" in out.getvalue()

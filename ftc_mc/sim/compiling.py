@@ -21,7 +21,8 @@ from pathlib import Path
 import numba
 
 from ..core import jit
-from ..core.shared.paths import describe
+from ..core.shared.paths import (LinearPlant, NonlinearPlant, SixdofExtendedPlant, SixdofPlant,
+                                 describe)
 from ..io.lock import waiting
 
 WAIT_NOTICE = ("ftc-mc: another process is compiling the simulation kernels; waiting "
@@ -43,6 +44,20 @@ def lock_path(dispatcher, path=None) -> Path:
     ``NUMBA_CACHE_DIR``)."""
     tag = "" if path is None else "." + re.sub(r"[^a-z0-9]+", "-", describe(path).lower())
     return Path(numba.config.CACHE_DIR) / f"{dispatcher.py_func.__name__}{tag}.compile.lock"
+
+
+EXPECTED_COMPILE = {LinearPlant: "1-1.5 min", NonlinearPlant: "1-1.5 min",
+                    SixdofPlant: "1.5-3 min", SixdofExtendedPlant: "3-4 min"}
+"""What the compile notice says a path's cold compile takes, by its plant marker
+(``core/shared/paths.py``): measured on 2 cores with an empty cache, the
+longitudinal paths 52-92 s (``docs/performance.md``, lesson 11), the 6-DOF ones
+67-160 s (nominal and reconfiguring, the latter beside another compile), with
+the extended side monitor 198 s (``docs/airframes.md``)."""
+
+
+def expected_compile(path) -> str:
+    """The duration :data:`EXPECTED_COMPILE` gives the compile ``path``."""
+    return EXPECTED_COMPILE[LinearPlant if path is None else type(path.plant)]
 
 
 @contextlib.contextmanager
@@ -76,7 +91,8 @@ def compiled_once(dispatcher, path=None, stream=None):
     out = sys.stderr if stream is None else stream
     needed = jit.needs_compile(dispatcher, first)
     if not jit.CACHE or needed is not True:
-        with _timed(jit.announce_compile(dispatcher, what, stream=out, needed=needed), out):
+        with _timed(jit.announce_compile(dispatcher, what, expected_compile(path), out,
+                                         needed), out):
             yield
         return
 
@@ -92,7 +108,8 @@ def compiled_once(dispatcher, path=None, stream=None):
         needed = jit.needs_compile(dispatcher, first)  # again: the holder may have filled it
         if needed is not True:
             stack.close()  # the holder filled the cache: load it without the lock
-        with _timed(jit.announce_compile(dispatcher, what, stream=out, needed=needed), out):
+        with _timed(jit.announce_compile(dispatcher, what, expected_compile(path), out,
+                                         needed), out):
             yield
 
 
