@@ -251,15 +251,22 @@ JACOBIANS = ("JA", "JB", "JW", "JC", "JHW")
 
 
 def lane_jacobians_ref(scheme, st, u, k):
-    """Every lane's Jacobians after step ``k``'s re-linearisation: recomputed about
-    ``st.xa`` (:func:`jacobians_ref`) when ``relin > 0`` divides ``k``, else
-    ``st``'s.  Returns a dict ``name -> (.., L)`` array."""
+    """Every lane's Jacobians after step ``k``'s re-linearisation: when ``relin >
+    0`` divides ``k``, those of the state map (``JA``, ``JB``, ``JW``) about the
+    estimate ``st.xa`` and those of the outputs (``JC``, ``JHW``) about its
+    prediction (:func:`predict_ref`), where the update linearises the outputs
+    (:func:`jacobians_ref` at each point); else ``st``'s.  Returns a dict
+    ``name -> (.., L)`` array."""
     model = ref_of(scheme)
     out = {f: np.array(getattr(st, f), copy=True) for f in JACOBIANS}
     if model.relin > 0 and k % model.relin == 0:
+        n = st.xa.shape[0]
         for l in range(st.xa.shape[1]):
-            for f, J in zip(JACOBIANS, jacobians_ref(st.xa[:, l], u[:, l], model)):
-                out[f][:, :, l] = J
+            Xp, _ = predict_ref(st.xa[:, l], np.zeros((n, n)), u[:, l], model)
+            at_estimate = jacobians_ref(st.xa[:, l], u[:, l], model)
+            at_prediction = jacobians_ref(Xp, u[:, l], model)
+            for f, J, Jp in zip(JACOBIANS, at_estimate, at_prediction):
+                out[f][:, :, l] = Jp if f in ("JC", "JHW") else J
     return out
 
 

@@ -348,11 +348,12 @@ def test_relinearised_filter_update(nonlinear_gusts, relin):
 
 def test_relinearised_at_trim_is_the_trim_model(nonlinear_gusts):
     """At trim (zero estimate, command and gust) the finite-difference Jacobians
-    are the trim model's: ``JA`` vs ``A`` (the exact discretisation of the
+    (the state map's about the estimate, the outputs' about the prediction,
+    which is trim again) are the trim model's: ``JA`` vs ``A`` (the exact discretisation of the
     continuous linearisation, JA the RK4 map's difference quotient), ``JB`` vs
     ``B``, ``JW`` vs ``B_w``, ``JC`` vs ``C``, ``JHW`` vs ``D_w``, each to 1e-4
     relative to the matrix's largest entry."""
-    from ftc_mc.core.longitudinal.gustfilter import relinearise_lanes
+    from ftc_mc.core.longitudinal.gustfilter import relinearise_lanes, relinearise_outputs_lanes
 
     fm, P0, d = extended(nonlinear_gusts, 1)
     rng = np.random.default_rng(67)
@@ -361,6 +362,7 @@ def test_relinearised_at_trim_is_the_trim_model(nonlinear_gusts):
                                                     trim_jacobians(fm).items()}))
     work = new_trial_work(L, N)
     relinearise_lanes(st.xa, work.u, fm, st, work)
+    relinearise_outputs_lanes(st.xa, fm, st, work)  # trim is its own prediction
     for f, M in trim_jacobians(fm).items():
         for l in range(L):
             err = np.abs(getattr(st, f)[:, :, l] - M[:, :, l]).max() / np.abs(M[:, :, l]).max()
