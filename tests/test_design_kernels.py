@@ -324,10 +324,11 @@ def test_extended_equals_linear_small_signal(nonlinear_gusts):
 # ------------------------------------------------------------------ re-linearised
 @pytest.mark.parametrize("relin", [1, 3])
 def test_relinearised_filter_update(nonlinear_gusts, relin):
-    """The extended filter stage re-linearising its covariance about each lane's
-    estimate (every step, and every 3 steps from step 10, so steps 10 and 13
-    re-compute and the others keep them) against the twin with the same finite
-    differences (``naive.jacobians_ref``).
+    """The extended filter stage re-linearising its covariance (the state map's
+    Jacobians about each lane's estimate, the outputs' about its prediction;
+    every step, and every 3 steps from step 10, so steps 10 and 13 re-compute
+    and the others keep them) against the twin with the same finite
+    differences (``naive.lane_jacobians_ref``).
 
     Tolerances 1e-7 instead of 1e-9: the finite differences divide the RK4
     results' rounding (1e-16 relative of states up to 18 m/s, which differs

@@ -557,7 +557,7 @@ class DesignConfig(_Strict):
     state_noise: dict[Literal[STATE_NAMES], NonNeg] = Field(default_factory=dict)
     """Extra filter process-noise standard deviation per step on named plant states (u, w [m/s], q [rad/s], ...): an allowance for the airframe model's error; {} adds none."""
     relinearise_s: Pos | None = None
-    """prediction: nonlinear only: every this many seconds [s], the covariance's Jacobians are re-computed about the lane's estimate (a multiple of model.dt_s); null: the Jacobians at trim."""
+    """prediction: nonlinear only: every this many seconds [s], the covariance's Jacobians are re-computed, the state map's about the lane's estimate and the outputs' about its prediction (an extended Kalman filter; a multiple of model.dt_s); null: the Jacobians at trim."""
     sensor_biases: list[Literal[BIASED_OUTPUTS]] = Field(default_factory=list)
     """Outputs whose sensor bias the filter estimates (issue 14; q, n_x, n_z: the residuals' sensors): a bias opens, like a fault block, when Table 1 resets the block sharing its residual (n_x with thrust; q and n_z with elevons); [] estimates none."""
     sensor_bias_sd: dict[Literal[BIASED_OUTPUTS], Pos] = Field(default_factory=dict)

@@ -166,7 +166,9 @@ def coupled_lqr(plant, K_lon: np.ndarray, Q_lon: np.ndarray, R_lon: np.ndarray,
         The paper's c0 gain (3 x 9) and its weights (9 x 9, 3 x 3), on the
         longitudinal model's states (:data:`ftc_mc.conventions.STATE_NAMES`).
     alpha : float
-        Discount of the coupled design (the paper's c0's, eq. 43).
+        Discount of the coupled design (the paper's c0's, eq. 43).  The lateral
+        loop is designed at 0.999, so with another discount the coupled law on
+        an uncoupled model is close to, but not exactly, the separate pair.
     lat : LateralDesign
         The lateral loop (its weights are used).
 

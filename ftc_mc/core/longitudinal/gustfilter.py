@@ -585,9 +585,10 @@ def gust_predict_lanes(fkind, xa, P, fm, tw, st, k):
         outputs, the prediction; row ``n + 13``: ``X_{k|k}``), ``crow``, ``jg``,
         ``jc`` and the one-lane buffers of the nonlinear airframe.
     st : LaneState
-        The lanes' Jacobians ``JA`` .. ``JHW`` (read with ``fm.relin > 0``,
-        re-computed first when ``k`` is a multiple of it,
-        :func:`relinearise_lanes`).
+        The lanes' Jacobians ``JA`` .. ``JHW`` (read with ``fm.relin > 0``;
+        when ``k`` is a multiple of it, the state map's are re-computed about
+        ``X_{k|k}`` first, :func:`relinearise_lanes`, and the outputs' about
+        ``X_{k+1|k}`` after the prediction, :func:`relinearise_outputs_lanes`).
     k : int
         Step.
     """

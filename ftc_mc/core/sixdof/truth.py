@@ -35,7 +35,10 @@ One step ``k -> k+1`` on every lane, with the longitudinal commands ``u_k``
    coupled laws (:func:`ftc_mc.design.lateral.coupled_lqr`,
    :func:`ftc_mc.design.lateral.coupled_engine_tables`) less the paper's
    c0 and c1, which ``u`` already holds (``ftc_mc/sim/truth.py``,
-   ``coupled_gains``).
+   ``coupled_controllers``).  The terms are added to the paper's command as
+   the commands stage saturated it (with room for a running excitation), and
+   the sum is clipped again: where the paper's command saturates, the lane
+   flies that clipped sum, not the coupled law's own saturation.
 2. **Faults.** Eq. (2) per actuator, ``e = b0 + (1 - b1) u - b1 u0``; the
    absolute command is ``u0 + e`` (a lock holds ``b0``).  A left and a right
    elevon fault are different faults here: elevator = (left + right)/2,
