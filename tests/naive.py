@@ -89,6 +89,7 @@ class RefModel:
     test: str = "one_step"
     window: int = 1
     min_window: int = 1
+    clip: float = np.inf
     settle: int = 0
     startup: int = 0
     nl: int = 0
@@ -643,7 +644,8 @@ def ref_of(scheme):
                     G=fm.G if gust else None, Ad=fm.Ad if gust else None,
                     Dg=fm.Dg if gust else None, Qg=fm.Qg if gust else None,
                     test=("one_step", "glr")[det.test], window=int(det.window),
-                    min_window=int(det.min_window), settle=int(det.settle),
+                    min_window=int(det.min_window), clip=float(det.clip),
+                    settle=int(det.settle),
                     startup=int(det.startup),
                     nl=int(fm.nl), p=fm.p, x0=fm.x0, y0=fm.y0,
                     Cg=fm.Cg if gust else None, n_sub=int(fm.n_sub), dt=float(fm.dt),
@@ -834,7 +836,7 @@ def filter_update_ref(scheme, st, u, z, k=0, relinearised_already=False):
         stat = None
         if model.test == "glr":
             def stat(e, l=l):
-                ebuf[k % W, :, l] = e
+                ebuf[k % W, :, l] = np.clip(e, -model.clip, model.clip)
                 ecount[l] = min(ecount[l] + 1, W)
                 return glr_ref(ebuf[(k - np.arange(ecount[l])) % W, :, l], model.min_window)
         gate = None

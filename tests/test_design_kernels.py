@@ -171,7 +171,7 @@ def test_glr_against_direct_window():
         shift = rng.uniform(-2.0, 2.0, (3, Lk))
         for k in range(n_steps):
             e = rng.standard_normal((3, Lk)) + (k > 15) * shift
-            glr_lanes(e, ebuf, ecount, k, m_min, stat)
+            glr_lanes(e, ebuf, ecount, k, m_min, np.inf, stat)
             for l in range(Lk):
                 hist[l].append(e[:, l])
                 window = np.array(hist[l][-W:])[::-1]
@@ -188,19 +188,48 @@ def test_glr_against_direct_window():
                 hist[l] = []
     # W = 1 is the one-step test: the statistic is e^2
     e = rng.standard_normal((3, Lk))
-    glr_lanes(e, np.zeros((1, 3, Lk)), np.zeros(Lk, dtype=np.int64), 7, 1, stat)
+    glr_lanes(e, np.zeros((1, 3, Lk)), np.zeros(Lk, dtype=np.int64), 7, 1, np.inf, stat)
     np.testing.assert_allclose(stat, e ** 2, rtol=1e-15)
 
 
+def test_glr_clip():
+    """With ``clip``, ``glr_lanes`` is the GLR of the clipped innovations (against
+    ``naive.glr_ref`` on ``np.clip``): one step's outlier of 40 standard deviations
+    adds at most ``clip`` to a window's sum, a persistent shift below ``clip`` is
+    summed as it is, and ``inf`` changes nothing."""
+    rng = np.random.default_rng(64)
+    Lk, W, m_min, c = 4, 8, 3, 4.0
+    for clip in (c, np.inf):
+        ebuf, ecount = np.zeros((W, 3, Lk)), np.zeros(Lk, dtype=np.int64)
+        stat, hist = np.zeros((3, Lk)), []
+        for k in range(20):
+            e = rng.standard_normal((3, Lk))
+            e[:, 1] += 1.5 * (k >= 10)  # lane 1: a persistent shift below the clip
+            if k == 12:
+                e[:, 0] = 40.0  # lane 0: one step's outlier
+            glr_lanes(e, ebuf, ecount, k, m_min, clip, stat)
+            hist.append(np.clip(e, -clip, clip))
+            window = np.array(hist[-W:])[::-1]
+            for l in range(Lk):
+                np.testing.assert_allclose(stat[:, l], naive.glr_ref(window[:, :, l], m_min),
+                                           rtol=1e-13)
+            if k == 12:  # the outlier's channel can hold at most (m_min - 1 + clip)^2 / m_min
+                big = stat[:, 0].max()
+                assert (big < 3 * c ** 2) if np.isfinite(clip) else (big > 40.0 ** 2 / W)
+        if np.isfinite(clip):
+            assert np.abs(ebuf).max() <= c
+
+
 @pytest.mark.usefixtures("trial_kernel")
-@pytest.mark.parametrize("startup", [0, 8])
-def test_gust_glr_whole_loop(linear_gusts, startup):
+@pytest.mark.parametrize("startup, clip", [(0, np.inf), (8, np.inf), (0, 1.5)])
+def test_gust_glr_whole_loop(linear_gusts, startup, clip):
     """25 steps of ``advance`` with the gust-aware filter, the GLR test and the
     reconfiguring controller, against ``naive.advance_ref``; with a start-up of 8
-    steps no reset comes before the window has filled after it."""
+    steps no reset comes before the window has filled after it; with the
+    innovations clipped at 1.5, the twin clips them too and the resets move."""
     fm, P0, d = gust_filter(linear_gusts)
     scheme = gust_scheme(linear_gusts, fm, window=6, test=TEST_GLR, t_q=12.0, t_nx=12.0,
-                         min_window=2, settle=5, startup=startup)
+                         min_window=2, settle=5, startup=startup, clip=clip)
     flight = linear_gusts.flight._replace(timing=linear_gusts.tim._replace(n_steps=25))
     rng = np.random.default_rng(111)
     inp = random_inputs(linear_gusts, rng, 25)
@@ -210,7 +239,11 @@ def test_gust_glr_whole_loop(linear_gusts, startup):
     rec, _ = assert_loop_matches(scheme, flight, inp, 25, 1e-9)
     assert rec.n_resets.sum() > 0
     first = rec.reset_k[0][rec.n_resets > 0]
-    if startup:  # armed at step 8, the GLR tests changes of >= 2 steps from step 9
+    if np.isfinite(clip):
+        unclipped, _ = assert_loop_matches(scheme._replace(
+            detection=scheme.detection._replace(clip=np.inf)), flight, inp, 25, 1e-9)
+        assert not np.array_equal(rec.reset_k, unclipped.reset_k)
+    elif startup:  # armed at step 8, the GLR tests changes of >= 2 steps from step 9
         assert first.min() >= startup + 1
     else:
         assert first.min() < 8 + 1  # the same lanes reset earlier without the start-up

@@ -544,6 +544,8 @@ class DesignConfig(_Strict):
     """The test is armed this long after the flight's start [s] (a multiple of model.dt_s): before it no block is reset and the GLR window stays empty, so the filter's start-up transient (the truth meets its initial gust at trim) is not tested; 0: armed at once (issue 25)."""
     min_change_s: Pos | None = None
     """Shortest change the GLR tests [s] (a multiple of model.dt_s, at most window_s): a one-step outlier is not a persistent change; null: one step (glr only)."""
+    innovation_clip: Pos | None = None
+    """Each signed normalised innovation enters the GLR window clipped to [-c, c] (glr only): a single step's outlier, such as the n_x spike of a sharp vertical gust (lift's alpha^2 term), then adds at most c to a window's sum, while a persistent change still adds up; null: no clip (docs/designs.md)."""
     signature: Literal["paper", "swapped"] = "swapped"
     """Table 1 as printed (paper) or with its third clause swapped."""
     t_q: Pos = 25.0
@@ -652,6 +654,9 @@ def _check_designs(cfg, listed, where: str, duration: tuple) -> None:
         if d.relinearise_s is not None and d.prediction != "nonlinear":
             raise ValueError(f"designs.{n}.relinearise_s: only with prediction: nonlinear "
                              f"(got prediction: {d.prediction})")
+        if d.innovation_clip is not None and d.test != "glr":
+            raise ValueError(f"designs.{n}.innovation_clip: only with test: glr "
+                             f"(got test: {d.test})")
         if d.test == "glr" and d.min_change_s is not None and d.min_change_s > d.window_s:
             raise ValueError(f"designs.{n}.min_change_s: must not exceed window_s "
                              f"({d.window_s:g} s), got {d.min_change_s:g}")

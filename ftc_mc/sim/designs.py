@@ -243,7 +243,8 @@ def build_design(name: str, dc: DesignConfig, plant: LinearPlant, est: Estimator
                   else int(round(dc.min_change_s / plant.dt)))
     det = _with_test(scaled_reset(detection(plant, s), dc.reset_scale), test, window,
                      min_window)._replace(
-        settle=int(round(dc.settle_s / plant.dt)), startup=int(round(dc.startup_s / plant.dt)))
+        settle=int(round(dc.settle_s / plant.dt)), startup=int(round(dc.startup_s / plant.dt)),
+        clip=math.inf if dc.innovation_clip is None else float(dc.innovation_clip))
     # every field but those Table 1 reads only when it decides (a shared start runs
     # with resets disabled); the excitation policy's are in: it flies before any reset
     key = dc.model_dump_json(exclude={"signature", "t_q", "t_nx"})

@@ -150,7 +150,8 @@ def detection(plant: LinearPlant, s: EstimatorSettings) -> Detection:
                           1.0 / s.t_nx ** 2, 1.0 / s.t_q ** 2, 1.0 / s.t_q ** 2])
     return Detection(thresholds=thresholds_of(s.t_q, s.t_nx),
                      table=decision_table(s.signature), reset_var=reset_var,
-                     test=TEST_ONE_STEP, window=1, min_window=1, settle=0, startup=0)
+                     test=TEST_ONE_STEP, window=1, min_window=1, clip=math.inf, settle=0,
+                     startup=0)
 
 
 def belief_settings(plant: LinearPlant, s: EstimatorSettings) -> Belief:

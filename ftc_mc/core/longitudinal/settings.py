@@ -63,6 +63,8 @@ _DetectionFields = namedtuple("Detection", [
     "test",       # conventions.TEST_ONE_STEP (eqs. 9-11) or TEST_GLR (core/shared/glr.py)
     "window",     # GLR window [steps] (1 with the one-step test)
     "min_window", # shortest change the GLR tests [steps] (1: any; <= window)
+    "clip",       # GLR: each normalised innovation enters the window clipped to
+                  #      [-clip, clip] (inf: none; DesignConfig.innovation_clip)
     "settle",     # steps after a reset during which the other block is not reset (0: none)
     "startup",    # steps from the start before the test is armed: no reset, GLR window
                   # kept empty (0: armed at once; DesignConfig.startup_s, issue 25)

@@ -275,7 +275,7 @@ def correct(path, scheme, st, work):
 def glr_statistics(det, st, k, work):
     """The GLR statistics of the window (:func:`ftc_mc.core.shared.glr.glr_lanes`) in
     place of the one-step residuals ``work.res``."""
-    glr_lanes(work.innov, st.ebuf, st.ecount, k, det.min_window, work.res)
+    glr_lanes(work.innov, st.ebuf, st.ecount, k, det.min_window, det.clip, work.res)
 
 
 @on_path("test", {GLR_TEST: glr_statistics})

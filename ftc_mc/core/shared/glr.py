@@ -18,6 +18,14 @@ replaces ``r_q``, ``r_nx``, ``r_nz`` in Table 1, each channel on its own window.
 After a reset the window restarts (the innovations before it belong to the
 fault the reset answered).  ``W = 1`` gives the one-step test back.
 
+Each innovation may enter the window clipped to ``[-c, c]``
+(``Detection.clip``; ``inf``: not clipped), a Huber-type limit (Huber, *Robust
+Statistics*, 1981, section 4.5): the sum then grows by at most ``c`` per step,
+so one step's outlier of many standard deviations (the n_x spike of a sharp
+vertical gust, whose alpha^2 term the filter's linearisation does not see;
+docs/designs.md) no longer passes a threshold alone, while a persistent shift
+``nu < c`` is summed unchanged.
+
 Plain-NumPy twin: ``tests/naive.py::glr_ref``.
 """
 
@@ -27,7 +35,7 @@ from ..jit import kernel
 
 
 @kernel(inline="always")
-def glr_lanes(innov, ebuf, ecount, k, m_min, stat):
+def glr_lanes(innov, ebuf, ecount, k, m_min, clip, stat):
     """Append step ``k``'s innovations to each lane's window and form the GLR.
 
     Parameters
@@ -44,6 +52,8 @@ def glr_lanes(innov, ebuf, ecount, k, m_min, stat):
         Shortest change tested, ``1 <= m_min <= W``: the maximum runs over
         ``m_min <= k - j + 1``, so an outlier of one step does not count as a
         persistent change; 0 until the window holds ``m_min`` innovations.
+    clip : float
+        Each innovation is stored clipped to ``[-clip, clip]`` (``inf``: as is).
     stat : ndarray, shape (c, L)
         Written with ``g_k`` per channel and lane.
     """
@@ -53,7 +63,8 @@ def glr_lanes(innov, ebuf, ecount, k, m_min, stat):
     p = k % W
     for c in range(nc):
         for l in range(L):
-            ebuf[p, c, l] = innov[c, l]
+            e = innov[c, l]
+            ebuf[p, c, l] = clip if e > clip else (-clip if e < -clip else e)
     for l in range(L):
         m = ecount[l] + 1
         ecount[l] = m if m < W else W

@@ -634,7 +634,7 @@ def monitor_decide(mon, flight, k, st, work, rec, num, den):
         for l in range(L):
             st.mcount[l] = 0
         return
-    glr_lanes(innov, st.mbuf, st.mcount, k, mon.min_window, stat)
+    glr_lanes(innov, st.mbuf, st.mcount, k, mon.min_window, np.inf, stat)
     block = np.zeros(L, dtype=np.int64)
     for l in range(L):
         best = mon.threshold
