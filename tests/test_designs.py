@@ -206,6 +206,22 @@ def test_gust_aware_glr_design():
     assert (det.t_q, det.t_nx, det.test, det.window) == (10.0, 12.0, TEST_GLR, 10)
     assert np.isinf(setup.detection("gust_glr", np.inf, np.inf).t_q)
     assert d.key != p.key
+    assert np.isinf(d.det.clip) and np.isinf(det.clip)
+
+
+def test_innovation_clip_reaches_every_detection():
+    """``innovation_clip`` is the design's ``Detection.clip``, at its own thresholds
+    and at a sweep point (a sweep once rebuilt the detection without it); a
+    design without it does not clip."""
+    from ftc_mc.sim.setup import build_setup
+
+    clipped = {**GUST_GLR, "innovation_clip": 4.0}
+    setup = build_setup(config(designs={"c": clipped, "g": GUST_GLR},
+                               campaign={"designs": ["c", "g"]}))
+    assert setup.det["c"].clip == 4.0 and np.isinf(setup.det["g"].clip)
+    assert setup.detection("c", 10.0, 12.0).clip == 4.0
+    assert np.isinf(setup.detection("g", 10.0, 12.0).clip)
+    assert setup.designs["c"].key != setup.designs["g"].key
 
 
 def test_relinearise_design():

@@ -543,7 +543,7 @@ class DesignConfig(_Strict):
     startup_s: NonNeg = 0.0
     """The test is armed this long after the flight's start [s] (a multiple of model.dt_s): before it no block is reset and the GLR window stays empty, so the filter's start-up transient (the truth meets its initial gust at trim) is not tested; 0: armed at once (issue 25)."""
     min_change_s: Pos | None = None
-    """Shortest change the GLR tests [s] (a multiple of model.dt_s, at most window_s): a one-step outlier is not a persistent change; null: one step (glr only)."""
+    """Shortest change the GLR tests [s] (a multiple of model.dt_s, at most window_s): a one-step outlier is not a persistent change (it is divided by this length, not removed: innovation_clip limits it); null: one step (glr only)."""
     innovation_clip: Pos | None = None
     """Each signed normalised innovation enters the GLR window clipped to [-c, c] (glr only): a single step's outlier, such as the n_x spike of a sharp vertical gust (lift's alpha^2 term), then adds at most c to a window's sum, while a persistent change still adds up; null: no clip (docs/designs.md)."""
     signature: Literal["paper", "swapped"] = "swapped"

@@ -149,7 +149,7 @@ class Design:
         det = scaled_reset(detection(plant, dataclasses.replace(self.est, t_q=t_q, t_nx=t_nx)),
                            self.reset_scale)
         return _with_test(det, self.test, self.window, self.det.min_window)._replace(
-            settle=self.det.settle, startup=self.det.startup)
+            settle=self.det.settle, startup=self.det.startup, clip=self.det.clip)
 
 
 def builtin_design(name: str, est: EstimatorConfig) -> DesignConfig:
