@@ -146,10 +146,11 @@ class Design:
         """
         if math.isinf(t_q) and math.isinf(t_nx):
             return self.det._replace(t_q=math.inf, t_nx=math.inf)
+        # only the thresholds and the reset variances follow (t_q, t_nx); every other
+        # field stays the design's (a sweep once lost its innovation_clip here)
         det = scaled_reset(detection(plant, dataclasses.replace(self.est, t_q=t_q, t_nx=t_nx)),
                            self.reset_scale)
-        return _with_test(det, self.test, self.window, self.det.min_window)._replace(
-            settle=self.det.settle, startup=self.det.startup, clip=self.det.clip)
+        return self.det._replace(thresholds=det.thresholds, reset_var=det.reset_var)
 
 
 def builtin_design(name: str, est: EstimatorConfig) -> DesignConfig:
