@@ -7,9 +7,9 @@ plant and the controller selection it never calls (``docs/performance.md``,
 lesson 11).  Instead, the choices that select large kernels travel as
 *types*: a :class:`Path` of empty marker namedtuples, one per choice, passed
 as the first argument of :func:`ftc_mc.core.longitudinal.trial.advance` and of the stages.
-At each point where the paths part, a dispatcher (a stub with a
-``numba.extending.overload``) looks at the marker's type while the caller is
-being typed and hands over one implementation; the others are never typed,
+At each point where the paths part, a dispatcher (a stub with a typing
+template and a lowering of its own, :func:`on_path`) looks at the marker's
+type while the caller is being typed and calls one implementation; the others are never typed,
 lowered or optimised.  Each path is one signature of ``advance``, compiled on
 its first use and cached on disk like any other.
 
@@ -40,17 +40,11 @@ from the settings in one place, :func:`ftc_mc.sim.paths.path_of`.
 from __future__ import annotations
 
 import importlib
-import inspect
 from collections import namedtuple
 
 from numba import types
-from numba.extending import overload
-
-from ..jit import OPTIONS
-
-_JIT_OPTIONS = {k: v for k, v in OPTIONS.items() if k != "cache"}
-"""The kernels' options for the dispatchers' chosen calls (compiled into their
-caller, which is cached)."""
+from numba.core.imputils import lower_builtin
+from numba.core.typing.templates import AbstractTemplate, infer_global, signature
 
 Path = namedtuple("Path", ["plant", "filter", "test", "control"])
 """The compile path of a trial kernel call: one marker per choice (module
@@ -142,14 +136,15 @@ def on_path(field: str, impls: dict, passes: str | None = None):
     the same choice); with ``passes="path"``, the first argument as it is
     (another dispatcher).
 
-    The choice is made while the caller is typed (a
-    ``numba.extending.overload``), so the kernels of the other markers are
-    never compiled.  The chosen kernels are ``@kernel`` functions of their own
-    (cached on disk) that take no :class:`Path`: compiled once, whatever the
-    path that calls them, and loaded from the cache by every later path.  The
-    call between is a small function of its own, not inlined into the
-    caller's IR: Numba's typed inlining of overloads gave wrong results inside
-    the trial loop (lanes read as out of the envelope at the first step;
+    The choice is made while the caller is typed (a typing template and a
+    lowering of the stub's own, :func:`_register_dispatch`), so the kernels
+    of the other markers are never compiled.  The chosen kernels are
+    ``@kernel`` functions of their own (cached on disk) that take no
+    :class:`Path`: compiled once, whatever the path that calls them, and
+    loaded from the cache by every later path.  The caller calls the chosen
+    kernel directly, as it calls any other kernel; nothing is IR-inlined
+    (Numba's typed inlining of overloads gave wrong results inside the trial
+    loop: lanes read as out of the envelope at the first step;
     ``docs/performance.md`` lesson 11).
 
     Parameters
@@ -167,25 +162,74 @@ def on_path(field: str, impls: dict, passes: str | None = None):
     table = _LazyTable({type(m): f for m, f in impls.items()})
 
     def decorate(stub):
-        params = list(inspect.signature(stub).parameters)
-        first, rest = params[0], ", ".join(params[1:])
-        arglist = ", ".join(params)
-        lead = {None: "", "path": f"{first}, ",
-                "marker": f"{first}.{field}, "}[passes]
-        # the overload must take the stub's own parameter names: written out
-        src = (f"def overload_of({arglist}):\n"
-               f"    impl = table.get(_marker_class({first}, field))\n"
-               f"    if impl is None:\n"
-               f"        return lambda {arglist}: None\n"
-               f"    if passes == 'marker' and not _is_path({first}):\n"
-               f"        return lambda {arglist}: impl({first}, {rest})\n"
-               f"    return lambda {arglist}: impl({lead}{rest})\n")
-        scope = {"table": table, "_marker_class": _marker_class, "field": field,
-                 "passes": passes, "_is_path": _is_path}
-        exec(src, scope)  # noqa: S102 -- source built above from the stub's names
-        overload(stub, jit_options=_JIT_OPTIONS)(scope["overload_of"])
+        _register_dispatch(stub, field, table, passes)
         return stub
     return decorate
+
+
+def _register_dispatch(stub, field: str, table: "_LazyTable", passes):
+    """Type and lower ``stub(first, *rest)`` as a direct call of the chosen
+    kernel (``on_path``).
+
+    The call is lowered in the caller itself: no function of its own sits
+    between the caller and the kernel.  (A ``numba.extending.overload``
+    returning ``lambda ...: impl(...)`` compiled that lambda as a library of
+    its own, which linked, re-optimised and re-emitted a whole copy of the
+    kernel it called: 20 of the default path's 120 s of cold compile,
+    ``docs/performance.md`` lesson 11.)
+    """
+
+    def chosen(first):
+        """The kernel for the first argument's type, and the argument types it
+        takes first (the marker or the path, or nothing)."""
+        impl = table.get(_marker_class(first, field))
+        if passes == "marker":
+            lead = (first.types[Path._fields.index(field)] if _is_path(first) else first,)
+        elif passes == "path":
+            lead = (first,)
+        else:
+            lead = ()
+        return impl, lead
+
+    def inner_signature(typing_context, args):
+        """The chosen kernel's Numba type and its signature for ``args``
+        (``None, None`` when the path has no kernel here)."""
+        impl, lead = chosen(args[0])
+        if impl is None:
+            return None, None
+        inner = tuple(types.unliteral(a) for a in lead + tuple(args[1:]))
+        # a kernel, or another dispatcher stub (``passes="path"``)
+        fnty = typing_context.resolve_value_type(impl)
+        return fnty, fnty.get_call_type(typing_context, inner, {})
+
+    class _Typer(AbstractTemplate):
+        key = stub
+
+        def generic(self, args, kws):
+            if kws:
+                raise TypeError(f"{stub.__name__}: keyword arguments are not supported")
+            impl, sig = inner_signature(self.context, args)
+            return signature(types.none if impl is None else sig.return_type, *args)
+
+    infer_global(stub, types.Function(_Typer))
+
+    @lower_builtin(stub, types.VarArg(types.Any))
+    def _lower(context, builder, sig, args):
+        impl, inner = inner_signature(context.typing_context, sig.args)
+        if impl is None:
+            return context.get_dummy_value()
+        first, rest = sig.args[0], sig.args[1:]
+        if passes == "marker":
+            lead = [builder.extract_value(args[0], Path._fields.index(field))
+                    if _is_path(first) else args[0]]
+        elif passes == "path":
+            lead = [args[0]]
+        else:
+            lead = []
+        given = list(chosen(first)[1]) + list(rest)
+        values = [context.cast(builder, v, t, want) for v, t, want
+                  in zip(lead + list(args[1:]), given, inner.args)]
+        return context.get_function(impl, inner)(builder, values)
 
 
 class _LazyTable(dict):
