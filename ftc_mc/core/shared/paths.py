@@ -9,9 +9,9 @@ lesson 11).  Instead, the choices that select large kernels travel as
 as the first argument of :func:`ftc_mc.core.longitudinal.trial.advance` and of the stages.
 At each point where the paths part, a dispatcher (a stub with a typing
 template and a lowering of its own, :func:`on_path`) looks at the marker's
-type while the caller is being typed and calls one implementation; the others are never typed,
-lowered or optimised.  Each path is one signature of ``advance``, compiled on
-its first use and cached on disk like any other.
+type while the caller is being typed and calls one implementation; the others
+are never typed, lowered or optimised.  Each path is one signature of
+``advance``, compiled on its first use and cached on disk like any other.
 
 The choices:
 
@@ -179,25 +179,24 @@ def _register_dispatch(stub, field: str, table: "_LazyTable", passes):
     ``docs/performance.md`` lesson 11.)
     """
 
-    def chosen(first):
-        """The kernel for the first argument's type, and the argument types it
-        takes first (the marker or the path, or nothing)."""
-        impl = table.get(_marker_class(first, field))
-        if passes == "marker":
-            lead = (first.types[Path._fields.index(field)] if _is_path(first) else first,)
-        elif passes == "path":
-            lead = (first,)
-        else:
-            lead = ()
-        return impl, lead
+    at = Path._fields.index(field)
+
+    def lead_types(first) -> tuple:
+        """The types of what the kernel gets before the stub's other
+        arguments: the marker, the path, or nothing (``passes``)."""
+        if passes is None:
+            return ()
+        if passes == "marker" and _is_path(first):
+            return (first.types[at],)
+        return (first,)
 
     def inner_signature(typing_context, args):
         """The chosen kernel's Numba type and its signature for ``args``
         (``None, None`` when the path has no kernel here)."""
-        impl, lead = chosen(args[0])
+        impl = table.get(_marker_class(args[0], field))
         if impl is None:
             return None, None
-        inner = tuple(types.unliteral(a) for a in lead + tuple(args[1:]))
+        inner = tuple(types.unliteral(a) for a in lead_types(args[0]) + tuple(args[1:]))
         # a kernel, or another dispatcher stub (``passes="path"``)
         fnty = typing_context.resolve_value_type(impl)
         return fnty, fnty.get_call_type(typing_context, inner, {})
@@ -218,17 +217,14 @@ def _register_dispatch(stub, field: str, table: "_LazyTable", passes):
         impl, inner = inner_signature(context.typing_context, sig.args)
         if impl is None:
             return context.get_dummy_value()
-        first, rest = sig.args[0], sig.args[1:]
-        if passes == "marker":
-            lead = [builder.extract_value(args[0], Path._fields.index(field))
-                    if _is_path(first) else args[0]]
-        elif passes == "path":
-            lead = [args[0]]
+        first = sig.args[0]
+        lead = lead_types(first)
+        if passes == "marker" and _is_path(first):  # the marker, read from the path
+            lead_values = [builder.extract_value(args[0], at)]
         else:
-            lead = []
-        given = list(chosen(first)[1]) + list(rest)
+            lead_values = list(args[:len(lead)])
         values = [context.cast(builder, v, t, want) for v, t, want
-                  in zip(lead + list(args[1:]), given, inner.args)]
+                  in zip(lead_values + list(args[1:]), lead + sig.args[1:], inner.args)]
         return context.get_function(impl, inner)(builder, values)
 
 
