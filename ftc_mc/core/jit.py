@@ -32,7 +32,7 @@ import os
 from pathlib import Path
 
 import numba
-from numba.core import caching
+from numba.core import caching, sigutils
 
 CACHE = os.environ.get("FTC_MC_NUMBA_CACHE", "1") != "0"
 
@@ -239,14 +239,75 @@ class ContentCacheImpl(caching.FunctionCache._impl_class):
                         *caching.FunctionCache._impl_class._locator_classes]
 
 
+CLAIM_WAIT_LIMIT_S = 900.0
+"""Longest wait for a kernel another process has claimed [s]
+(:meth:`ContentFunctionCache.load_overload`); then this process compiles it."""
+
+
+def _claim_held(fd: int) -> bool:
+    """Whether another process holds the ``flock`` of the open claim ``fd``."""
+    import fcntl
+    try:
+        fcntl.flock(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)
+    except BlockingIOError:
+        return True
+    fcntl.flock(fd, fcntl.LOCK_UN)
+    return False
+
+
 class ContentFunctionCache(caching.FunctionCache):
     """The on-disk cache of one kernel (:func:`kernel`): Numba's, located by
     :class:`ContentCacheImpl`, that saves nothing once the kernel sources have
     changed while this process ran (:func:`sources_unchanged`), and says so once
-    on stderr."""
+    on stderr.
+
+    A process that compiles part of a path for another (the compile helper,
+    :mod:`ftc_mc.sim.compile_helper`) *claims* each kernel signature it will
+    compile: it holds ``flock`` on the file :meth:`claim_path` until the
+    kernel is saved.  Before loading or compiling a signature,
+    :meth:`load_overload` waits while its claim is held (at most
+    :data:`CLAIM_WAIT_LIMIT_S`), so the kernel is loaded from the cache instead
+    of compiled twice.  A claim no live process holds is not waited for, and a
+    process that claims waits for no claim (:attr:`awaits_claims`), so waits
+    never form a cycle.
+    """
 
     _impl_class = ContentCacheImpl
     _warned = False
+    awaits_claims = True
+    """Whether this process waits for claims; a compile helper, which holds
+    claims, does not (so two helpers never wait for each other)."""
+
+    def claim_path(self, sig) -> Path:
+        """The claim file of the signature ``sig`` (argument types) of this
+        kernel: in its cache folder, named after the kernel, its line and a
+        digest of the signature's text."""
+        args, _ = sigutils.normalize_signature(sig)
+        digest = hashlib.sha256(str(tuple(args)).encode()).hexdigest()[:16]
+        name = f"{self._py_func.__qualname__}-{self._py_func.__code__.co_firstlineno}"
+        return Path(self._cache_path) / f"{name}.{digest}.claim"
+
+    def load_overload(self, sig, target_context):
+        self._await_claim(sig)
+        return super().load_overload(sig, target_context)
+
+    def _await_claim(self, sig) -> None:
+        """Wait while another process holds the claim of ``sig`` (class docstring)."""
+        import time
+        if not self.awaits_claims:
+            return
+        try:
+            fd = os.open(self.claim_path(sig), os.O_RDONLY)
+        except (OSError, ValueError, TypeError):
+            return  # no claim (or no claim can be named): nothing to wait for
+        try:
+            deadline = time.monotonic() + CLAIM_WAIT_LIMIT_S
+            while _claim_held(fd) and time.monotonic() < deadline:
+                time.sleep(0.02)
+        except (ImportError, OSError):
+            pass  # no flock here: compile without waiting
+        finally:
+            os.close(fd)
 
     def _save_overload(self, sig, data):
         if not sources_unchanged():
@@ -365,6 +426,18 @@ def in_disk_cache(dispatcher, first=None) -> bool | None:
     code_hash = hashlib.sha256(dispatcher.py_func.__code__.co_code).hexdigest()
     keys = [k for k in index.keys() if first is None or _first_arg(k) == first]
     return index_has_overload(keys, magic, code_hash)
+
+
+def cached_signature(dispatcher, sig) -> bool:
+    """Whether Numba's on-disk cache holds ``dispatcher``'s overload for the
+    signature ``sig`` (argument types) on this machine and source; False when
+    that cannot be told."""
+    try:
+        cache = dispatcher._cache
+        key = cache._index_key(sig, dispatcher.targetctx.codegen())
+        return key in cache._cache_file._load_index()
+    except Exception:  # noqa: BLE001 -- numba internals; then it is compiled
+        return False
 
 
 def _first_arg(key):

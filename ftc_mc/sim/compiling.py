@@ -24,6 +24,7 @@ from ..core import jit
 from ..core.shared.paths import (LinearPlant, NonlinearPlant, SixdofExtendedPlant, SixdofPlant,
                                  describe)
 from ..io.lock import waiting
+from . import compile_helper
 
 WAIT_NOTICE = ("ftc-mc: another process is compiling the simulation kernels; waiting "
                "for it, then loading them")
@@ -75,7 +76,9 @@ def compiled_once(dispatcher, path=None, stream=None):
     :data:`WAIT_LIMIT_S`).  If the holder filled the cache meanwhile, the lock
     is let go at once and the block loads the kernel; otherwise the block
     announces the compile (:func:`ftc_mc.core.jit.announce_compile`) and runs
-    holding the lock.
+    holding the lock, with a compile helper (:mod:`ftc_mc.sim.compile_helper`)
+    compiling the later stages of ``path`` in a second process meanwhile; the
+    helper is ended when the block ends.
     Without a disk cache (``FTC_MC_NUMBA_CACHE=0``) there is nothing to share:
     the block only announces.
 
@@ -111,6 +114,8 @@ def compiled_once(dispatcher, path=None, stream=None):
         needed = jit.needs_compile(dispatcher, first)  # again: the holder may have filled it
         if needed is not True:
             stack.close()  # the holder filled the cache: load it without the lock
+        elif path is not None:
+            stack.callback(compile_helper.stop, compile_helper.start(path))
         with _timed(jit.announce_compile(dispatcher, what, expected_compile(path), out,
                                          needed), out):
             yield

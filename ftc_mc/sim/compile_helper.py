@@ -1,0 +1,212 @@
+"""A second process that compiles part of a path while this one compiles the rest.
+
+Numba compiles a kernel on one core: a path's cold compile
+(:func:`ftc_mc.sim.compiling.compiled_once`) types :func:`advance
+<ftc_mc.core.longitudinal.trial.advance>`, and each stage it calls (the truth
+plant, the filter's prediction and correction, the selection, ...) is compiled
+in full, one after another, when its call is typed.  Those stages do not depend
+on each other, so on a machine with two cores a helper process compiles the
+later ones into the kernel cache while this process compiles the earlier ones;
+when this process reaches a stage the helper has done it loads it from the cache,
+and one the helper is still compiling it waits for (the *claims* of
+:class:`ftc_mc.core.jit.ContentFunctionCache`).  ``advance``'s own compile,
+which links every stage, stays in this process (measured: ``docs/performance.md``,
+lesson 11).
+
+The helper must know each stage's Numba signature before ``advance`` is typed.
+The *compile plan* (:data:`PLAN_FILE`, written by ``scripts/make_compile_plan.py``)
+holds, per path of the shipped configs, the stages ``advance`` compiles, in the
+order it compiles them, with their argument types and the seconds each took.
+A plan that no longer matches the kernels costs only the helper's work: the
+cache is keyed on the signature and the kernel sources, so a stage compiled
+for a signature ``advance`` no longer uses is never loaded, and this process
+compiles whatever it finds missing.  Results never depend on the helper.
+
+Run as ``python -m ftc_mc.sim.compile_helper KEY [--plan FILE]`` by
+:func:`start`; ``FTC_MC_COMPILE_HELPER=0`` turns it off.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import os
+import pickle
+import subprocess
+import sys
+from pathlib import Path
+
+import numba
+
+from ..core import jit
+from ..core.shared.paths import describe
+
+PLAN_FILE = Path(__file__).with_name("compile_plan.pkl")
+"""The compile plan shipped with the package (module docstring)."""
+
+STOP_WAIT_S = 5.0
+"""How long :func:`stop` waits for a helper it asked to end [s]."""
+
+
+def enabled() -> bool:
+    """Whether a compile helper may run: the disk cache is on, ``flock``
+    exists, ``FTC_MC_COMPILE_HELPER`` is not ``0`` and this process may use at
+    least two cores."""
+    if not jit.CACHE or os.environ.get("FTC_MC_COMPILE_HELPER", "1") == "0":
+        return False
+    try:
+        import fcntl  # noqa: F401 -- the claims are flocks
+    except ImportError:
+        return False
+    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
+    return (cores or 1) >= 2
+
+
+def plan_key(path) -> str:
+    """The key of a compile path in the plan: its words
+    (:func:`ftc_mc.core.shared.paths.describe`)."""
+    return describe(path)
+
+
+def load_plan(plan_file: Path = PLAN_FILE) -> dict:
+    """The plan's paths: ``{key: {"before_s": s, "stages": [(module, qualname,
+    argument types, seconds), ...]}}``; empty when the file is missing, cannot
+    be read, or was written by another Numba version (whose types may differ)."""
+    try:
+        with open(plan_file, "rb") as f:
+            plan = pickle.load(f)
+    except Exception:  # noqa: BLE001 -- no plan: this process compiles alone
+        return {}
+    if not isinstance(plan, dict) or plan.get("numba") != numba.__version__:
+        return {}
+    return plan.get("paths", {})
+
+
+def helper_share(stages, before_s: float) -> list:
+    """The stages the helper compiles: the tail of ``stages`` (in this
+    process's compile order) that best balances the two processes' work,
+    this process having ``before_s`` seconds of compile before ``advance``'s
+    first stage.
+
+    Parameters
+    ----------
+    stages : list of tuple
+        One tuple per stage, in compile order, its compile seconds last
+        (the plan's ``(module, qualname, argument types, seconds)``).
+    before_s : float
+        Seconds this process compiles before the first stage [s].
+    """
+    secs = [s[3] for s in stages]
+    best, cut = float("inf"), len(stages)
+    for k in range(len(stages) + 1):
+        longest = max(before_s + sum(secs[:k]), sum(secs[k:]))
+        if longest < best:
+            best, cut = longest, k
+    return list(stages[cut:])
+
+
+def start(path, plan_file: Path = PLAN_FILE):
+    """Start the helper for the compile ``path`` if it may run (:func:`enabled`)
+    and the plan knows the path; return its process, or None."""
+    if not enabled():
+        return None
+    key = plan_key(path)
+    if key not in load_plan(plan_file):
+        return None
+    cmd = [sys.executable, "-m", __name__, key, "--plan", str(plan_file)]
+    try:
+        return subprocess.Popen(cmd, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
+                                stderr=subprocess.DEVNULL)
+    except OSError:
+        return None
+
+
+def stop(proc) -> None:
+    """End the helper ``proc`` (from :func:`start`) if it still runs: this
+    process has compiled the path, so what is left of the helper's work is
+    for signatures the path did not use (a stale plan)."""
+    if proc is None or proc.poll() is not None:
+        return
+    proc.terminate()
+    try:
+        proc.wait(STOP_WAIT_S)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        proc.wait()
+
+
+def _dispatcher(module: str, qualname: str):
+    """The kernel ``module.qualname`` if it is a cached kernel of ``core/``."""
+    obj = importlib.import_module(module)
+    for part in qualname.split("."):
+        obj = getattr(obj, part)
+    return obj if isinstance(getattr(obj, "_cache", None), jit.ContentFunctionCache) else None
+
+
+def _claim(dispatcher, args):
+    """Take the claim of ``dispatcher``'s signature ``args``; the open file,
+    or None if another process holds it."""
+    import fcntl
+    path = dispatcher._cache.claim_path(args)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd = os.open(path, os.O_CREAT | os.O_RDWR, 0o644)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        os.close(fd)
+        return None
+    return fd, path
+
+
+def _release(claim) -> None:
+    """Let go of a claim from :func:`_claim`, deleting its file first."""
+    fd, path = claim
+    try:
+        path.unlink()
+    except OSError:
+        pass
+    os.close(fd)
+
+
+def run(key: str, plan_file: Path = PLAN_FILE) -> int:
+    """The helper's work: claim its share (:func:`helper_share`) of the path
+    ``key``'s stages that the cache lacks (those it holds, from another path
+    compiled before, cost this process nothing), then compile them in order,
+    letting go of each claim when its kernel is saved.  Returns the exit
+    status (0, or 1 when the plan does not know ``key``)."""
+    entry = load_plan(plan_file).get(key)
+    if entry is None:
+        return 1
+    parent = os.getppid()
+    jit.ContentFunctionCache.awaits_claims = False  # never wait: no cycle of waits
+    todo = []
+    for module, qualname, args, seconds in entry["stages"]:
+        dispatcher = _dispatcher(module, qualname)
+        if dispatcher is not None and not jit.cached_signature(dispatcher, args):
+            todo.append((dispatcher, qualname, args, seconds))
+    claimed = []
+    for dispatcher, _, args, _ in helper_share(todo, entry["before_s"]):
+        claim = _claim(dispatcher, args)
+        if claim is not None:
+            claimed.append((dispatcher, args, claim))
+    for dispatcher, args, claim in claimed:
+        if os.getppid() != parent:  # the process it works for has gone
+            return 0
+        try:
+            dispatcher.compile(tuple(args))
+        finally:
+            _release(claim)
+    return 0
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m ftc_mc.sim.compile_helper",
+                                 description=__doc__.splitlines()[0])
+    ap.add_argument("key", help="the path's key in the plan (its words)")
+    ap.add_argument("--plan", type=Path, default=PLAN_FILE, help="the compile plan file")
+    a = ap.parse_args(argv)
+    return run(a.key, a.plan)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

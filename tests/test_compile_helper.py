@@ -1,0 +1,247 @@
+"""The compile helper (sim/compile_helper.py) and the kernel claims it holds
+(core/jit.py ``ContentFunctionCache``): a second process compiles the later
+stages of a path into the cache while this one compiles the earlier ones.
+
+The protocol runs on one small kernel of ``core/`` in a separate Numba cache
+folder; the shipped plan is checked against the default path's own compile.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import pickle
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import numba
+import pytest
+
+from ftc_mc.core import jit
+from ftc_mc.core.shared import excitation
+from ftc_mc.sim import compile_helper
+from ftc_mc.sim.compile_helper import helper_share, load_plan, plan_key
+
+ROOT = Path(__file__).resolve().parents[1]
+MODULE, NAME = excitation.__name__, "doublet_length"
+ARGS = (numba.int64,)
+
+needs_cache = pytest.mark.skipif(not jit.CACHE, reason="FTC_MC_NUMBA_CACHE=0")
+
+
+def _stage(name, seconds):
+    return ("m", name, (), seconds)
+
+
+def test_the_helper_takes_the_tail_that_balances_the_two_processes():
+    # by hand: this process does `before` plus the head, the helper the tail
+    four = [_stage(c, 10.0) for c in "abcd"]
+    assert [s[1] for s in helper_share(four, 0.0)] == ["c", "d"]  # 20 / 20
+    assert [s[1] for s in helper_share(four, 20.0)] == ["b", "c", "d"]  # 20 / 30
+    assert [s[1] for s in helper_share(four, 100.0)] == ["a", "b", "c", "d"]
+    uneven = [_stage("a", 2.0), _stage("b", 2.0), _stage("c", 20.0), _stage("d", 19.0)]
+    assert [s[1] for s in helper_share(uneven, 4.0)] == ["d"]  # 28 / 19, not 8 / 39
+    assert helper_share([], 5.0) == []
+
+
+def test_the_helper_shares_only_what_the_cache_lacks(monkeypatch):
+    """Stages another path left in the cache cost nothing: the helper balances
+    the rest (by hand: a, b, d of 10 s each, c cached -> the helper takes b and
+    d; blind to the cache it would take c and d, and c is no work), and
+    compiles its share in this process's order, never waiting for claims."""
+    compiled = []
+
+    class Fake:
+        def __init__(self, name):
+            self.name = name
+
+        def compile(self, args):
+            compiled.append(self.name)
+
+    plan = {"p": {"before_s": 0.0, "stages": [("m", c, (), 10.0) for c in "abcd"]}}
+    monkeypatch.setattr(compile_helper, "load_plan", lambda f: plan)
+    monkeypatch.setattr(compile_helper, "_dispatcher", lambda m, q: Fake(q))
+    monkeypatch.setattr(jit, "cached_signature", lambda d, args: d.name == "c")
+    monkeypatch.setattr(compile_helper, "_claim", lambda d, args: d.name)
+    released = []
+    monkeypatch.setattr(compile_helper, "_release", released.append)
+    monkeypatch.setattr(jit.ContentFunctionCache, "awaits_claims", True)
+    assert compile_helper.run("p") == 0
+    assert compiled == ["b", "d"] and released == ["b", "d"]
+    assert jit.ContentFunctionCache.awaits_claims is False
+    assert compile_helper.run("unknown") == 1
+
+
+def _write_plan(path: Path, version=None) -> Path:
+    plan = {"numba": version or numba.__version__,
+            "paths": {"probe path": {"before_s": 0.0,
+                                     "stages": [(MODULE, NAME, ARGS, 1.0)]}}}
+    path.write_bytes(pickle.dumps(plan, protocol=4))
+    return path
+
+
+def test_a_plan_of_another_numba_or_unreadable_is_not_used(tmp_path):
+    assert load_plan(_write_plan(tmp_path / "ok.pkl")) == {
+        "probe path": {"before_s": 0.0, "stages": [(MODULE, NAME, ARGS, 1.0)]}}
+    assert load_plan(_write_plan(tmp_path / "old.pkl", version="0.1.0")) == {}
+    (tmp_path / "junk.pkl").write_bytes(b"not a pickle")
+    assert load_plan(tmp_path / "junk.pkl") == {}
+    assert load_plan(tmp_path / "missing.pkl") == {}
+
+
+def test_no_helper_when_switched_off_or_the_path_is_unknown(tmp_path, monkeypatch):
+    from ftc_mc.core.shared.paths import (LINEAR_PLANT, ONE_STEP_TEST, PAPER_FILTER,
+                                          RECONFIGURING, Path as Path_)
+    path = Path_(LINEAR_PLANT, PAPER_FILTER, ONE_STEP_TEST, RECONFIGURING)
+    plan = _write_plan(tmp_path / "plan.pkl")  # knows only "probe path"
+    assert compile_helper.start(path, plan) is None
+    monkeypatch.setenv("FTC_MC_COMPILE_HELPER", "0")
+    assert not compile_helper.enabled()
+    monkeypatch.setattr(compile_helper, "plan_key", lambda p: "probe path")
+    assert compile_helper.start(path, plan) is None
+
+
+@needs_cache
+def test_a_held_claim_is_waited_for_and_a_free_one_is_not():
+    """``load_overload`` waits while another open file holds the claim's flock
+    (flocks of two open files conflict within one process as across two), and
+    not once it is let go, nor in a process that claims itself."""
+    d = getattr(excitation, NAME)
+    cache = d._cache
+    claim = compile_helper._claim(d, ARGS)
+    assert claim is not None and claim[1] == cache.claim_path(ARGS)
+    assert claim[1].parent == Path(cache.cache_path)
+    done = threading.Event()
+
+    def load():
+        cache.load_overload(ARGS, d.targetctx)
+        done.set()
+
+    t0 = time.perf_counter()
+    th = threading.Thread(target=load, daemon=True)
+    th.start()
+    assert not done.wait(0.5)  # held: it waits
+    try:
+        cache.awaits_claims = False  # a helper's own loads do not wait
+        t1 = time.perf_counter()
+        cache.load_overload(ARGS, d.targetctx)
+        assert time.perf_counter() - t1 < 0.4
+    finally:
+        del cache.awaits_claims
+    compile_helper._release(claim)
+    assert done.wait(10) and time.perf_counter() - t0 >= 0.5
+    th.join(10)
+    assert not claim[1].exists()
+    # a claim file nobody holds (a helper that died before deleting it)
+    claim[1].touch()
+    try:
+        t1 = time.perf_counter()
+        cache.load_overload(ARGS, d.targetctx)
+        assert time.perf_counter() - t1 < 0.4
+    finally:
+        claim[1].unlink()
+
+
+PROBE = f'''
+import json, sys
+from ftc_mc.core import jit
+from ftc_mc.core.shared import excitation
+d = excitation.{NAME}
+value = d(3)
+print(json.dumps({{"value": value, "hits": sum(d.stats.cache_hits.values()),
+                  "misses": sum(d.stats.cache_misses.values())}}))
+'''
+
+
+def _env(cache: Path) -> dict:
+    env = {k: v for k, v in os.environ.items() if k != "FTC_MC_NUMBA_CACHE"}
+    env.update(NUMBA_CACHE_DIR=str(cache), PYTHONPATH=str(ROOT))
+    return env
+
+
+@needs_cache
+def test_the_helper_compiles_its_share_and_this_process_loads_it(tmp_path):
+    """``python -m ftc_mc.sim.compile_helper KEY --plan F`` compiles the plan's
+    stage into the cache and leaves no claim; a process then loads the kernel
+    (a cache hit, no compile) and computes the same value as one that
+    compiled it itself."""
+    plan = _write_plan(tmp_path / "plan.pkl")
+    alone = subprocess.run([sys.executable, "-c", PROBE], env=_env(tmp_path / "alone"),
+                           capture_output=True, text=True, timeout=300, cwd=ROOT)
+    assert alone.returncode == 0, alone.stderr
+    alone = json.loads(alone.stdout)
+    assert alone["misses"] == 1 and alone["hits"] == 0
+    env = _env(tmp_path / "shared")
+    helper = subprocess.run([sys.executable, "-m", "ftc_mc.sim.compile_helper", "probe path",
+                             "--plan", str(plan)], env=env, capture_output=True, text=True,
+                            timeout=300, cwd=ROOT)
+    assert helper.returncode == 0, helper.stderr
+    assert not list((tmp_path / "shared").rglob("*.claim"))
+    assert list((tmp_path / "shared").rglob("excitation.doublet_length-*.nbi"))
+    loaded = subprocess.run([sys.executable, "-c", PROBE], env=env, capture_output=True,
+                            text=True, timeout=300, cwd=ROOT)
+    assert loaded.returncode == 0, loaded.stderr
+    loaded = json.loads(loaded.stdout)
+    assert loaded == {"value": alone["value"], "hits": 1, "misses": 0}
+    unknown = subprocess.run([sys.executable, "-m", "ftc_mc.sim.compile_helper", "no such path",
+                              "--plan", str(plan)], env=env, capture_output=True, timeout=300,
+                             cwd=ROOT)
+    assert unknown.returncode == 1
+
+
+def _type_only(dispatcher, sig) -> None:
+    """Type ``dispatcher`` for ``sig`` with Numba's own passes up to type
+    inference, and no further: the kernels it calls are compiled, or loaded
+    from the cache, as a compile would, while it is not lowered."""
+    from numba.core import compiler, typed_passes
+    from numba.core.compiler_machinery import PassManager
+
+    class TypeOnly(compiler.CompilerBase):
+        def define_pipelines(self):
+            pm = PassManager("type only")
+            pm.passes.extend(compiler.DefaultPassBuilder.define_untyped_pipeline(
+                self.state).passes)
+            pm.add_pass(typed_passes.NopythonTypeInference, "nopython type inference")
+            pm.finalize()
+            return [pm]
+
+    flags = compiler.Flags()
+    flags.no_compile = True
+    try:
+        compiler.compile_extra(dispatcher.typingctx, dispatcher.targetctx,
+                               dispatcher.py_func, sig, None, flags, {},
+                               pipeline_class=TypeOnly)
+    except AttributeError as exc:  # no lowering pass: no compile result to return
+        assert str(exc) == "cr", exc
+
+
+@needs_cache
+def test_the_shipped_plan_matches_the_default_path(trial_kernel):
+    """Every stage the plan lists for the default path (``paper_tables.yaml``'s
+    first variant) is a signature that path's ``advance`` calls: typing
+    ``advance`` for the path (loaded from the cache, so typed again here)
+    loads or compiles exactly those.  A stale plan fails here
+    (``scripts/make_compile_plan.py`` writes it again)."""
+    from ftc_mc.campaign.chunk import chunk_spec
+    from ftc_mc.config import load_config
+    from ftc_mc.core.longitudinal.trial import advance
+    from ftc_mc.sim.paths import path_of
+    cfg = load_config(ROOT / "configs" / "paper_tables.yaml")
+    spec = chunk_spec(cfg)
+    path = path_of(spec.setup.scheme(spec.variants[0]), spec.setup.flight)
+    plan = load_plan()
+    assert plan_key(path) in plan, f"the compile plan lacks the default path {plan_key(path)!r}"
+    stages = plan[plan_key(path)]["stages"]
+    assert len(stages) >= 5 and all(s[3] >= 0 for s in stages)
+    [sig] = [s for s in advance.signatures if s[0] == numba.typeof(path)]
+    _type_only(advance, sig)
+    for module, qualname, args, _ in stages:
+        d = compile_helper._dispatcher(module, qualname)
+        assert d is not None, f"{module}.{qualname} is not a cached kernel of core/"
+        assert tuple(args) in d.overloads, f"{qualname}: {args} not called by the path"
+    # the helper's share is real work: at least a third of the stages' seconds
+    share = helper_share(stages, plan[plan_key(path)]["before_s"])
+    assert sum(s[3] for s in share) >= sum(s[3] for s in stages) / 3
