@@ -461,7 +461,7 @@ def needs_compile(dispatcher, first=None) -> bool | None:
     return None if cached is None else not cached
 
 
-def announce_compile(dispatcher, what="", duration="1-1.5 min", stream=None,
+def announce_compile(dispatcher, what="", duration="1 min", stream=None,
                      needed=None) -> bool:
     """Print :data:`COMPILE_NOTICE` to stderr if ``dispatcher`` is about to be
     compiled (:func:`needs_compile`, or ``needed`` when the caller has just
