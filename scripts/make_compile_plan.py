@@ -109,13 +109,19 @@ def main():
             sys.exit(f"no shipped config takes the path(s) {sorted(unknown)}")
         wanted = {k: wanted[k] for k in args.only}
     paths = load_plan() if args.only else {}
+    if args.only and not paths and PLAN_FILE.exists():
+        sys.exit(f"{PLAN_FILE}: unreadable or of another Numba version; record every "
+                 "path (without --only)")
     for key, (config, variant) in wanted.items():
         with tempfile.TemporaryDirectory() as tmp:
             env = dict(os.environ, NUMBA_CACHE_DIR=tmp, FTC_MC_COMPILE_HELPER="0")
             out = Path(tmp) / "stages.pkl"
             t = time.perf_counter()
-            subprocess.run([sys.executable, __file__, "--record", config, variant, str(out)],
-                           cwd=ROOT, env=env, check=True, stderr=subprocess.DEVNULL)
+            rec = subprocess.run([sys.executable, __file__, "--record", config, variant,
+                                  str(out)], cwd=ROOT, env=env, stderr=subprocess.PIPE,
+                                 text=True)
+            if rec.returncode != 0:
+                sys.exit(f"recording {key} ({config}, {variant}) failed:\n{rec.stderr}")
             with open(out, "rb") as f:
                 before_s, stages = pickle.load(f)
         paths[key] = {"before_s": before_s, "stages": stages}

@@ -104,6 +104,25 @@ def test_no_helper_when_switched_off_or_the_path_is_unknown(tmp_path, monkeypatc
     assert compile_helper.start(path, plan) is None
 
 
+@pytest.mark.skipif(not compile_helper.enabled(), reason="one core, or the helper is off")
+def test_start_runs_the_helper_for_a_known_path_and_stop_ends_it(tmp_path, monkeypatch):
+    """A path the plan knows starts a helper process, which exits 0 when its
+    share is done; :func:`stop` ends one that still runs (here a process that
+    sleeps) and leaves a finished one alone."""
+    from ftc_mc.core.shared.paths import (LINEAR_PLANT, ONE_STEP_TEST, PAPER_FILTER,
+                                          RECONFIGURING, Path as Path_)
+    plan = _write_plan(tmp_path / "plan.pkl")
+    monkeypatch.setattr(compile_helper, "plan_key", lambda p: "probe path")
+    proc = compile_helper.start(Path_(LINEAR_PLANT, PAPER_FILTER, ONE_STEP_TEST,
+                                      RECONFIGURING), plan)
+    assert proc is not None and proc.wait(300) == 0
+    compile_helper.stop(proc)
+    assert proc.returncode == 0
+    sleeper = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)"])
+    compile_helper.stop(sleeper)
+    assert sleeper.returncode is not None and sleeper.returncode != 0
+
+
 @needs_cache
 def test_a_held_claim_is_waited_for_and_a_free_one_is_not():
     """``load_overload`` waits while another open file holds the claim's flock
@@ -122,16 +141,16 @@ def test_a_held_claim_is_waited_for_and_a_free_one_is_not():
 
     t0 = time.perf_counter()
     th = threading.Thread(target=load, daemon=True)
-    th.start()
-    assert not done.wait(0.5)  # held: it waits
     try:
+        th.start()
+        assert not done.wait(0.5)  # held: it waits
         cache.awaits_claims = False  # a helper's own loads do not wait
         t1 = time.perf_counter()
         cache.load_overload(ARGS, d.targetctx)
         assert time.perf_counter() - t1 < 0.4
     finally:
-        del cache.awaits_claims
-    compile_helper._release(claim)
+        cache.__dict__.pop("awaits_claims", None)
+        compile_helper._release(claim)
     assert done.wait(10) and time.perf_counter() - t0 >= 0.5
     th.join(10)
     assert not claim[1].exists()
@@ -245,3 +264,34 @@ def test_the_shipped_plan_matches_the_default_path(trial_kernel):
     # the helper's share is real work: at least a third of the stages' seconds
     share = helper_share(stages, plan[plan_key(path)]["before_s"])
     assert sum(s[3] for s in share) >= sum(s[3] for s in stages) / 3
+
+
+@needs_cache
+def test_a_kernel_s_index_is_saved_under_its_lock(monkeypatch):
+    """Numba rewrites a kernel's cache index unlocked; here each save holds an
+    ``flock`` of ``<index>.lock`` (another open file cannot take it meanwhile)."""
+    import fcntl
+
+    from numba.core import caching
+    cache = getattr(excitation, NAME)._cache
+    lock = Path(cache._cache_file._index_path + ".lock")
+    seen = []
+
+    def probe(self, sig, data):
+        fd = os.open(lock, os.O_RDWR)
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            seen.append("free")
+        except BlockingIOError:
+            seen.append("held")
+        finally:
+            os.close(fd)
+
+    monkeypatch.setattr(caching.Cache, "_save_overload", probe)
+    cache._save_overload(ARGS, None)
+    assert seen == ["held"]
+    fd = os.open(lock, os.O_RDWR)  # and let go after
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    finally:
+        os.close(fd)

@@ -284,7 +284,8 @@ class ContentFunctionCache(caching.FunctionCache):
         digest of the signature's text."""
         args, _ = sigutils.normalize_signature(sig)
         digest = hashlib.sha256(str(tuple(args)).encode()).hexdigest()[:16]
-        name = f"{self._py_func.__qualname__}-{self._py_func.__code__.co_firstlineno}"
+        f = self._py_func
+        name = f"{f.__module__}.{f.__qualname__}-{f.__code__.co_firstlineno}"
         return Path(self._cache_path) / f"{name}.{digest}.claim"
 
     def load_overload(self, sig, target_context):
@@ -310,6 +311,11 @@ class ContentFunctionCache(caching.FunctionCache):
             os.close(fd)
 
     def _save_overload(self, sig, data):
+        """Save, unless the sources changed (class docstring), under an
+        ``flock`` of ``<index>.lock``: Numba reads, extends and rewrites a
+        kernel's index unlocked, so two processes saving overloads of one
+        kernel at once (a compile helper and this one) could lose an entry or
+        give two the same data file."""
         if not sources_unchanged():
             if not ContentFunctionCache._warned:
                 import sys
@@ -317,7 +323,16 @@ class ContentFunctionCache(caching.FunctionCache):
                       "its compiled kernels are not cached", file=sys.stderr, flush=True)
                 ContentFunctionCache._warned = True
             return
-        super()._save_overload(sig, data)
+        try:
+            import fcntl
+            fd = os.open(self._cache_file._index_path + ".lock", os.O_CREAT | os.O_RDWR, 0o644)
+        except (ImportError, OSError, AttributeError):
+            return super()._save_overload(sig, data)
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX)
+            super()._save_overload(sig, data)
+        finally:
+            os.close(fd)
 
 
 if CACHE:

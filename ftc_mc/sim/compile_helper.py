@@ -44,6 +44,10 @@ from ..core.shared.paths import describe
 PLAN_FILE = Path(__file__).with_name("compile_plan.pkl")
 """The compile plan shipped with the package (module docstring)."""
 
+PACKAGE_ROOT = Path(__file__).resolve().parents[2]
+"""The folder holding this ``ftc_mc`` package: the helper's working folder, so
+that ``python -m`` imports the same package and nothing else from elsewhere."""
+
 STOP_WAIT_S = 5.0
 """How long :func:`stop` waits for a helper it asked to end [s]."""
 
@@ -113,10 +117,11 @@ def start(path, plan_file: Path = PLAN_FILE):
     key = plan_key(path)
     if key not in load_plan(plan_file):
         return None
-    cmd = [sys.executable, "-m", __name__, key, "--plan", str(plan_file)]
-    try:
-        return subprocess.Popen(cmd, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
-                                stderr=subprocess.DEVNULL)
+    cmd = [sys.executable, "-m", __name__, key, "--plan", str(plan_file),
+           "--parent", str(os.getpid())]
+    try:  # run from the folder this package is in: the helper imports this ftc_mc
+        return subprocess.Popen(cmd, cwd=PACKAGE_ROOT, stdin=subprocess.DEVNULL,
+                                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     except OSError:
         return None
 
@@ -147,12 +152,14 @@ def _claim(dispatcher, args):
     """Take the claim of ``dispatcher``'s signature ``args``; the open file,
     or None if another process holds it."""
     import fcntl
-    path = dispatcher._cache.claim_path(args)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd = os.open(path, os.O_CREAT | os.O_RDWR, 0o644)
+    try:
+        path = dispatcher._cache.claim_path(args)
+        fd = os.open(path, os.O_CREAT | os.O_RDWR, 0o644)
+    except (OSError, ValueError, TypeError):  # e.g. a cache folder of another user
+        return None
     try:
         fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-    except BlockingIOError:
+    except OSError:  # held by another helper, or no flock on this file system
         os.close(fd)
         return None
     return fd, path
@@ -168,16 +175,18 @@ def _release(claim) -> None:
     os.close(fd)
 
 
-def run(key: str, plan_file: Path = PLAN_FILE) -> int:
+def run(key: str, plan_file: Path = PLAN_FILE, parent: int | None = None) -> int:
     """The helper's work: claim its share (:func:`helper_share`) of the path
     ``key``'s stages that the cache lacks (those it holds, from another path
     compiled before, cost this process nothing), then compile them in order,
-    letting go of each claim when its kernel is saved.  Returns the exit
-    status (0, or 1 when the plan does not know ``key``)."""
+    letting go of each claim when its kernel is saved.  A stage that fails
+    to compile (a stale plan) is left to the process it works for.  Stops
+    when that process, ``parent`` (default: this one's parent), has gone.
+    Returns the exit status (0, or 1 when the plan does not know ``key``)."""
     entry = load_plan(plan_file).get(key)
     if entry is None:
         return 1
-    parent = os.getppid()
+    parent = os.getppid() if parent is None else parent
     jit.ContentFunctionCache.awaits_claims = False  # never wait: no cycle of waits
     todo = []
     for module, qualname, args, seconds in entry["stages"]:
@@ -194,6 +203,8 @@ def run(key: str, plan_file: Path = PLAN_FILE) -> int:
             return 0
         try:
             dispatcher.compile(tuple(args))
+        except Exception:  # noqa: BLE001 -- that process compiles what it lacks
+            pass
         finally:
             _release(claim)
     return 0
@@ -204,8 +215,10 @@ def main(argv=None) -> int:
                                  description=__doc__.splitlines()[0])
     ap.add_argument("key", help="the path's key in the plan (its words)")
     ap.add_argument("--plan", type=Path, default=PLAN_FILE, help="the compile plan file")
+    ap.add_argument("--parent", type=int, default=None,
+                    help="the process it works for (default: its parent)")
     a = ap.parse_args(argv)
-    return run(a.key, a.plan)
+    return run(a.key, a.plan, a.parent)
 
 
 if __name__ == "__main__":
