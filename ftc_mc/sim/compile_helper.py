@@ -100,7 +100,7 @@ def helper_share(stages, before_s: float) -> list:
     before_s : float
         Seconds this process compiles before the first stage [s].
     """
-    secs = [s[3] for s in stages]
+    secs = [s[-1] for s in stages]
     best, cut = float("inf"), len(stages)
     for k in range(len(stages) + 1):
         longest = max(before_s + sum(secs[:k]), sum(secs[k:]))
@@ -192,9 +192,9 @@ def run(key: str, plan_file: Path = PLAN_FILE, parent: int | None = None) -> int
     for module, qualname, args, seconds in entry["stages"]:
         dispatcher = _dispatcher(module, qualname)
         if dispatcher is not None and not jit.cached_signature(dispatcher, args):
-            todo.append((dispatcher, qualname, args, seconds))
+            todo.append((dispatcher, args, seconds))
     claimed = []
-    for dispatcher, _, args, _ in helper_share(todo, entry["before_s"]):
+    for dispatcher, args, _ in helper_share(todo, entry["before_s"]):
         claim = _claim(dispatcher, args)
         if claim is not None:
             claimed.append((dispatcher, args, claim))
