@@ -12,7 +12,13 @@ Extra arguments after ``run`` go to ``ftc-mc``; after ``test`` to ``pytest``.
 The install is repeated only when ``pyproject.toml`` changes.  It is editable
 (the sources stay in this folder, so an edit is run and tested at once), and
 pip runs with ``-qq``: its errors are shown, its warnings are not (setuptools
-boxes every editable install with a warning meant for package authors).
+boxes every editable install with a warning meant for package authors).  pip
+installs with ``--no-compile``, and the packages' bytecode is then compiled on
+every core by :mod:`compileall` (pip compiles on one: 32 s of install -> 15 s
+plus 12 s here, measured stop 39).  The bytecode is needed before the first
+run: where ``PYTHONDONTWRITEBYTECODE`` is set, as in this project's CI, Python
+would otherwise compile every imported module again in every process (the test
+suite took 245 s instead of 180 s).
 """
 
 from __future__ import annotations
@@ -31,6 +37,11 @@ PY = BIN / "python"
 
 MAIN_JOB = ["run", "configs/paper_tables.yaml"]
 
+# run by the venv's python: the bytecode of its installed packages
+COMPILE_PACKAGES = ("import compileall, sysconfig; "
+                    "compileall.compile_dir(sysconfig.get_paths()['purelib'], quiet=2, "
+                    "workers=0)")
+
 
 def ensure_venv(extras: str) -> None:
     """Create ``.venv`` and install the package (editable) with ``extras``,
@@ -45,14 +56,17 @@ def ensure_venv(extras: str) -> None:
     if stamp.exists() and stamp.read_text() == digest:
         return
     name = f"ftc-mc[{extras}]" if extras else "ftc-mc"
-    print(f"dev.py: installing {name} into {VENV} (about a minute)", flush=True)
+    print(f"dev.py: installing {name} into {VENV} (about half a minute)", flush=True)
     target = f".[{extras}]" if extras else "."
-    # -qq: pip's errors only (see the module docstring)
-    for args in (["--upgrade", "pip"], ["-e", target]):
+    # -qq: pip's errors only; --no-compile: see the module docstring
+    for args in (["--upgrade", "pip"], ["--no-compile", "-e", target]):
         done = subprocess.run([str(PY), "-m", "pip", "install", "-qq", *args], cwd=ROOT)
         if done.returncode:
             sys.exit(f"dev.py: 'pip install {' '.join(args)}' failed (exit code "
                      f"{done.returncode}); pip's errors are above")
+    # as pip would, on every core; like pip, a file that does not compile is
+    # left to fail at its import
+    subprocess.run([str(PY), "-c", COMPILE_PACKAGES], cwd=ROOT)
     stamp.write_text(digest)
 
 

@@ -38,19 +38,38 @@ def dev(tmp_path, monkeypatch):
 
 def test_install_is_editable_quiet_and_once(dev, capsys):
     dev.ensure_venv("test")
-    assert len(dev.calls) == 2
-    upgrade, install = dev.calls
+    assert len(dev.calls) == 3
+    upgrade, install, compile_ = dev.calls
     assert upgrade[1:] == ["-m", "pip", "install", "-qq", "--upgrade", "pip"]
-    # editable (the tests import the sources in place), warnings not shown
-    assert install[1:] == ["-m", "pip", "install", "-qq", "-e", ".[test]"]
+    # editable (the tests import the sources in place), warnings not shown,
+    # the bytecode compiled afterwards on every core
+    assert install[1:] == ["-m", "pip", "install", "-qq", "--no-compile", "-e", ".[test]"]
+    assert compile_[1:] == ["-c", dev.COMPILE_PACKAGES]
     assert capsys.readouterr().out.startswith("dev.py: installing ftc-mc[test]")
     dev.ensure_venv("test")
-    assert len(dev.calls) == 2  # same pyproject.toml: nothing to do
+    assert len(dev.calls) == 3  # same pyproject.toml: nothing to do
     dev.ensure_venv("")
-    assert dev.calls[-1][-2:] == ["-e", "."]  # the run command's own install
+    assert dev.calls[-2][-2:] == ["-e", "."]  # the run command's own install
     (dev.ROOT / "pyproject.toml").write_text("[project]\nname = 'y'\n")
     dev.ensure_venv("test")
-    assert len(dev.calls) == 6 and dev.calls[-1][-1] == ".[test]"
+    assert len(dev.calls) == 9 and dev.calls[-2][-1] == ".[test]"
+
+
+def test_the_packages_bytecode_is_compiled(tmp_path):
+    """``COMPILE_PACKAGES`` writes the bytecode of a module in ``purelib``
+    (pointed at a scratch folder), as pip's install would have."""
+    import sys
+
+    spec = importlib.util.spec_from_file_location("dev_under_test", ROOT / "dev.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    (tmp_path / "pkg").mkdir()
+    (tmp_path / "pkg" / "m.py").write_text("X = 1\n")
+    code = (f"import sysconfig; sysconfig.get_paths = lambda: {{'purelib': {str(tmp_path)!r}}}; "
+            + mod.COMPILE_PACKAGES)
+    subprocess.run([sys.executable, "-c", code], check=True)
+    tag = sys.implementation.cache_tag
+    assert (tmp_path / "pkg" / "__pycache__" / f"m.{tag}.pyc").exists()
 
 
 def test_a_failed_install_is_one_line_and_not_stamped(dev):
@@ -61,5 +80,5 @@ def test_a_failed_install_is_one_line_and_not_stamped(dev):
     assert not list(dev.VENV.glob(".installed-*"))
     dev.returncode = 0
     dev.ensure_venv("")
-    assert len(dev.calls) == 3  # tried again
+    assert len(dev.calls) == 4  # tried again: upgrade, install, compile
 
