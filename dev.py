@@ -15,7 +15,7 @@ pip runs with ``-qq``: its errors are shown, its warnings are not (setuptools
 boxes every editable install with a warning meant for package authors).  pip
 installs with ``--no-compile``, and the packages' bytecode is then compiled on
 every core by :mod:`compileall` (pip compiles on one: 32 s of install -> 15 s
-plus 12 s here, measured stop 39).  The bytecode is needed before the first
+plus 8 s here, measured stop 39).  The bytecode is needed before the first
 run: where ``PYTHONDONTWRITEBYTECODE`` is set, as in this project's CI, Python
 would otherwise compile every imported module again in every process (the test
 suite took 245 s instead of 180 s).
@@ -37,10 +37,12 @@ PY = BIN / "python"
 
 MAIN_JOB = ["run", "configs/paper_tables.yaml"]
 
-# run by the venv's python: the bytecode of its installed packages
-COMPILE_PACKAGES = ("import compileall, sysconfig; "
+# run by the venv's python: the bytecode of its installed packages, but for
+# their own test suites (folders test/ and tests/, never imported by a run;
+# 7081 files in 12.2 s -> 4378 in 7.9 s)
+COMPILE_PACKAGES = ("import compileall, re, sysconfig; "
                     "compileall.compile_dir(sysconfig.get_paths()['purelib'], quiet=2, "
-                    "workers=0)")
+                    "workers=0, rx=re.compile(r'[/\\\\]tests?[/\\\\]'))")
 
 
 def ensure_venv(extras: str) -> None:

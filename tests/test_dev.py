@@ -57,19 +57,22 @@ def test_install_is_editable_quiet_and_once(dev, capsys):
 
 def test_the_packages_bytecode_is_compiled(tmp_path):
     """``COMPILE_PACKAGES`` writes the bytecode of a module in ``purelib``
-    (pointed at a scratch folder), as pip's install would have."""
+    (pointed at a scratch folder), as pip's install would have, but not of
+    the package's own test suite."""
     import sys
 
     spec = importlib.util.spec_from_file_location("dev_under_test", ROOT / "dev.py")
     mod = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(mod)
-    (tmp_path / "pkg").mkdir()
-    (tmp_path / "pkg" / "m.py").write_text("X = 1\n")
+    (tmp_path / "pkg" / "tests").mkdir(parents=True)
+    for f in ("m.py", "tests/test_m.py"):
+        (tmp_path / "pkg" / f).write_text("X = 1\n")
     code = (f"import sysconfig; sysconfig.get_paths = lambda: {{'purelib': {str(tmp_path)!r}}}; "
             + mod.COMPILE_PACKAGES)
     subprocess.run([sys.executable, "-c", code], check=True)
     tag = sys.implementation.cache_tag
     assert (tmp_path / "pkg" / "__pycache__" / f"m.{tag}.pyc").exists()
+    assert not (tmp_path / "pkg" / "tests" / "__pycache__").exists()  # a package's own tests
 
 
 def test_a_failed_install_is_one_line_and_not_stamped(dev):
