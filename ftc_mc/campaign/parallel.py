@@ -313,7 +313,7 @@ def run_chunks(spec: ChunkSpec, units, *, n_jobs: int = 1, backend_name: str = "
         if todo:
             pool = _executor(backend_name, spec, max(1, n_jobs), scheduler)
             writer = cf.ThreadPoolExecutor(1, thread_name_prefix="ftc-mc-write")
-            aborted, interrupted = True, False
+            aborted = True
             pending, writing = {}, {}
             try:
                 queued = iter(todo)
@@ -348,14 +348,13 @@ def run_chunks(spec: ChunkSpec, units, *, n_jobs: int = 1, backend_name: str = "
                         del out
                     refill()
                 aborted = False
-            except KeyboardInterrupt:
-                interrupted = True
-                raise
             finally:
-                # an interrupt does not wait for a write under way (the process
-                # ends at once; a chunk's trials file is written last); an error
-                # does, so that the caller finds the store as it stays
-                writer.shutdown(wait=not interrupted, cancel_futures=aborted)
+                # the write under way is finished (a chunk's tables, tens of
+                # ms), the queued ones are dropped: the interrupt's message then
+                # counts the chunks that stay (it counted one too few when a
+                # write ended between its count and the exit); an error
+                # waits too, so that the caller finds the store as it stays
+                writer.shutdown(wait=True, cancel_futures=aborted)
                 if aborted:
                     for fut in pending:
                         fut.cancel()
