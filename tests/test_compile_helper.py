@@ -164,12 +164,15 @@ def test_a_held_claim_is_waited_for_and_a_free_one_is_not():
         claim[1].unlink()
 
 
+# the stage is an internal kernel (no Python wrappers), called by another
+# kernel as the trial kernel calls its stages
 PROBE = f'''
 import json, sys
+import numba
 from ftc_mc.core import jit
 from ftc_mc.core.shared import excitation
 d = excitation.{NAME}
-value = d(3)
+value = numba.njit(lambda n: d(n))(3)
 print(json.dumps({{"value": value, "hits": sum(d.stats.cache_hits.values()),
                   "misses": sum(d.stats.cache_misses.values())}}))
 '''

@@ -63,7 +63,7 @@ UPDATE_ROWS = 2 * GROUP + 1
 """First dimension of the update's work array ``h[UPDATE_ROWS, n, L]``."""
 
 
-@kernel
+@kernel(internal=True)
 def step_rows(n_aug):
     """First dimension of :func:`filter_step_lanes`' work array
     ``work[step_rows(n), n, L]``: the prediction (``n`` rows), the update's
@@ -80,32 +80,32 @@ more re-predict every lane (identical results for the lanes without a reset)."""
 
 
 # ------------------------------------------------------------------ helpers
-@kernel
+@kernel(internal=True)
 def _row_x(M, i):
     """Row ``i`` of a ``(m, N_X)`` matrix as a tuple (lane-invariant coefficients)."""
     return (M[i, 0], M[i, 1], M[i, 2], M[i, 3], M[i, 4], M[i, 5], M[i, 6], M[i, 7],
             M[i, 8])
 
 
-@kernel
+@kernel(internal=True)
 def _row_b0(M, i):
     """Row ``i`` of a ``(m, N_B0)`` matrix as a tuple (``B_b0``, eq. 4)."""
     return (M[i, 0], M[i, 1])
 
 
-@kernel
+@kernel(internal=True)
 def _row_b(M, i):
     """Row ``i`` of a ``(m, N_U)`` matrix as a tuple (``B_i``, eq. 1)."""
     return (M[i, 0], M[i, 1], M[i, 2])
 
 
-@kernel
+@kernel(internal=True)
 def _neg_row_b(M, i):
     """Negated row ``i`` of a ``(m, N_U)`` matrix as a tuple (``-B_i``, eq. 4)."""
     return (-M[i, 0], -M[i, 1], -M[i, 2])
 
 
-@kernel
+@kernel(internal=True)
 def _mirror(P, l0, l1):
     """Copy the upper triangle of ``P[:, :, l0:l1]`` onto the lower one."""
     n = P.shape[0]
@@ -115,7 +115,7 @@ def _mirror(P, l0, l1):
                 P[k, i, l] = P[i, k, l]
 
 
-@kernel
+@kernel(internal=True)
 def _mirror_x(P, l0, l1):
     """Copy the upper triangle of the plant-state block ``P[:9, :9]`` downwards."""
     for i in range(N_X):
@@ -124,7 +124,7 @@ def _mirror_x(P, l0, l1):
                 P[k, i, l] = P[i, k, l]
 
 
-@kernel
+@kernel(internal=True)
 def _symmetric_copy(P, Pout, L):
     """``Pout <- P`` from the upper triangle of ``P`` (both triangles written)."""
     n = P.shape[0]
@@ -138,7 +138,7 @@ def _symmetric_copy(P, Pout, L):
 
 
 # ------------------------------------------------------------------ predict
-@kernel
+@kernel(internal=True)
 def _predict(xa, P, Pn, u, fm, phi, T, l0, l1):
     """Eq. (5) on lanes ``l0:l1``: ``Pn <- A_aug P A_aug^T + Q`` (``Pn`` may be ``P``).
 
@@ -279,7 +279,7 @@ def predict_lanes(xa, P, u, fm, phi, T):
 
 
 # ------------------------------------------------------------------ residuals
-@kernel
+@kernel(internal=True)
 def _normalised_lanes(xa, P, z, fm, out, signed):
     """``mu_i^2 / S_ii`` (``signed`` false) or ``mu_i / sqrt(S_ii)`` (true) of the
     residual outputs of every lane into ``out`` (3, L); see :func:`residuals_lanes`.
@@ -363,7 +363,7 @@ def innovations_lanes(xa, P, z, fm, innov):
 
 
 # ------------------------------------------------------------------ signature
-@kernel
+@kernel(internal=True)
 def reset_lanes(P, block, reset_var):
     """Reset the suspected fault block of each lane (section 3.2.2).
 
@@ -497,7 +497,7 @@ def _dense_row(xa, P, z, fm, h, v, gs, r):
                 P[a, b, l] -= v[a, l] * h[b, l]
 
 
-@kernel
+@kernel(internal=True)
 def _update(xa, P, z, fm, h):
     """The sequential scalar updates, one per output, on the upper triangle of
     ``P`` (no mirror)."""
@@ -539,7 +539,7 @@ def update_lanes(xa, P, z, fm, h):
 
 
 # ------------------------------------------------------------------ projection
-@kernel
+@kernel(internal=True)
 def project_lanes(xa, fm):
     """Active-set projection of every lane's fault parameters (eqs. 6-8).
 
@@ -625,7 +625,7 @@ def filter_correct_lanes(xa, P, u, z, fm, det, phi, T, work, block):
     project_lanes(xa, fm)
 
 
-@kernel
+@kernel(internal=True)
 def filter_step_lanes(xa, P, u, z, fm, det, phi, T, work, res, block):
     """Advance every lane's filter by one sampling period, as
     ``tests/single_trajectory.py::filter_step``.

@@ -124,7 +124,7 @@ def feedback_lanes(K, x, U):
                 U[i, l] -= kij * x[j, l]
 
 
-@kernel
+@kernel(internal=True)
 def controller_command(c, xa, K, eng, u0, U):
     """Command of controller ``c`` from an augmented estimate (no saturation).
 
@@ -157,7 +157,7 @@ def controller_command(c, xa, K, eng, u0, U):
             u0[U_RIGHT])
 
 
-@kernel
+@kernel(internal=True)
 def _lane_commands(c, xs, K, eng, u0, lo, hi, U, xl, Ul):
     """Saturated command of controller ``c`` for every lane of ``xs`` (eq. 16).
 

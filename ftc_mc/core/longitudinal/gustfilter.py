@@ -43,7 +43,7 @@ N_WIND = 3
 """Gust outputs ``u_g, w_g, q_g`` of the gust states (``FilterModel.Cg``)."""
 
 
-@kernel
+@kernel(internal=True)
 def _c_row(fm, r, crow):
     """Row ``r`` of ``C_aug = [C, 0, D_g]`` into ``crow`` (n,)."""
     n = crow.shape[0]
@@ -63,7 +63,7 @@ FD_W = 1e-6
 """Step of the finite differences in the wind [m/s, rad/s]."""
 
 
-@kernel
+@kernel(internal=True)
 def _lane_point(xa, u, fm, l, xabs, cmd, wind):
     """Lane ``l``'s operating point for the airframe's equations: the absolute
     state ``x0 + x``, the absolute commands under the estimated faults (eq. 2
@@ -86,7 +86,7 @@ def _lane_point(xa, u, fm, l, xabs, cmd, wind):
         wind[i] = acc
 
 
-@kernel
+@kernel(internal=True)
 def _c_rows_lanes(fm, st, r, cl):
     """Row ``r`` of every lane's re-linearised ``C_aug = [JC, 0, JHW C_d + D_z]``
     into ``cl`` (n, L)."""
@@ -118,7 +118,7 @@ def _at_point(xabs, cmd, wl, xs, c0, w0):
         wl[i] = w0[i]
 
 
-@kernel
+@kernel(internal=True)
 def relinearise_lanes(xa, u, fm, st, tw):
     """Every lane's state-map Jacobians about its estimate ``X_{k|k}`` by
     forward finite differences (issue 13 item 2).
@@ -173,7 +173,7 @@ def relinearise_lanes(xa, u, fm, st, tw):
                 st.JW[i, j, l] = (xabs[i] - fb[i]) / dw
 
 
-@kernel
+@kernel(internal=True)
 def relinearise_outputs_lanes(xa, fm, st, tw):
     """Every lane's output Jacobians ``st.JC`` (12, 9, L) and ``st.JHW`` (12, 3,
     L) about its prediction ``X_{k+1|k}`` (``xa``: state and gust), where the
@@ -211,7 +211,7 @@ def relinearise_outputs_lanes(xa, fm, st, tw):
                 st.JHW[r, j, l] = (y[r] - yb[r]) / dw
 
 
-@kernel
+@kernel(internal=True)
 def _nl_state(xa, u, fm, xn, tw):
     """The extended filter's state prediction: ``x_{k+1|k} = f(x0 + x, u0 + e, C_d g) - x0``.
 
@@ -232,7 +232,7 @@ def _nl_state(xa, u, fm, xn, tw):
             xn[i, l] = xabs[i] - fm.x0[i]
 
 
-@kernel
+@kernel(internal=True)
 def _nl_outputs(xa, fm, hpred, xp, tw):
     """The extended filter's predicted outputs ``h(x0 + x, C_d g) - y0 + D_z g``
     (``D_z``: a sensor-aware design's output biases) into ``hpred[:12]`` and the prediction itself into ``xp`` (the update linearises
@@ -278,7 +278,7 @@ def relinearise(fkind, xa, u, fm, st, tw):
     """:func:`relinearise_lanes` on the extended filter's path."""
 
 
-@kernel
+@kernel(internal=True)
 def _gpredict(fkind, xa, P, Pn, u, fm, phi, T, xn, tw, st):
     """Time update of every lane: ``X <- F X + B_aug u``, ``Pn <- F P F^T + Q``.
 
@@ -498,7 +498,7 @@ def _apply_gain(xa, P, h, v, gs):
                 P[a, b, l] -= v[a, l] * h[b, l]
 
 
-@kernel
+@kernel(internal=True)
 def _gupdate(xa, P, z, fm, crow, h, v, gs, hpred, xp, st, cl):
     """Sequential scalar updates with the 12 outputs in order, on the upper
     triangle of ``P`` (mirrored by the caller): ``h = P c^T``, ``s = c h + R``,
@@ -609,7 +609,7 @@ def gust_predict_lanes(fkind, xa, P, fm, tw, st, k):
                          st, tw.jc)
 
 
-@kernel
+@kernel(internal=True)
 def reset_extra_lanes(P, block, reset_g):
     """Reset the extra states that go with each lane's block (issue 14).
 

@@ -176,7 +176,7 @@ def outputs_nb(x, p, wind, y):
     y[OUT_VA] = Va
 
 
-@kernel
+@kernel(internal=True)
 def rk4_step(x, cmd, p, wind, h, k1, k2, k3, k4, xt):
     """One classical RK4 step of length ``h`` [s] in place on ``x``.
 
@@ -199,7 +199,7 @@ def rk4_step(x, cmd, p, wind, h, k1, k2, k3, k4, xt):
         x[i] += h6 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
 
 
-@kernel
+@kernel(internal=True)
 def propagate(x, cmd, p, wind, dt, n_sub, work):
     """Advance ``x`` in place over one control period ``dt`` by ``n_sub`` RK4 steps.
 
@@ -225,7 +225,7 @@ def propagate(x, cmd, p, wind, dt, n_sub, work):
         rk4_step(x, cmd, p, wind, h, work[0], work[1], work[2], work[3], work[4])
 
 
-@kernel
+@kernel(internal=True)
 def make_work():
     """A work array for :func:`propagate`, shape ``(N_WORK, N_STATE)`` (callable
     from Python and from kernels)."""

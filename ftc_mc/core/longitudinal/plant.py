@@ -281,14 +281,14 @@ def sensor_fault(inp, k, dt, v, zhold, z):
             z[o, l] += (size - 1.0) * v[o, l]
 
 
-@kernel
+@kernel(internal=True)
 def linear_truth(model, flight, w, v, x, work):
     """:func:`linear_step` as a kernel of its own (one compile for every path
     that flies the linear plant)."""
     linear_step(model, flight, w, v, x, work)
 
 
-@kernel
+@kernel(internal=True)
 def nonlinear_truth(model, flight, w, v, x, work):
     """:func:`nonlinear_step` with :func:`linear_step`'s parameters, as a kernel
     of its own."""
@@ -335,7 +335,7 @@ def truth_step(path, model, flight, inp, k, st, work):
     sensor_fault(inp, k, pl.dt, inp.v[k], st.zhold, work.z)
 
 
-@kernel
+@kernel(internal=True)
 def longitudinal_truth(plant, scheme, flight, inp, k, st, work, rec):
     """:func:`truth_step` on a longitudinal plant (``plant`` its marker), as a
     kernel of its own."""

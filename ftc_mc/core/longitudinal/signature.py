@@ -23,7 +23,7 @@ from ...conventions import (ELEVON_BLOCK, NO_RESET, RESET_ELEVONS,  # noqa: F401
 from ..jit import kernel
 
 
-@kernel
+@kernel(internal=True)
 def in_block(j, block):
     """Whether fault parameter ``j`` of ``[b0_T, b0_e, b1_T, b1_L, b1_R]`` is in a block.
 

@@ -64,7 +64,7 @@ def nominal_output(scheme, st, work):
     feedback_lanes(scheme.controller.K, st.xa, work.u)
 
 
-@kernel
+@kernel(internal=True)
 def reconfiguring_output(scheme, st, work):
     """The output of each lane's controller in use into ``work.u``
     (:func:`ftc_mc.core.longitudinal.control.controller_command`: c0, c1 of eq. 44 or c2 of
@@ -210,7 +210,7 @@ def record_cost(track, k_switch, st, kn, work, rec):
 # (core/shared/paths.py).  The filter's take the filter's marker (``fkind``), by
 # which the general filter picks its prediction.
 
-@kernel
+@kernel(internal=True)
 def paper_predict(fkind, scheme, st, k, work):
     """The paper filter's prediction and one-step residuals
     (:func:`ftc_mc.core.longitudinal.batch.filter_predict_lanes`)."""
@@ -218,7 +218,7 @@ def paper_predict(fkind, scheme, st, k, work):
                          work.fwork, work.res)
 
 
-@kernel
+@kernel(internal=True)
 def general_predict(fkind, scheme, st, k, work):
     """The general filter's prediction and residuals, with the airframe's
     equations on the extended filter's path
@@ -232,7 +232,7 @@ def predict(path, scheme, st, k, work):
     """The first half of the path's filter step."""
 
 
-@kernel
+@kernel(internal=True)
 def paper_innovations(scheme, st, work):
     """The signed innovations the GLR test reads, of the paper's filter
     (:func:`ftc_mc.core.longitudinal.batch.innovations_lanes`; the general
@@ -250,7 +250,7 @@ def innovations(path, scheme, st, work):
     """The paper filter's innovations on the GLR test's path."""
 
 
-@kernel
+@kernel(internal=True)
 def paper_correct(fkind, scheme, st, work):
     """Reset, update and projection of the paper's filter
     (:func:`ftc_mc.core.longitudinal.batch.filter_correct_lanes`)."""
@@ -258,7 +258,7 @@ def paper_correct(fkind, scheme, st, work):
                          work.phi, work.T, work.fwork, work.block)
 
 
-@kernel
+@kernel(internal=True)
 def general_correct(fkind, scheme, st, work):
     """Reset, re-prediction, update and projection of the general filter
     (:func:`ftc_mc.core.longitudinal.gustfilter.gust_correct_lanes`)."""
@@ -271,7 +271,7 @@ def correct(path, scheme, st, work):
     """The second half of the path's filter step."""
 
 
-@kernel
+@kernel(internal=True)
 def glr_statistics(det, st, k, work):
     """The GLR statistics of the window (:func:`ftc_mc.core.shared.glr.glr_lanes`) in
     place of the one-step residuals ``work.res``."""
@@ -622,7 +622,7 @@ def record_step(k, st, work, rec):
 
 
 # ------------------------------------------------------------------ 7. reconfigure
-@kernel
+@kernel(internal=True)
 def select_lanes(scheme, st, work):
     """The controller selection (eqs. 45-47) of every lane
     (:func:`ftc_mc.core.longitudinal.control.select_controllers_lanes`) on the estimate's

@@ -100,7 +100,7 @@ TrialWork = namedtuple("TrialWork", [
 """Scratch of one :func:`ftc_mc.core.longitudinal.trial.advance` call (see module docstring)."""
 
 
-@kernel
+@kernel(internal=True)
 def new_lane_selection_work(L, n):
     """Zeroed :class:`LaneSelectionWork` for ``L`` lanes and augmented dimension ``n``."""
     return LaneSelectionWork(
@@ -111,7 +111,7 @@ def new_lane_selection_work(L, n):
         bvar=np.zeros(N_FAULT), bwork=np.zeros(2 * N_MODES))
 
 
-@kernel
+@kernel(internal=True)
 def new_trial_work(L, n):
     """Zeroed :class:`TrialWork` for ``L`` lanes and augmented dimension ``n``.
 

@@ -23,7 +23,7 @@ from ..jit import kernel
 LOG_TINY = -745.0  # log of the smallest subnormal float64
 
 
-@kernel
+@kernel(internal=True)
 def log_normal_interval(a, b):
     """``log(Phi(b) - Phi(a))`` for standard-normal bounds ``a <= b``, tail-safe.
 
@@ -49,7 +49,7 @@ def log_normal_interval(a, b):
     return math.log(p)
 
 
-@kernel
+@kernel(internal=True)
 def mode_log_likelihood(bhat, var, lo, hi, out):
     """Log of eq. (12) for each mode.
 
@@ -74,7 +74,7 @@ def mode_log_likelihood(bhat, var, lo, hi, out):
         out[m] = acc
 
 
-@kernel
+@kernel(internal=True)
 def belief_update(belief, bs, bhat, var, work):
     """One reconfiguration-period belief update (eqs. 13-14), in place.
 

@@ -10,13 +10,13 @@ from ...conventions import S3211_UNITS  # noqa: F401  (3, 2, 1, 1): Fig. 4
 from ..jit import kernel
 
 
-@kernel
+@kernel(internal=True)
 def doublet_length(half_steps):
     """Steps a doublet lasts: two halves."""
     return 2 * half_steps
 
 
-@kernel
+@kernel(internal=True)
 def signal_3211_length(unit_steps):
     """Steps a 3211 lasts: 3 + 2 + 1 + 1 units."""
     total = 0
@@ -58,7 +58,7 @@ def doublet(k, half_steps, amplitude):
     return 0.0
 
 
-@kernel
+@kernel(internal=True)
 def signal_3211(k, unit_steps, amplitude):
     """3211 input: ``+A, -A, +A, -A`` lasting 3, 2, 1, 1 units (Fig. 4).
 
@@ -89,7 +89,7 @@ def signal_3211(k, unit_steps, amplitude):
     return 0.0
 
 
-@kernel
+@kernel(internal=True)
 def saturate(U, s, A, lo, hi):
     """Command saturation that keeps room for the excitation (eq. 15).
 

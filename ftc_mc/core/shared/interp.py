@@ -47,7 +47,7 @@ eq. (44): ``u = -K x - k``.
 """
 
 
-@kernel
+@kernel(internal=True)
 def locate(grid, x):
     """Cell index and fractional position of ``x`` in a sorted grid, clamped.
 
@@ -85,7 +85,7 @@ def locate(grid, x):
     return i, (x - grid[i]) / (grid[i + 1] - grid[i])
 
 
-@kernel
+@kernel(internal=True)
 def bilinear(table, x_grid, y_grid, x, y, out):
     """Bilinear interpolation of a table over its first two axes, clamped.
 

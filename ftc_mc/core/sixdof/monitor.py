@@ -163,7 +163,7 @@ def on_trim(mon, pl, v, x6):
         x6[mon.states[i]] += v[i]
 
 
-@kernel
+@kernel(internal=True)
 def nonlinear_prediction(mon, pl, x, ns, nu, u, xn):
     """The nonlinear prediction of the states (``monitor.prediction:
     nonlinear``), written over ``xn`` (ns, L).
@@ -199,7 +199,7 @@ def nonlinear_prediction(mon, pl, x, ns, nu, u, xn):
             xn[i, l] = acc
 
 
-@kernel
+@kernel(internal=True)
 def nonlinear_offsets(mon, pl, x, ns):
     """``h(x) - C x`` (m, L) at each lane's predicted estimate ``x``: the
     airframe's outputs (:func:`~ftc_mc.core.sixdof.plant.outputs`, no wind)
@@ -246,7 +246,7 @@ def times_wind(mon, J, out, col0):
             out[i, col0 + c] = acc
 
 
-@kernel
+@kernel(internal=True)
 def extended_filter(mon, pl, x, P, u, z, lat, num, den):
     """Predict and update every lane with the extended filter
     (``monitor.prediction: extended``), one lane at a time, dense; writes the
@@ -670,7 +670,7 @@ def monitor_decide(mon, flight, k, st, work, rec, num, den):
                 rec.mon_b[2 * nu + a, l] = position(mon, x, ns, nu, a, l, work.u)
 
 
-@kernel
+@kernel(internal=True)
 def sixdof_monitor(plant, scheme, flight, k, st, work, rec):
     """Advance the side monitor of every lane over step ``k -> k+1``.
 
@@ -706,7 +706,7 @@ def sixdof_monitor(plant, scheme, flight, k, st, work, rec):
     monitor_decide(mon, flight, k, st, work, rec, num, den)
 
 
-@kernel
+@kernel(internal=True)
 def sixdof_monitor_extended(plant, scheme, flight, k, st, work, rec):
     """:func:`sixdof_monitor` with the extended filter (:func:`extended_filter`),
     on the ``SIXDOF_EXTENDED_PLANT`` path (``core/shared/paths.py``): the

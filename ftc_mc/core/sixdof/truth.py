@@ -182,7 +182,7 @@ def wind6(wind, wlat, l, out):
     out[W_R] = wlat[2, l]
 
 
-@kernel
+@kernel(internal=True)
 def sixdof_truth(plant, scheme, flight, inp, k, st, work, rec):
     """Stage 2 on the 6-DOF plant: lateral loop, faults, gusts, plant and
     measurements over step ``k -> k+1`` on every lane (module docstring).
