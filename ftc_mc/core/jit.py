@@ -381,10 +381,9 @@ def kernel(func=None, *, internal=False, **overrides):
         Function to compile; when omitted, returns a decorator.
     internal : bool
         The kernel is called by other kernels only: it is compiled without
-        its Python wrappers (:data:`NO_WRAPPERS`), which makes the default
-        path's cold compile 17 % shorter on one core (90.4 s -> 74.9 s with
-        the trial kernel's stages internal, ``docs/performance.md`` lesson
-        12).  A call from Python still works: it compiles a twin with its
+        its Python wrappers (:data:`NO_WRAPPERS`), which shortens every
+        path's cold compile (``docs/performance.md``, lesson 14).  A call
+        from Python still works: it compiles a twin with its
         wrappers once (cached beside the kernel, :class:`InternalKernel`).
     **overrides
         Options that replace the defaults for this kernel.
