@@ -23,7 +23,7 @@ import pytest
 from ftc_mc.core import jit
 from ftc_mc.core.shared import excitation
 from ftc_mc.sim import compile_helper
-from ftc_mc.sim.compile_helper import helper_share, load_plan, plan_key
+from ftc_mc.sim.compile_helper import HELPER_START_S, load_plan, plan_key, split
 
 ROOT = Path(__file__).resolve().parents[1]
 MODULE, NAME = excitation.__name__, "doublet_length"
@@ -36,22 +36,38 @@ def _stage(name, seconds):
     return ("m", name, (), seconds)
 
 
-def test_the_helper_takes_the_tail_that_balances_the_two_processes():
-    # by hand: this process does `before` plus the head, the helper the tail
+def _names(share):
+    return [s[1] for s in share]
+
+
+def test_the_stages_are_split_longest_first_to_the_less_loaded_process():
+    # by hand, the helper starting at HELPER_START_S (3 s), this process at `before`
+    assert HELPER_START_S == 3.0
     four = [_stage(c, 10.0) for c in "abcd"]
-    assert [s[1] for s in helper_share(four, 0.0)] == ["c", "d"]  # 20 / 20
-    assert [s[1] for s in helper_share(four, 20.0)] == ["b", "c", "d"]  # 20 / 30
-    assert [s[1] for s in helper_share(four, 100.0)] == ["a", "b", "c", "d"]
-    uneven = [_stage("a", 2.0), _stage("b", 2.0), _stage("c", 20.0), _stage("d", 19.0)]
-    assert [s[1] for s in helper_share(uneven, 4.0)] == ["d"]  # 28 / 19, not 8 / 39
-    assert helper_share([], 5.0) == []
+    own, helper = split(four, 0.0)  # a -> own (0 < 3), b -> helper, c -> own, d -> helper
+    assert _names(own) == ["a", "c"] and _names(helper) == ["b", "d"]
+    own, helper = split(four, 20.0)  # a, b to the helper (3, 13 < 20), c here, d there
+    assert _names(helper) == ["a", "b", "d"] and _names(own) == ["c"]  # 33 / 30
+    assert split(four, 100.0) == ([], four)
+    # the two largest go one to each process whatever their order in the plan
+    default_like = [_stage("truth", 6.7), _stage("predict", 5.8), _stage("correct", 13.6),
+                    _stage("belief", 0.9), _stage("select", 16.6)]
+    own, helper = split(default_like, 4.0)
+    assert _names(helper) == ["predict", "select"]  # 3 + 16.6 + 5.8 = 25.4
+    assert _names(own) == ["truth", "correct", "belief"]  # 4 + 13.6 + 6.7 + 0.9 = 25.2
+    assert split([], 5.0) == ([], [])
+    # a partition, in the plan's order
+    for stages, before in ((four, 7.0), (default_like, 0.0)):
+        own, helper = split(stages, before)
+        assert sorted(_names(own) + _names(helper)) == sorted(_names(stages))
+        assert _names(own) == [n for n in _names(stages) if n in _names(own)]
 
 
 def test_the_helper_shares_only_what_the_cache_lacks(monkeypatch):
-    """Stages another path left in the cache cost nothing: the helper balances
-    the rest (by hand: a, b, d of 10 s each, c cached -> the helper takes b and
-    d; blind to the cache it would take c and d, and c is no work), and
-    compiles its share in this process's order, never waiting for claims."""
+    """Stages another path left in the cache cost nothing: the split is of the
+    rest (by hand: a, b, d of 10 s each, c cached: a to this process, b to the
+    helper, d to this one, at 10 / 13), and the helper compiles the indices
+    it is given, or without them its own share, never waiting for claims."""
     compiled = []
 
     class Fake:
@@ -70,9 +86,16 @@ def test_the_helper_shares_only_what_the_cache_lacks(monkeypatch):
     monkeypatch.setattr(compile_helper, "_release", released.append)
     monkeypatch.setattr(jit.ContentFunctionCache, "awaits_claims", True)
     assert compile_helper.run("p") == 0
-    assert compiled == ["b", "d"] and released == ["b", "d"]
+    assert compiled == ["b"] and released == ["b"]
     assert jit.ContentFunctionCache.awaits_claims is False
+    compiled.clear()
+    assert compile_helper.run("p", stages=[3, 2, 0]) == 0  # c is cached meanwhile
+    assert compiled == ["a", "d"]
     assert compile_helper.run("unknown") == 1
+    # this process's own share: what start() hands to compile_own()
+    compiled.clear()
+    compile_helper.compile_own([(Fake("a"), ()), (Fake("d"), ())])
+    assert compiled == ["a", "d"]
 
 
 def _write_plan(path: Path, version=None) -> Path:
@@ -97,11 +120,11 @@ def test_no_helper_when_switched_off_or_the_path_is_unknown(tmp_path, monkeypatc
                                           RECONFIGURING, Path as Path_)
     path = Path_(LINEAR_PLANT, PAPER_FILTER, ONE_STEP_TEST, RECONFIGURING)
     plan = _write_plan(tmp_path / "plan.pkl")  # knows only "probe path"
-    assert compile_helper.start(path, plan) is None
+    assert compile_helper.start(path, plan) == (None, [])
     monkeypatch.setenv("FTC_MC_COMPILE_HELPER", "0")
     assert not compile_helper.enabled()
     monkeypatch.setattr(compile_helper, "plan_key", lambda p: "probe path")
-    assert compile_helper.start(path, plan) is None
+    assert compile_helper.start(path, plan) == (None, [])
 
 
 @pytest.mark.skipif(not compile_helper.enabled(), reason="one core, or the helper is off")
@@ -113,9 +136,15 @@ def test_start_runs_the_helper_for_a_known_path_and_stop_ends_it(tmp_path, monke
                                           RECONFIGURING, Path as Path_)
     plan = _write_plan(tmp_path / "plan.pkl")
     monkeypatch.setattr(compile_helper, "plan_key", lambda p: "probe path")
-    proc = compile_helper.start(Path_(LINEAR_PLANT, PAPER_FILTER, ONE_STEP_TEST,
-                                      RECONFIGURING), plan)
-    assert proc is not None and proc.wait(300) == 0
+    # one stage of 1 s, not cached: the helper's (it starts at 3 s of work,
+    # this process at the plan's 5 s before the stages)
+    plan.write_bytes(pickle.dumps({"numba": numba.__version__, "paths": {"probe path": {
+        "before_s": 5.0, "stages": [(MODULE, NAME, ARGS, 1.0)]}}}, protocol=4))
+    monkeypatch.setattr(jit, "cached_signature", lambda d, args: False)
+    proc, own = compile_helper.start(Path_(LINEAR_PLANT, PAPER_FILTER, ONE_STEP_TEST,
+                                           RECONFIGURING), plan)
+    assert own == [] and proc is not None and proc.wait(300) == 0
+    assert proc.args[-2:] == ["--stages", "0"]
     compile_helper.stop(proc)
     assert proc.returncode == 0
     sleeper = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)"])
@@ -186,8 +215,8 @@ def _env(cache: Path) -> dict:
 
 @needs_cache
 def test_the_helper_compiles_its_share_and_this_process_loads_it(tmp_path):
-    """``python -m ftc_mc.sim.compile_helper KEY --plan F`` compiles the plan's
-    stage into the cache and leaves no claim; a process then loads the kernel
+    """``python -m ftc_mc.sim.compile_helper KEY --plan F --stages 0`` compiles
+    the plan's stage into the cache and leaves no claim; a process then loads the kernel
     (a cache hit, no compile) and computes the same value as one that
     compiled it itself."""
     plan = _write_plan(tmp_path / "plan.pkl")
@@ -198,8 +227,8 @@ def test_the_helper_compiles_its_share_and_this_process_loads_it(tmp_path):
     assert alone["misses"] == 1 and alone["hits"] == 0
     env = _env(tmp_path / "shared")
     helper = subprocess.run([sys.executable, "-m", "ftc_mc.sim.compile_helper", "probe path",
-                             "--plan", str(plan)], env=env, capture_output=True, text=True,
-                            timeout=300, cwd=ROOT)
+                             "--plan", str(plan), "--stages", "0"], env=env,
+                            capture_output=True, text=True, timeout=300, cwd=ROOT)
     assert helper.returncode == 0, helper.stderr
     assert not list((tmp_path / "shared").rglob("*.claim"))
     assert list((tmp_path / "shared").rglob("excitation.doublet_length-*.nbi"))
@@ -265,7 +294,7 @@ def test_the_shipped_plan_matches_the_default_path(trial_kernel):
         assert d is not None, f"{module}.{qualname} is not a cached kernel of core/"
         assert tuple(args) in d.overloads, f"{qualname}: {args} not called by the path"
     # the helper's share is real work: at least a third of the stages' seconds
-    share = helper_share(stages, plan[plan_key(path)]["before_s"])
+    own, share = split(stages, plan[plan_key(path)]["before_s"])
     assert sum(s[3] for s in share) >= sum(s[3] for s in stages) / 3
 
 

@@ -5,22 +5,24 @@ Numba compiles a kernel on one core: a path's cold compile
 <ftc_mc.core.longitudinal.trial.advance>`, and each stage it calls (the truth
 plant, the filter's prediction and correction, the selection, ...) is compiled
 in full, one after another, when its call is typed.  Those stages do not depend
-on each other, so on a machine with two cores a helper process compiles the
-later ones into the kernel cache while this process compiles the earlier ones;
-when this process reaches a stage the helper has done it loads it from the cache,
-and one the helper is still compiling it waits for (the *claims* of
-:class:`ftc_mc.core.jit.ContentFunctionCache`).  ``advance``'s own compile,
-which links every stage, stays in this process (measured: ``docs/performance.md``,
-lesson 11).
+on each other, so on a machine with two cores they are split in two shares of
+about equal work (:func:`split`): a helper process compiles one into the kernel
+cache while this process compiles the other before it types ``advance``
+(:func:`compile_own`); when the typing reaches a stage the helper has done it
+loads it from the cache, and one the helper is still compiling it waits for
+(the *claims* of :class:`ftc_mc.core.jit.ContentFunctionCache`).  ``advance``'s
+own compile, which links every stage, stays in this process (measured:
+``docs/performance.md``, lessons 11 and 14).
 
 The helper must know each stage's Numba signature before ``advance`` is typed.
 The *compile plan* (:data:`PLAN_FILE`, written by ``scripts/make_compile_plan.py``)
 holds, per path of the shipped configs, the stages ``advance`` compiles, in the
 order it compiles them, with their argument types and the seconds each took.
-A plan that no longer matches the kernels costs only the helper's work: the
-cache is keyed on the signature and the kernel sources, so a stage compiled
-for a signature ``advance`` no longer uses is never loaded, and this process
-compiles whatever it finds missing.  Results never depend on the helper.
+A plan that no longer matches the kernels costs only the work of compiling
+its stages: the cache is keyed on the signature and the kernel sources, so a
+stage compiled for a signature ``advance`` no longer uses is never loaded, and
+``advance``'s typing compiles whatever it finds missing.  Results never depend
+on the helper.
 
 Run as ``python -m ftc_mc.sim.compile_helper KEY [--plan FILE]`` by
 :func:`start`; ``FTC_MC_COMPILE_HELPER=0`` turns it off.
@@ -86,44 +88,100 @@ def load_plan(plan_file: Path = PLAN_FILE) -> dict:
     return plan.get("paths", {})
 
 
-def helper_share(stages, before_s: float) -> list:
-    """The stages the helper compiles: the tail of ``stages`` (in this
-    process's compile order) that best balances the two processes' work,
-    this process having ``before_s`` seconds of compile before ``advance``'s
-    first stage.
+HELPER_START_S = 3.0
+"""Seconds a helper takes to start (Python, Numba and ``ftc_mc`` imported,
+the plan read) before it compiles: its load at the start of :func:`split`."""
+
+
+def split(stages, before_s: float) -> tuple[list, list]:
+    """The stages this process compiles and those the helper compiles: the
+    longest first, each to the process with less work so far (this one
+    starting at ``before_s``, the helper at :data:`HELPER_START_S`), both
+    shares in the plan's order.
+
+    The stages do not depend on each other, so any partition is valid; this
+    process compiles its share before it types ``advance``
+    (:func:`compile_own`), not when ``advance``'s typing reaches each stage,
+    so the two largest stages can go one to each process whatever their
+    order in ``advance``.
 
     Parameters
     ----------
     stages : list of tuple
-        One tuple per stage, in compile order, its compile seconds last
-        (the plan's ``(module, qualname, argument types, seconds)``).
+        One tuple per stage, its compile seconds last (the plan's ``(module,
+        qualname, argument types, seconds)``).
     before_s : float
-        Seconds this process compiles before the first stage [s].
+        Seconds this process compiles besides the stages (the setup kernels
+        before ``advance``) [s].
+
+    Returns
+    -------
+    own, helper : list of tuple
+        The two shares of ``stages``.
     """
-    secs = [s[-1] for s in stages]
-    best, cut = float("inf"), len(stages)
-    for k in range(len(stages) + 1):
-        longest = max(before_s + sum(secs[:k]), sum(secs[k:]))
-        if longest < best:
-            best, cut = longest, k
-    return list(stages[cut:])
+    load = [before_s, HELPER_START_S]
+    where = {}
+    for i in sorted(range(len(stages)), key=lambda i: -stages[i][-1]):
+        p = 0 if load[0] <= load[1] else 1
+        where[i] = p
+        load[p] += stages[i][-1]
+    return ([s for i, s in enumerate(stages) if where[i] == 0],
+            [s for i, s in enumerate(stages) if where[i] == 1])
+
+
+def _to_compile(entry) -> list:
+    """``(index, dispatcher, args, seconds)`` of each stage of the plan's
+    ``entry`` the kernel cache lacks (a stage another path left in the cache
+    costs nothing)."""
+    todo = []
+    for i, (module, qualname, args, seconds) in enumerate(entry["stages"]):
+        dispatcher = _dispatcher(module, qualname)
+        if dispatcher is not None and not jit.cached_signature(dispatcher, args):
+            todo.append((i, dispatcher, args, seconds))
+    return todo
 
 
 def start(path, plan_file: Path = PLAN_FILE):
     """Start the helper for the compile ``path`` if it may run (:func:`enabled`)
-    and the plan knows the path; return its process, or None."""
+    and the plan knows the path.
+
+    Returns
+    -------
+    proc : subprocess.Popen or None
+        The helper, compiling its share of :func:`split` (its stages' indices
+        in the plan passed as ``--stages``).
+    own : list of tuple
+        ``(dispatcher, argument types)`` of this process's share, for
+        :func:`compile_own`; empty without a helper.
+    """
     if not enabled():
-        return None
+        return None, []
     key = plan_key(path)
-    if key not in load_plan(plan_file):
-        return None
+    entry = load_plan(plan_file).get(key)
+    if entry is None:
+        return None, []
+    own, theirs = split(_to_compile(entry), entry["before_s"])
+    if not theirs:
+        return None, []
     cmd = [sys.executable, "-m", __name__, key, "--plan", str(plan_file),
-           "--parent", str(os.getpid())]
+           "--parent", str(os.getpid()), "--stages", ",".join(str(t[0]) for t in theirs)]
     try:  # run from the folder this package is in: the helper imports this ftc_mc
-        return subprocess.Popen(cmd, cwd=PACKAGE_ROOT, stdin=subprocess.DEVNULL,
+        proc = subprocess.Popen(cmd, cwd=PACKAGE_ROOT, stdin=subprocess.DEVNULL,
                                 stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     except OSError:
-        return None
+        return None, []
+    return proc, [(t[1], t[2]) for t in own]
+
+
+def compile_own(own) -> None:
+    """Compile this process's share (:func:`start`) into the kernel cache,
+    before ``advance`` is typed; a stage that fails to compile (a stale plan)
+    is left to that typing."""
+    for dispatcher, args in own:
+        try:
+            dispatcher.compile(tuple(args))
+        except Exception:  # noqa: BLE001 -- advance's typing compiles what it lacks
+            pass
 
 
 def stop(proc) -> None:
@@ -175,26 +233,28 @@ def _release(claim) -> None:
     os.close(fd)
 
 
-def run(key: str, plan_file: Path = PLAN_FILE, parent: int | None = None) -> int:
-    """The helper's work: claim its share (:func:`helper_share`) of the path
-    ``key``'s stages that the cache lacks (those it holds, from another path
-    compiled before, cost this process nothing), then compile them in order,
-    letting go of each claim when its kernel is saved.  A stage that fails
-    to compile (a stale plan) is left to the process it works for.  Stops
-    when that process, ``parent`` (default: this one's parent), has gone.
-    Returns the exit status (0, or 1 when the plan does not know ``key``)."""
+def run(key: str, plan_file: Path = PLAN_FILE, parent: int | None = None,
+        stages=None) -> int:
+    """The helper's work: claim its share of the path ``key``'s stages that
+    the cache lacks (the plan indices ``stages`` that :func:`start` chose;
+    without them, the helper's share of :func:`split`), then compile them in
+    the plan's order, letting go of each claim when its kernel is saved.  A
+    stage that is cached meanwhile is skipped; one that fails to compile (a
+    stale plan) is left to the process it works for.  Stops when that
+    process, ``parent`` (default: this one's parent), has gone.  Returns the
+    exit status (0, or 1 when the plan does not know ``key``)."""
     entry = load_plan(plan_file).get(key)
     if entry is None:
         return 1
     parent = os.getppid() if parent is None else parent
     jit.ContentFunctionCache.awaits_claims = False  # never wait: no cycle of waits
-    todo = []
-    for module, qualname, args, seconds in entry["stages"]:
-        dispatcher = _dispatcher(module, qualname)
-        if dispatcher is not None and not jit.cached_signature(dispatcher, args):
-            todo.append((dispatcher, args, seconds))
+    todo = _to_compile(entry)
+    if stages is None:
+        share = split(todo, entry["before_s"])[1]
+    else:
+        share = [t for t in todo if t[0] in set(stages)]
     claimed = []
-    for dispatcher, args, _ in helper_share(todo, entry["before_s"]):
+    for _, dispatcher, args, _ in share:
         claim = _claim(dispatcher, args)
         if claim is not None:
             claimed.append((dispatcher, args, claim))
@@ -217,8 +277,12 @@ def main(argv=None) -> int:
     ap.add_argument("--plan", type=Path, default=PLAN_FILE, help="the compile plan file")
     ap.add_argument("--parent", type=int, default=None,
                     help="the process it works for (default: its parent)")
+    ap.add_argument("--stages", default=None,
+                    help="the plan indices of the stages to compile, comma-separated "
+                    "(default: the helper's share of the balance)")
     a = ap.parse_args(argv)
-    return run(a.key, a.plan, a.parent)
+    stages = None if a.stages is None else [int(i) for i in a.stages.split(",") if i]
+    return run(a.key, a.plan, a.parent, stages)
 
 
 if __name__ == "__main__":

@@ -79,8 +79,9 @@ def compiled_once(dispatcher, path=None, stream=None):
     is let go at once and the block loads the kernel; otherwise the block
     announces the compile (:func:`ftc_mc.core.jit.announce_compile`) and runs
     holding the lock, with a compile helper (:mod:`ftc_mc.sim.compile_helper`)
-    compiling the later stages of ``path`` in a second process meanwhile; the
-    helper is ended when the block ends.
+    compiling part of the stages of ``path`` in a second process meanwhile,
+    while this process compiles the other part before the block; the helper
+    is ended when the block ends.
     Without a disk cache (``FTC_MC_NUMBA_CACHE=0``) there is nothing to share:
     the block only announces.
 
@@ -114,12 +115,15 @@ def compiled_once(dispatcher, path=None, stream=None):
         stack.enter_context(waiting(lock_path(dispatcher, path), on_wait=say_wait,
                                     timeout_s=WAIT_LIMIT_S, on_timeout=give_up))
         needed = jit.needs_compile(dispatcher, first)  # again: the holder may have filled it
+        own = []  # this process's share of the path's stages (compile_helper.split)
         if needed is not True:
             stack.close()  # the holder filled the cache: load it without the lock
         elif path is not None:
-            stack.callback(compile_helper.stop, compile_helper.start(path))
+            proc, own = compile_helper.start(path)
+            stack.callback(compile_helper.stop, proc)
         with _timed(jit.announce_compile(dispatcher, what, expected_compile(path), out,
                                          needed), out):
+            compile_helper.compile_own(own)
             yield
 
 
