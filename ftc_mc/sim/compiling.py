@@ -50,9 +50,9 @@ def lock_path(dispatcher, path=None) -> Path:
 EXPECTED_COMPILE = {LinearPlant: "1 min", NonlinearPlant: "1-1.5 min",
                     SixdofPlant: "1-3.5 min", SixdofExtendedPlant: "1.5-4 min"}
 """What the compile notice says a path's cold compile takes, by its plant marker
-(``core/shared/paths.py``), on 2 cores: the default (linear) path 51-66 s on
+(``core/shared/paths.py``), on 2 cores: the default (linear) path 48-61 s on
 an empty cache with the compile helper (:mod:`ftc_mc.sim.compile_helper`;
-``docs/performance.md``, lesson 11, stop 38), the longitudinal paths 52-92 s
+``docs/performance.md``, lessons 11 and 14, stop 39), the longitudinal paths 52-92 s
 in one process; the 6-DOF paths 67-87 s when
 the kernels they share with a longitudinal path are cached (nominal and
 reconfiguring, measured at stop 35; 160 s beside another compile) and 166-208
