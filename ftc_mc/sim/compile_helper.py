@@ -24,7 +24,7 @@ stage compiled for a signature ``advance`` no longer uses is never loaded, and
 ``advance``'s typing compiles whatever it finds missing.  Results never depend
 on the helper.
 
-Run as ``python -m ftc_mc.sim.compile_helper KEY [--plan FILE]`` by
+Run as ``python -m ftc_mc.sim.compile_helper KEY [--plan FILE] [--stages I,J,...]`` by
 :func:`start`; ``FTC_MC_COMPILE_HELPER=0`` turns it off.
 """
 
@@ -252,7 +252,8 @@ def run(key: str, plan_file: Path = PLAN_FILE, parent: int | None = None,
     if stages is None:
         share = split(todo, entry["before_s"])[1]
     else:
-        share = [t for t in todo if t[0] in set(stages)]
+        chosen = set(stages)
+        share = [t for t in todo if t[0] in chosen]
     claimed = []
     for _, dispatcher, args, _ in share:
         claim = _claim(dispatcher, args)
