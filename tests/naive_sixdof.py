@@ -298,6 +298,7 @@ class SideMonitorRef:
         self.side_k, self.side_block, self.side_pre, self.side_n = -1, 0, 0, 0
         self.b = np.zeros(9)
         self.side, self.pos = 0, 0.0  # the first elevon named and its position estimate
+        self.turn_k = -1  # the step from which the lock-turn law may fly (k + 1 of that decision)
 
     def step(self, k, u, z, alive):
         from naive import glr_ref
@@ -355,7 +356,7 @@ class SideMonitorRef:
                 self.P[:, i] = 0.0
                 self.P[i, i] = mon.reset_var[i - ns]
             if block > 1 and self.side == 0:
-                self.side = block
+                self.side, self.turn_k = block, kn
             if alive:
                 self.side_n += 1
                 if kn >= self.kf:
@@ -464,6 +465,20 @@ def equation_outputs(pl, states, outs, x_dev, wind=None):
     from ftc_mc.model.sixdof import outputs
 
     return outputs(_on_trim(pl, states, x_dev), pl.p, wind)[outs] - pl.y0[outs]
+
+
+def turn_probe_ref(tab, t, b1):
+    """The lock-turn law's probe and hand-back ``t`` steps after it took over
+    (``ftc_mc/core/sixdof/lockturn.py``, written from that module's docstring):
+    the 3211 of Fig. 4 (``+A`` for 3 units, ``-A`` for 2, ``+A``, ``-A``) on the
+    named elevon, and whether a lane whose monitor estimates its ``b1`` hands
+    back.  Returns ``(addition [rad], hands back)``."""
+    if tab.probe == 0.0:
+        return 0.0, False
+    units = t // tab.probe_unit if t >= 0 else -1
+    signs = [1.0] * 3 + [-1.0] * 2 + [1.0, -1.0]
+    value = tab.probe * signs[units] if 0 <= units < len(signs) else 0.0
+    return value, bool(t == tab.check and b1 < tab.hand_back)
 
 
 def lock_turn_law_ref(tab, s, p, xhat, lo_dev, hi_dev):

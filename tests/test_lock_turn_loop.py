@@ -11,13 +11,13 @@ import numpy as np
 import pytest
 
 from ftc_mc import api
-from ftc_mc.core.sixdof.lockturn import LockTurnTable, lock_turn_law
+from ftc_mc.core.sixdof.lockturn import LockTurnTable, hands_back, lock_turn_law, turn_probe
 from ftc_mc.design import lock_turn as lt
 from ftc_mc.model.presets import PRESETS
 from ftc_mc.sim.monitor import MEASURED, lock_turn_table
 from ftc_mc.sim.setup import CONTROLLER_KINDS, build_setup
 
-from naive_sixdof import lock_turn_law_ref
+from naive_sixdof import lock_turn_law_ref, turn_probe_ref
 
 AF = PRESETS["x8-pyfly"].airframe
 
@@ -67,6 +67,24 @@ def test_law_matches_its_twin(measured):
                     assert MEASURED[o] == names[r]
     else:
         assert (tab.meas < 0).all()
+
+
+@pytest.mark.parametrize("probe, unit, check", [(0.03, 2, 30), (0.05, 1, 7), (0.0, 2, 30)])
+def test_probe_matches_its_twin(probe, unit, check):
+    """The probe's 3211 on the named elevon and the hand-back decision, at every
+    step from before the law took over to past the check, with estimates of
+    ``b1`` either side of the threshold: the kernels equal the twin."""
+    tab = build_empty_table(True)._replace(probe=probe, probe_unit=unit, check=check,
+                                           hand_back=0.5)
+    for t in range(-3, check + 5):
+        for b1 in (0.0, 0.49, 0.5, 0.97):
+            value, back = turn_probe_ref(tab, t, b1)
+            assert turn_probe(tab, t) == value, (t, b1)
+            assert hands_back(tab, t, b1) == back, (t, b1)
+    # the probe is the paper's 3211 (Fig. 4): 7 units, of which one more up than down
+    values = [turn_probe(tab, t) for t in range(0, 8 * unit)]
+    assert sum(v != 0.0 for v in values) == (7 * unit if probe else 0)
+    assert sum(values) == pytest.approx(unit * probe, abs=1e-15)
 
 
 def build_empty_table(measured):
@@ -140,6 +158,39 @@ def test_lock_turn_design_flies_on(tmp_path):
     assert "sixdof: stay in" in (tmp_path / "run" / "summary.md").read_text()
 
 
+def probe_config(probe_rad):
+    """Nonlinear 6-DOF, still air: left-elevon losses of 10-40 % at 5 s (which
+    the monitor names like locks) and locks within 1 deg of trim, 30 s flown."""
+    cfg = flies_on_config(0.0)
+    cfg["campaign"].update(transitions=["elevon_loss", "elevon_lock"], trials=4, chunk_size=4)
+    cfg["draws"] = {"loss_b1_range": [0.1, 0.4], "elevon_lock_range_rad": [0.04, 0.075]}
+    cfg["timing"]["duration_s"] = 30.0
+    cfg["monitor"].update(turn_probe_rad=probe_rad, hand_back_after_s=3.0,
+                          estimate_after_s=3.0)  # side_b1: the estimate the hand-back reads
+    return cfg
+
+
+def test_the_probe_hands_a_loss_back_and_keeps_a_lock(tmp_path):
+    """Without the probe the lock-turn law flies a partial loss as a lock and
+    circles; with it, the monitor's ``b1`` of the named elevon learns the loss,
+    the lane hands back to the paper's loop and holds its heading, while a lock
+    (``b1`` learnt near 1) keeps turning.  The same trials either way."""
+    runs = {p: api.run_campaign(probe_config(p), jobs=1, progress=False,
+                                out=tmp_path / f"run{p}").trials for p in (0.0, 0.03)}
+    off, on = (runs[p][runs[p]["variant"] == "sixdof"].set_index(["transition", "trial_id"])
+               for p in (0.0, 0.03))
+    assert (off["status"] == "ok").all() and (on["status"] == "ok").all()
+    loss_off, loss_on = off.loc["elevon_loss"], on.loc["elevon_loss"]
+    assert (loss_off["side_correct"] == 1).all()
+    assert (loss_off["heading_rms_deg"] > 20).all(), loss_off["heading_rms_deg"]
+    assert (loss_on["heading_rms_deg"] < 10).all(), loss_on["heading_rms_deg"]
+    lock_off, lock_on = off.loc["elevon_lock"], on.loc["elevon_lock"]
+    assert (lock_on["side_b1"] > 0.5).all(), lock_on["side_b1"]  # learnt: not handed back
+    assert (lock_off["side_b1"] < 0.2).all()  # without the probe, b0 takes the lock
+    np.testing.assert_allclose(lock_on["heading_rms_deg"], lock_off["heading_rms_deg"],
+                               rtol=0.05)
+
+
 @pytest.mark.parametrize("change, field", [
     ({"plant": {"dof": 3}}, "designs.sixdof.controller: lock_turn flies the 6-DOF plant"),
     ({"monitor": {"enabled": False}}, "designs.sixdof.controller: lock_turn is scheduled "
@@ -148,6 +199,8 @@ def test_lock_turn_design_flies_on(tmp_path):
      "controller.kind: lock_turn flies the 6-DOF plant"),
     ({"monitor": {"turn_offsets_deg": [2.0, -2.0]}}, "turn_offsets_deg: the first must be"),
     ({"monitor": {"turn_step_deg": 0.7}}, "turn_step_deg: must divide"),
+    ({"monitor": {"turn_probe_rad": 0.03, "hand_back_after_s": 1.0}},
+     "hand_back_after_s: must be at least the probe's length (1.4 s)"),
 ])
 def test_configs_that_cannot_fly_it_are_one_line(tmp_path, change, field):
     """A lock-turn design on the longitudinal plant or without the monitor, and

@@ -85,7 +85,9 @@ def _shared_periods(cfg) -> list:
             ("monitor.window_s", cfg.monitor.window_s),
             ("monitor.min_window_s", cfg.monitor.min_window_s),
             ("monitor.startup_s", cfg.monitor.startup_s),
-            ("monitor.estimate_after_s", cfg.monitor.estimate_after_s)]
+            ("monitor.estimate_after_s", cfg.monitor.estimate_after_s),
+            ("monitor.turn_probe_unit_s", cfg.monitor.turn_probe_unit_s),
+            ("monitor.hand_back_after_s", cfg.monitor.hand_back_after_s)]
 
 
 def _check_airframe_use(cfg) -> tuple:
@@ -394,11 +396,23 @@ class MonitorConfig(_Strict):
     """Step of that table [deg]: its range must hold a whole number of steps."""
     turn_feedback: Literal["measured", "estimate"] = "measured"
     """What the lock-turn law feeds back: ``measured``, the sensors' bank, pitch, body velocities and rates (the actuators from the monitor's estimate); ``estimate``, the monitor's estimate of every state, whose linear model drifts in steep turns."""
+    turn_probe_rad: Annotated[float, NoBool, Field(ge=0, le=0.3, allow_inf_nan=False)] = 0.0
+    """Amplitude of a 3211 the lock-turn law sends on the elevon the monitor named, from the step it takes over [rad]; 0: none, and no hand-back. A locked elevon does not move; one that lost only part of its effectiveness follows it, and the monitor's b1 of that side learns which (``ftc_mc/core/sixdof/lockturn.py``)."""
+    turn_probe_unit_s: Pos = 0.2
+    """One unit of that 3211 [s] (it lasts 7 units; the paper's 3211 unit by default)."""
+    hand_back_after_s: Pos = 3.0
+    """Time after the lock-turn law took over at which a probed lane is judged [s]: at least the probe's 7 units."""
+    hand_back_b1: Annotated[float, NoBool, Field(gt=0, le=1, allow_inf_nan=False)] = 0.5
+    """A probed lane whose monitor then estimates the named elevon's b1 (the share of its effectiveness lost) below this hands back: it flies the paper's reconfiguring loop and lateral autopilot again for the rest of the flight."""
 
     @model_validator(mode="after")
     def _ordered(self):
         if not self.min_window_s <= self.window_s:
             raise ValueError("min_window_s: must not exceed window_s")
+        probe_s = sum(S3211_UNITS) * self.turn_probe_unit_s
+        if self.turn_probe_rad > 0 and self.hand_back_after_s < probe_s * (1 - 1e-9):
+            raise ValueError(f"hand_back_after_s: must be at least the probe's length "
+                             f"({probe_s:g} s), got {self.hand_back_after_s:g}")
         lo, hi = self.turn_offsets_deg
         if not lo < hi:
             raise ValueError(f"turn_offsets_deg: the first must be below the second, got "

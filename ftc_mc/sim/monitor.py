@@ -76,6 +76,9 @@ class MonitorSpec:
         flies it.
     turn_measured : bool
         The lock-turn law feeds back the measured states (else the estimate).
+    turn_probe : tuple
+        ``(amplitude [rad], unit [steps], check [steps], hand_back [-])`` of the
+        lock-turn law's probe and hand-back (``LockTurnTable``; amplitude 0: off).
     nonlinear : bool
         The airframe's equations predict (``monitor.prediction``, resolved
         against the truth plant's kind; ``extended`` too).
@@ -102,6 +105,7 @@ class MonitorSpec:
     altitude_m: float = 100.0
     turn_offsets: tuple = ()
     turn_measured: bool = True
+    turn_probe: tuple = (0.0, 1, 0, 0.0)
     nonlinear: bool = False
     substeps: int = 5
     extended: bool = False
@@ -142,6 +146,8 @@ def monitor_spec(cfg, fm, det, lock_turn: bool = False) -> MonitorSpec | None:
         design_turbulence=mc.design_turbulence, altitude_m=float(cfg.plant.altitude_m),
         turn_offsets=tuple(np.radians(mc.turn_offsets())) if lock_turn else (),
         turn_measured=mc.turn_feedback == "measured",
+        turn_probe=(float(mc.turn_probe_rad), cfg.steps(mc.turn_probe_unit_s),
+                    cfg.steps(mc.hand_back_after_s), float(mc.hand_back_b1)),
         nonlinear=(mc.prediction in ("nonlinear", "extended") or
                    (mc.prediction == "auto" and cfg.plant.kind == "nonlinear")),
         substeps=int(mc.substeps),
@@ -178,7 +184,7 @@ def gust_block(six, spec: MonitorSpec, span: float):
 
 
 def lock_turn_table(six, u0: np.ndarray, offsets=(), airframe=None,
-                    measured: bool = True) -> LockTurnTable:
+                    measured: bool = True, probe=(0.0, 1, 0, 0.0)) -> LockTurnTable:
     """The kernels' :class:`LockTurnTable` (empty, ``x`` of shape ``(2, 0, 10)``,
     when ``offsets`` is).
 
@@ -200,6 +206,9 @@ def lock_turn_table(six, u0: np.ndarray, offsets=(), airframe=None,
     measured : bool
         Feed back the measured outputs of the states the sensors measure
         (``monitor.turn_feedback: measured``); else the monitor's estimate.
+    probe : tuple
+        ``(probe, probe_unit, check, hand_back)`` of the table
+        (:attr:`MonitorSpec.turn_probe`).
 
     Designs the cache does not hold are computed with a notice on stderr and
     their duration.
@@ -215,12 +224,15 @@ def lock_turn_table(six, u0: np.ndarray, offsets=(), airframe=None,
     seen = list(MEASURED) if measured else []
     meas = np.array([[seen.index(n) if n in seen else -1 for n in turn_states(side)]
                      for side in SIDES], dtype=np.int64)
+    amp, unit, check, back = probe
+    pr = dict(probe=float(amp), probe_unit=int(unit), check=int(check), hand_back=float(back))
     off = np.asarray(offsets, dtype=float)
     if off.size == 0:
         z = np.zeros
         return LockTurnTable(lo=z(2), step=1.0, x=z((2, 0, nf)), u=z((2, 0, len(COMMAND))),
                              K=z((2, 0, 2, nf)), k=z((2, 0, 2)), rows=rows, meas=meas,
-                             cmd=cmd, locked=locked, steady=z((2, 0)), hold=z(len(COMMAND)))
+                             cmd=cmd, locked=locked, steady=z((2, 0)), hold=z(len(COMMAND)),
+                             **pr)
     d = cached_lock_turn_designs(airframe, off, float(six.trim.V0),
                                  float(np.degrees(six.trim.gamma0)), six.dt,
                                  stream=sys.stderr)
@@ -231,7 +243,7 @@ def lock_turn_table(six, u0: np.ndarray, offsets=(), airframe=None,
                          else 1.0, x=c(x), u=c(d.cmd - np.asarray(u0, dtype=float)),
                          K=c(d.K), k=c(d.k), rows=rows, meas=meas, cmd=cmd, locked=locked,
                          steady=c(d.steady, dtype=np.float64),
-                         hold=c(six.u0 - np.asarray(u0, dtype=float)))
+                         hold=c(six.u0 - np.asarray(u0, dtype=float)), **pr)
 
 
 def side_monitor(six, u_ff: np.ndarray, u_lower, u_upper, lon_out: np.ndarray,
@@ -301,6 +313,7 @@ def side_monitor(six, u_ff: np.ndarray, u_lower, u_upper, lon_out: np.ndarray,
         r=c(np.concatenate([spec.r_lon, spec.r_lat])), reset_var=c(spec.reset_var),
         threshold=float(spec.threshold), window=int(spec.window),
         min_window=int(spec.min_window), startup=int(spec.startup), snap=int(spec.snap),
-        turn=lock_turn_table(six, u0, spec.turn_offsets, airframe, spec.turn_measured),
+        turn=lock_turn_table(six, u0, spec.turn_offsets, airframe, spec.turn_measured,
+                             spec.turn_probe),
         nonlinear=EXTENDED if spec.extended else int(spec.nonlinear),
         states=c(states, dtype=np.int64), outs=outs, n_sub=int(spec.substeps), wind=c(W))

@@ -316,6 +316,8 @@ LaneState = namedtuple("LaneState", [
     "mcount",   # (L,) int64 projections in that window
     "mside",    # (L,) int64 the first elevon it named: 0 none, else its block code (2, 3)
     "mpos",     # (L,) that elevon's estimated absolute position [rad] (core/sixdof/lockturn.py)
+    "mturn",    # (L,) int64 the step from which the lock-turn law may fly (the monitor's
+                #        first elevon decision, k + 1), or -1; ``mside`` < 0 once handed back
     # the extended filter's Jacobians about the lane's estimate (FilterModel.relin > 0;
     # the trim matrices otherwise, never read)
     "JA",       # (9, 9, L)  d x_{k+1} / d x_k of the one-period airframe map

@@ -44,7 +44,23 @@ to ``p`` let that estimate run away in the 6-DOF paper scenario).  Commands
 and ``u*`` are deviations from the longitudinal trim ``u0``, ``x*`` from the
 6-DOF trim, as the kernels hold them.
 
-Plain-NumPy twin: ``tests/naive_sixdof.py::lock_turn_law_ref``.
+**Probe and hand-back** (:func:`turn_probe`, :func:`hands_back`; off when
+``LockTurnTable.probe`` is 0).  The monitor names an elevon from the offset
+it sees, and a partial loss of effectiveness offsets the elevon as a lock does
+(by ``b1 (u + u0)``): with a steady command the two are the same to the
+monitor, which then puts the offset into ``b0`` and estimates ``b1`` near 0
+for both.  So while the law flies, the named elevon's command also carries a
+3211 of amplitude ``probe`` (eq. 23's shape, ``probe_unit`` steps a unit)
+from the step the law takes over (``LaneState.mturn``).  A locked elevon does
+not move; one that still works follows it in proportion to ``1 - b1``, and the
+monitor's ``b1`` of that side (its block was reset at the decision) learns
+which.  ``check`` steps after the law took over, a lane whose ``b1`` estimate
+is below ``hand_back`` hands back: its ``mside`` turns negative, and from that
+step it flies the paper's reconfiguring loop and lateral autopilot again, for
+the rest of the flight (the monitor names no elevon after it).
+
+Plain-NumPy twins: ``tests/naive_sixdof.py::lock_turn_law_ref``,
+``turn_probe_ref``.
 """
 
 from __future__ import annotations
@@ -52,6 +68,7 @@ from __future__ import annotations
 from collections import namedtuple
 
 from ..jit import kernel
+from ..shared.excitation import signal_3211, signal_3211_length
 
 LOCK_TURN = 2
 """``Reconfig.kind`` of a ``controller: lock_turn`` design (after 0 nominal and
@@ -71,6 +88,10 @@ LockTurnTable = namedtuple("LockTurnTable", [
     "steady",  # (2, n) 1.0: the lock has its own steady flight in the design box; 0.0: not
     "hold",    # (3,) the 6-DOF trim commands less u0: the locked elevon's command, and
                # the others' where neither lock bracketing the estimate is steady
+    "probe",   # amplitude of the 3211 on the named elevon [rad]; 0.0: no probe, no hand-back
+    "probe_unit",  # steps of one unit of that 3211
+    "check",   # steps after the law took over at which the hand-back is judged
+    "hand_back",  # the lane hands back when the monitor's b1 of the named elevon is below
 ])
 """The lock-turn designs of both sides over a grid of lock positions (module
 docstring); ``x`` of shape ``(2, 0, n_f)`` when no design flies it.  Built by
@@ -115,6 +136,24 @@ def lock_turn_law(tab, s, p, mx, z, lat, l, lo_dev, hi_dev, u):
         turn_law(tab, s, i, j1, w, mx, z, lat, l, lo_dev, hi_dev, u)
     a = tab.locked[s]
     u[a, l] = min(hi_dev[a], max(lo_dev[a], tab.hold[a]))
+
+
+@kernel(inline="always")
+def turn_probe(tab, t):
+    """The probe's addition to the named elevon's command ``t`` steps after
+    the law took over [rad]: the 3211 of ``tab.probe`` (0 outside it, or when
+    ``tab.probe`` is 0; module docstring)."""
+    if tab.probe == 0.0 or t < 0 or t >= signal_3211_length(tab.probe_unit):
+        return 0.0
+    return signal_3211(t, tab.probe_unit, tab.probe)
+
+
+@kernel(inline="always")
+def hands_back(tab, t, b1):
+    """Whether a lane whose law took over ``t`` steps ago, and whose monitor
+    estimates the named elevon's ``b1`` [-], hands back to the paper's loop
+    (module docstring)."""
+    return tab.probe != 0.0 and t == tab.check and b1 < tab.hand_back
 
 
 @kernel(inline="always")

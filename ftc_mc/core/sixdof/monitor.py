@@ -652,6 +652,7 @@ def monitor_decide(mon, flight, k, st, work, rec, num, den):
             P[pidx, pidx, l] = mon.reset_var[pidx - ns]
         if b > 1 and st.mside[l] == 0:  # the first elevon named (lockturn.py)
             st.mside[l] = b
+            st.mturn[l] = kn
         if st.alive[l]:
             rec.side_n[l] += 1
             if kn >= flight.timing.k_fault:

@@ -16,7 +16,8 @@ One step ``k -> k+1`` on every lane, with the longitudinal commands ``u_k``
 1. **Lateral loop.** (A ``controller: lock_turn`` design's lane whose side
    monitor has named an elevon flies the lock-turn law of
    :mod:`ftc_mc.core.sixdof.lockturn` instead: ``u`` is replaced, no
-   ``da``.)  ``da = -K_lat lat_k``, ``lat_k`` the loop's measured
+   ``da``, and the named elevon's command carries the law's probe; a lane
+   the probe hands back flies this loop again from that step.)  ``da = -K_lat lat_k``, ``lat_k`` the loop's measured
    state (``LaneState.lat``: bank, side velocity, roll and yaw rates and
    heading measured at ``k``, and its model of the commanded elevon
    positions).  The commands become ``u + u_ff + [0, da, -da]``, each
@@ -76,7 +77,7 @@ from ..longitudinal.plant import actuator_effect, gust_lanes, schedule_entry, se
 from ..shared.interp import engine_controller
 from .layout import (N_OUTPUT, N_STATE, N_WIND, OUTPUT, STATE, U_LEFT, U_RIGHT, W_P, W_Q,
                      W_R, W_U, W_V, W_W, X_PHI, X_PSI, Y_ALPHA, Y_VA, sixdof_name)
-from .lockturn import LOCK_TURN, lock_turn_law
+from .lockturn import LOCK_TURN, hands_back, lock_turn_law, turn_probe
 from .plant import N_WORK, outputs, propagate
 
 SIXDOF_NONLINEAR, SIXDOF_LINEAR = 2, 3
@@ -215,15 +216,25 @@ def sixdof_truth(plant, scheme, flight, inp, k, st, work, rec):
     u0 = scheme.filter.u0
     L = st.x.shape[1]
     u = work.u
-    a = pl.a_act
+    lag = pl.a_act
     turn = pl.monitor.turn
     turning = scheme.reconfig.kind == LOCK_TURN and turn.x.shape[1] > 0
+    b1_row = pl.monitor.A.shape[0] + pl.monitor.B.shape[1]  # the monitor's b1 of actuator 0
     xl = np.empty(N_X + N_LAT)
     du = np.empty(N_U)
     for l in range(L):
-        if turning and st.mside[l] > 0:
+        flies_turn = turning and st.mside[l] > 0
+        if flies_turn:
+            named = st.mside[l] - 1  # the named elevon's command (block code - 1)
+            if hands_back(turn, k - st.mturn[l], st.mx[b1_row + named, l]):
+                st.mside[l] = -st.mside[l]  # the paper's loop from this step on
+                flies_turn = False
+        if flies_turn:
             lock_turn_law(turn, st.mside[l] - 2, st.mpos[l], st.mx, work.z, st.lat, l,
                           ctl.lo_dev, ctl.hi_dev, u)
+            named = st.mside[l] - 1
+            v = u[named, l] + turn_probe(turn, k - st.mturn[l])
+            u[named, l] = min(ctl.hi_dev[named], max(ctl.lo_dev[named], v))
         elif pl.coupled != 0 and st.cur[l] <= C_ENGINE:
             for j in range(N_X):
                 xl[j] = st.xa[j, l]
@@ -247,10 +258,10 @@ def sixdof_truth(plant, scheme, flight, inp, k, st, work, rec):
             for i in range(N_U):
                 ui = u[i, l] + pl.u_ff[i] + _ELEVON_SIGN[i] * da
                 u[i, l] = min(ctl.hi_dev[i], max(ctl.lo_dev[i], ui))
-        st.lat[LAT_LEFT, l] = a * st.lat[LAT_LEFT, l] + (1.0 - a) * (u[U_LEFT, l]
-                                                                      - pl.u_ff[U_LEFT])
-        st.lat[LAT_RIGHT, l] = a * st.lat[LAT_RIGHT, l] + (1.0 - a) * (u[U_RIGHT, l]
-                                                                        - pl.u_ff[U_RIGHT])
+        st.lat[LAT_LEFT, l] = (lag * st.lat[LAT_LEFT, l]
+                               + (1.0 - lag) * (u[U_LEFT, l] - pl.u_ff[U_LEFT]))
+        st.lat[LAT_RIGHT, l] = (lag * st.lat[LAT_RIGHT, l]
+                                + (1.0 - lag) * (u[U_RIGHT, l] - pl.u_ff[U_RIGHT]))
     ev = schedule_entry(inp.k_switch, k)
     actuator_effect(u0, inp.b0[ev], inp.b1[ev], u, work.e)
     wlat = np.zeros((3, L))
