@@ -467,18 +467,19 @@ def equation_outputs(pl, states, outs, x_dev, wind=None):
     return outputs(_on_trim(pl, states, x_dev), pl.p, wind)[outs] - pl.y0[outs]
 
 
-def turn_probe_ref(tab, t, b1):
+def turn_probe_ref(tab, t, b1, var):
     """The lock-turn law's probe and hand-back ``t`` steps after it took over
     (``ftc_mc/core/sixdof/lockturn.py``, written from that module's docstring):
     the 3211 of Fig. 4 (``+A`` for 3 units, ``-A`` for 2, ``+A``, ``-A``) on the
-    named elevon, and whether a lane whose monitor estimates its ``b1`` hands
-    back.  Returns ``(addition [rad], hands back)``."""
+    named elevon, and whether a lane whose monitor estimates its ``b1`` with
+    variance ``var`` hands back.  Returns ``(addition [rad], hands back)``."""
     if tab.probe == 0.0:
         return 0.0, False
     units = t // tab.probe_unit if t >= 0 else -1
     signs = [1.0] * 3 + [-1.0] * 2 + [1.0, -1.0]
     value = tab.probe * signs[units] if 0 <= units < len(signs) else 0.0
-    return value, bool(t == tab.check and b1 < tab.hand_back)
+    upper = b1 + tab.hand_back_sd * np.sqrt(max(var, 0.0))
+    return value, bool(t == tab.check and upper < tab.hand_back)
 
 
 def lock_turn_law_ref(tab, s, p, xhat, lo_dev, hi_dev):

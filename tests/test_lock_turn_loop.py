@@ -73,14 +73,15 @@ def test_law_matches_its_twin(measured):
 def test_probe_matches_its_twin(probe, unit, check):
     """The probe's 3211 on the named elevon and the hand-back decision, at every
     step from before the law took over to past the check, with estimates of
-    ``b1`` either side of the threshold: the kernels equal the twin."""
+    ``b1`` and spreads either side of the threshold: the kernels equal the twin."""
     tab = build_empty_table(True)._replace(probe=probe, probe_unit=unit, check=check,
-                                           hand_back=0.5)
+                                           hand_back=0.5, hand_back_sd=2.0)
     for t in range(-3, check + 5):
-        for b1 in (0.0, 0.49, 0.5, 0.97):
-            value, back = turn_probe_ref(tab, t, b1)
+        for b1, var in ((0.0, 0.0), (0.49, 0.0), (0.5, 0.0), (0.97, 1e-4), (0.3, 0.0099),
+                        (0.3, 0.0101), (0.1, -1e-18)):
+            value, back = turn_probe_ref(tab, t, b1, var)
             assert turn_probe(tab, t) == value, (t, b1)
-            assert hands_back(tab, t, b1) == back, (t, b1)
+            assert hands_back(tab, t, b1, var) == back, (t, b1, var)
     # the probe is the paper's 3211 (Fig. 4): 7 units, of which one more up than down
     values = [turn_probe(tab, t) for t in range(0, 8 * unit)]
     assert sum(v != 0.0 for v in values) == (7 * unit if probe else 0)
@@ -187,8 +188,10 @@ def test_the_probe_hands_a_loss_back_and_keeps_a_lock(tmp_path):
     lock_off, lock_on = off.loc["elevon_lock"], on.loc["elevon_lock"]
     assert (lock_on["side_b1"] > 0.5).all(), lock_on["side_b1"]  # learnt: not handed back
     assert (lock_off["side_b1"] < 0.2).all()  # without the probe, b0 takes the lock
+    # the same turn (the probe moves the monitor's estimate the law reads, a
+    # little); a lock handed back would fly the paper's loop instead
     np.testing.assert_allclose(lock_on["heading_rms_deg"], lock_off["heading_rms_deg"],
-                               rtol=0.05)
+                               rtol=0.25)
 
 
 @pytest.mark.parametrize("change, field", [

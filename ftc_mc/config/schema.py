@@ -404,6 +404,8 @@ class MonitorConfig(_Strict):
     """Time after the lock-turn law took over at which a probed lane is judged [s]: at least the probe's 7 units."""
     hand_back_b1: Annotated[float, NoBool, Field(gt=0, le=1, allow_inf_nan=False)] = 0.5
     """A probed lane whose monitor then estimates the named elevon's b1 (the share of its effectiveness lost) below this hands back: it flies the paper's reconfiguring loop and lateral autopilot again for the rest of the flight."""
+    hand_back_sd: NonNeg = 2.0
+    """Standard deviations of the monitor's b1 estimate (its covariance) by which b1 must lie below hand_back_b1 to hand back: in gusts the probe hardly moves b1, and its spread keeps a lock turning."""
 
     @model_validator(mode="after")
     def _ordered(self):

@@ -77,8 +77,9 @@ class MonitorSpec:
     turn_measured : bool
         The lock-turn law feeds back the measured states (else the estimate).
     turn_probe : tuple
-        ``(amplitude [rad], unit [steps], check [steps], hand_back [-])`` of the
-        lock-turn law's probe and hand-back (``LockTurnTable``; amplitude 0: off).
+        ``(amplitude [rad], unit [steps], check [steps], hand_back [-],
+        hand_back_sd [-])`` of the lock-turn law's probe and hand-back
+        (``LockTurnTable``; amplitude 0: off).
     nonlinear : bool
         The airframe's equations predict (``monitor.prediction``, resolved
         against the truth plant's kind; ``extended`` too).
@@ -105,7 +106,7 @@ class MonitorSpec:
     altitude_m: float = 100.0
     turn_offsets: tuple = ()
     turn_measured: bool = True
-    turn_probe: tuple = (0.0, 1, 0, 0.0)
+    turn_probe: tuple = (0.0, 1, 0, 0.0, 0.0)
     nonlinear: bool = False
     substeps: int = 5
     extended: bool = False
@@ -147,7 +148,8 @@ def monitor_spec(cfg, fm, det, lock_turn: bool = False) -> MonitorSpec | None:
         turn_offsets=tuple(np.radians(mc.turn_offsets())) if lock_turn else (),
         turn_measured=mc.turn_feedback == "measured",
         turn_probe=(float(mc.turn_probe_rad), cfg.steps(mc.turn_probe_unit_s),
-                    cfg.steps(mc.hand_back_after_s), float(mc.hand_back_b1)),
+                    cfg.steps(mc.hand_back_after_s), float(mc.hand_back_b1),
+                    float(mc.hand_back_sd)),
         nonlinear=(mc.prediction in ("nonlinear", "extended") or
                    (mc.prediction == "auto" and cfg.plant.kind == "nonlinear")),
         substeps=int(mc.substeps),
@@ -184,7 +186,7 @@ def gust_block(six, spec: MonitorSpec, span: float):
 
 
 def lock_turn_table(six, u0: np.ndarray, offsets=(), airframe=None,
-                    measured: bool = True, probe=(0.0, 1, 0, 0.0)) -> LockTurnTable:
+                    measured: bool = True, probe=(0.0, 1, 0, 0.0, 0.0)) -> LockTurnTable:
     """The kernels' :class:`LockTurnTable` (empty, ``x`` of shape ``(2, 0, 10)``,
     when ``offsets`` is).
 
@@ -207,7 +209,7 @@ def lock_turn_table(six, u0: np.ndarray, offsets=(), airframe=None,
         Feed back the measured outputs of the states the sensors measure
         (``monitor.turn_feedback: measured``); else the monitor's estimate.
     probe : tuple
-        ``(probe, probe_unit, check, hand_back)`` of the table
+        ``(probe, probe_unit, check, hand_back, hand_back_sd)`` of the table
         (:attr:`MonitorSpec.turn_probe`).
 
     Designs the cache does not hold are computed with a notice on stderr and
@@ -224,8 +226,9 @@ def lock_turn_table(six, u0: np.ndarray, offsets=(), airframe=None,
     seen = list(MEASURED) if measured else []
     meas = np.array([[seen.index(n) if n in seen else -1 for n in turn_states(side)]
                      for side in SIDES], dtype=np.int64)
-    amp, unit, check, back = probe
-    pr = dict(probe=float(amp), probe_unit=int(unit), check=int(check), hand_back=float(back))
+    amp, unit, check, back, sd = probe
+    pr = dict(probe=float(amp), probe_unit=int(unit), check=int(check), hand_back=float(back),
+              hand_back_sd=float(sd))
     off = np.asarray(offsets, dtype=float)
     if off.size == 0:
         z = np.zeros

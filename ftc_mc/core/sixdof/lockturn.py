@@ -54,10 +54,16 @@ for both.  So while the law flies, the named elevon's command also carries a
 from the step the law takes over (``LaneState.mturn``).  A locked elevon does
 not move; one that still works follows it in proportion to ``1 - b1``, and the
 monitor's ``b1`` of that side (its block was reset at the decision) learns
-which.  ``check`` steps after the law took over, a lane whose ``b1`` estimate
-is below ``hand_back`` hands back: its ``mside`` turns negative, and from that
-step it flies the paper's reconfiguring loop and lateral autopilot again, for
-the rest of the flight (the monitor names no elevon after it).
+which.  The law is scheduled on the lock estimate without the probe
+(``mpos - (1 - b1) probe``: a lock estimate that followed the probe would
+move the law across the designs near the edge of the steady band).
+``check`` steps after the law took over, a lane whose ``b1`` estimate
+is below ``hand_back`` by at least ``hand_back_sd`` of its standard deviations
+(the monitor's covariance) hands back: its ``mside`` turns negative, and from
+that step it flies the paper's reconfiguring loop and lateral autopilot again,
+for the rest of the flight (the monitor names no elevon after it).  In gusts
+the probe hardly moves ``b1`` (``docs/airframes.md``); its spread then keeps
+the lane turning.
 
 Plain-NumPy twins: ``tests/naive_sixdof.py::lock_turn_law_ref``,
 ``turn_probe_ref``.
@@ -66,6 +72,8 @@ Plain-NumPy twins: ``tests/naive_sixdof.py::lock_turn_law_ref``,
 from __future__ import annotations
 
 from collections import namedtuple
+
+import numpy as np
 
 from ..jit import kernel
 from ..shared.excitation import signal_3211, signal_3211_length
@@ -91,7 +99,8 @@ LockTurnTable = namedtuple("LockTurnTable", [
     "probe",   # amplitude of the 3211 on the named elevon [rad]; 0.0: no probe, no hand-back
     "probe_unit",  # steps of one unit of that 3211
     "check",   # steps after the law took over at which the hand-back is judged
-    "hand_back",  # the lane hands back when the monitor's b1 of the named elevon is below
+    "hand_back",  # the lane hands back when the monitor's b1 of the named elevon is below,
+    "hand_back_sd",  # by at least this many of its standard deviations
 ])
 """The lock-turn designs of both sides over a grid of lock positions (module
 docstring); ``x`` of shape ``(2, 0, n_f)`` when no design flies it.  Built by
@@ -149,11 +158,12 @@ def turn_probe(tab, t):
 
 
 @kernel(inline="always")
-def hands_back(tab, t, b1):
+def hands_back(tab, t, b1, var):
     """Whether a lane whose law took over ``t`` steps ago, and whose monitor
-    estimates the named elevon's ``b1`` [-], hands back to the paper's loop
-    (module docstring)."""
-    return tab.probe != 0.0 and t == tab.check and b1 < tab.hand_back
+    estimates the named elevon's ``b1`` [-] with variance ``var``, hands back
+    to the paper's loop (module docstring)."""
+    return (tab.probe != 0.0 and t == tab.check
+            and b1 + tab.hand_back_sd * np.sqrt(max(var, 0.0)) < tab.hand_back)
 
 
 @kernel(inline="always")

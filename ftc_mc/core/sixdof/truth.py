@@ -226,14 +226,18 @@ def sixdof_truth(plant, scheme, flight, inp, k, st, work, rec):
         flies_turn = turning and st.mside[l] > 0
         if flies_turn:
             named = st.mside[l] - 1  # the named elevon's command (block code - 1)
-            if hands_back(turn, k - st.mturn[l], st.mx[b1_row + named, l]):
+            t = k - st.mturn[l]
+            b1 = st.mx[b1_row + named, l]
+            if hands_back(turn, t, b1, st.mP[b1_row + named, b1_row + named, l]):
                 st.mside[l] = -st.mside[l]  # the paper's loop from this step on
                 flies_turn = False
         if flies_turn:
-            lock_turn_law(turn, st.mside[l] - 2, st.mpos[l], st.mx, work.z, st.lat, l,
+            # the monitor's lock estimate holds the probe sent last step; the law
+            # is scheduled on the position without it
+            p = st.mpos[l] - (1.0 - b1) * turn_probe(turn, t - 1)
+            lock_turn_law(turn, st.mside[l] - 2, p, st.mx, work.z, st.lat, l,
                           ctl.lo_dev, ctl.hi_dev, u)
-            named = st.mside[l] - 1
-            v = u[named, l] + turn_probe(turn, k - st.mturn[l])
+            v = u[named, l] + turn_probe(turn, t)
             u[named, l] = min(ctl.hi_dev[named], max(ctl.lo_dev[named], v))
         elif pl.coupled != 0 and st.cur[l] <= C_ENGINE:
             for j in range(N_X):
