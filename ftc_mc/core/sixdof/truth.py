@@ -20,8 +20,9 @@ One step ``k -> k+1`` on every lane, with the longitudinal commands ``u_k``
    the probe hands back flies this loop again from that step.)
    ``da = -K_lat lat_k``, ``lat_k`` the loop's measured state
    (``LaneState.lat``: bank, side velocity, roll and yaw rates and heading
-   measured at ``k``, and its model of the commanded elevon positions).  The commands become ``u + u_ff + [0, da, -da]``, each
-   saturated at the command limits; ``u_ff`` is the 6-DOF trim's commands
+   measured at ``k``, and its model of the commanded elevon positions).  The
+   commands become ``u + u_ff + [0, da, -da]``, each saturated at the command
+   limits; ``u_ff`` is the 6-DOF trim's commands
    minus the longitudinal trim's (2e-3 rad of aileron against the propeller
    torque on ``x8-pyfly``).  ``TrialWork.u`` holds the result, so the
    filter and the history see the commands sent to the actuators.  The
