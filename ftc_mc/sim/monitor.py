@@ -31,7 +31,7 @@ Imported only on the 6-DOF path (by :func:`ftc_mc.sim.truth.sixdof_truth_plant`)
 from __future__ import annotations
 
 import sys
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -42,6 +42,10 @@ from ..core.sixdof.layout import (COMMAND, LAYOUT, MONITOR_DIRECTIONS, MONITOR_G
 from ..core.sixdof.lockturn import LockTurnTable
 from ..core.sixdof.monitor import EXTENDED, SideMonitor
 
+
+NO_PROBE = dict(probe=0.0, probe_unit=1, check=0, hand_back=0.0, hand_back_sd=0.0)
+"""The ``LockTurnTable`` fields of no probe and no hand-back (the same types as a
+configured probe's, so that both compile to one signature)."""
 
 MEASURED = LONGITUDINAL.outputs + MONITOR_LATERAL
 """The monitor's measured outputs in its order (``CAS`` and ``Va`` both the
@@ -76,10 +80,10 @@ class MonitorSpec:
         flies it.
     turn_measured : bool
         The lock-turn law feeds back the measured states (else the estimate).
-    turn_probe : tuple
-        ``(amplitude [rad], unit [steps], check [steps], hand_back [-],
-        hand_back_sd [-])`` of the lock-turn law's probe and hand-back
-        (``LockTurnTable``; amplitude 0: off).
+    turn_probe : dict
+        The lock-turn law's probe and hand-back, by their ``LockTurnTable``
+        fields: ``probe`` [rad] (0: off), ``probe_unit`` and ``check`` [steps],
+        ``hand_back`` and ``hand_back_sd`` [-].
     nonlinear : bool
         The airframe's equations predict (``monitor.prediction``, resolved
         against the truth plant's kind; ``extended`` too).
@@ -106,7 +110,7 @@ class MonitorSpec:
     altitude_m: float = 100.0
     turn_offsets: tuple = ()
     turn_measured: bool = True
-    turn_probe: tuple = (0.0, 1, 0, 0.0, 0.0)
+    turn_probe: dict = field(default_factory=lambda: dict(NO_PROBE))
     nonlinear: bool = False
     substeps: int = 5
     extended: bool = False
@@ -147,9 +151,10 @@ def monitor_spec(cfg, fm, det, lock_turn: bool = False) -> MonitorSpec | None:
         design_turbulence=mc.design_turbulence, altitude_m=float(cfg.plant.altitude_m),
         turn_offsets=tuple(np.radians(mc.turn_offsets())) if lock_turn else (),
         turn_measured=mc.turn_feedback == "measured",
-        turn_probe=(float(mc.turn_probe_rad), cfg.steps(mc.turn_probe_unit_s),
-                    cfg.steps(mc.hand_back_after_s), float(mc.hand_back_b1),
-                    float(mc.hand_back_sd)),
+        turn_probe=dict(probe=float(mc.turn_probe_rad),
+                        probe_unit=cfg.steps(mc.turn_probe_unit_s),
+                        check=cfg.steps(mc.hand_back_after_s),
+                        hand_back=float(mc.hand_back_b1), hand_back_sd=float(mc.hand_back_sd)),
         nonlinear=(mc.prediction in ("nonlinear", "extended") or
                    (mc.prediction == "auto" and cfg.plant.kind == "nonlinear")),
         substeps=int(mc.substeps),
@@ -186,7 +191,7 @@ def gust_block(six, spec: MonitorSpec, span: float):
 
 
 def lock_turn_table(six, u0: np.ndarray, offsets=(), airframe=None,
-                    measured: bool = True, probe=(0.0, 1, 0, 0.0, 0.0)) -> LockTurnTable:
+                    measured: bool = True, probe=None) -> LockTurnTable:
     """The kernels' :class:`LockTurnTable` (empty, ``x`` of shape ``(2, 0, 10)``,
     when ``offsets`` is).
 
@@ -208,9 +213,9 @@ def lock_turn_table(six, u0: np.ndarray, offsets=(), airframe=None,
     measured : bool
         Feed back the measured outputs of the states the sensors measure
         (``monitor.turn_feedback: measured``); else the monitor's estimate.
-    probe : tuple
-        ``(probe, probe_unit, check, hand_back, hand_back_sd)`` of the table
-        (:attr:`MonitorSpec.turn_probe`).
+    probe : dict, optional
+        The table's probe fields (:attr:`MonitorSpec.turn_probe`); default
+        :data:`NO_PROBE`.
 
     Designs the cache does not hold are computed with a notice on stderr and
     their duration.
@@ -226,9 +231,7 @@ def lock_turn_table(six, u0: np.ndarray, offsets=(), airframe=None,
     seen = list(MEASURED) if measured else []
     meas = np.array([[seen.index(n) if n in seen else -1 for n in turn_states(side)]
                      for side in SIDES], dtype=np.int64)
-    amp, unit, check, back, sd = probe
-    pr = dict(probe=float(amp), probe_unit=int(unit), check=int(check), hand_back=float(back),
-              hand_back_sd=float(sd))
+    pr = NO_PROBE if probe is None else probe
     off = np.asarray(offsets, dtype=float)
     if off.size == 0:
         z = np.zeros
