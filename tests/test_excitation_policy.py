@@ -55,6 +55,10 @@ def config(transitions=("elevon_loss",), trials=8, **over):
      "designs.x.excitation_residual"),
     ({"s3211_floor": 1.5}, "designs.x.s3211_floor"),
     ({"s3211_floor": -0.1}, "designs.x.s3211_floor"),
+    ({"doublet_amplitude": 0.0}, "designs.x.doublet_amplitude"),
+    ({"doublet_amplitude": 0.6}, "designs.x.doublet_amplitude"),
+    ({"s3211_amplitude_rad": 0.4}, "designs.x.s3211_amplitude_rad"),
+    ({"s3211_amplitude_rad": float("nan")}, "designs.x.s3211_amplitude_rad"),
 ])
 def test_bad_policies_are_one_line(design, needle):
     with pytest.raises(UserError) as exc:
@@ -95,6 +99,36 @@ def test_s3211_floor_reaches_the_kernels():
     assert fl._asdict() == {**sw._asdict(), "s3211_floor": 0.2}
     assert type(sw.s3211_floor) is type(fl.s3211_floor) is float
     assert setup.designs["fl"].key != setup.designs["swapped"].key
+
+
+def test_a_design_s_own_amplitudes_reach_the_kernels_and_fly():
+    """A design's ``doublet_amplitude`` and ``s3211_amplitude_rad`` (issue 25)
+    replace the excitation section's in its ``Excitation`` only, as floats, and
+    are part of the design key.  A design that sets the section's own values
+    flies bit for bit as one that sets none; a larger 3211 on the same policy
+    flies differently (more elevon energy)."""
+    same = {**PERIODIC, "doublet_amplitude": 0.1, "s3211_amplitude_rad": 0.05}
+    big = {**PERIODIC, "s3211_amplitude_rad": 0.15}
+    cfg = config(designs={"per": PERIODIC, "same": same, "big": big},
+                 campaign={"transitions": ["elevon_loss"], "trials": 8, "chunk_size": 8,
+                           "signature": "swapped", "designs": ["per", "same", "big"]})
+    spec = chunk_spec(cfg)
+    setup = spec.setup
+    assert (setup.exc.doublet_amp, setup.exc.s3211_amp) == (0.1, 0.05)  # the section's
+    per, same_x, big_x, sw = (setup.scheme(n).excitation for n in ("per", "same", "big",
+                                                                   "swapped"))
+    assert per._asdict() == same_x._asdict()
+    assert big_x._asdict() == {**per._asdict(), "s3211_amp": 0.15}
+    assert (sw.doublet_amp, sw.s3211_amp) == (0.1, 0.05)
+    assert [type(v) for v in big_x] == [type(v) for v in sw]
+    assert len({setup.designs[n].key for n in ("per", "same", "big")}) == 3
+    inp, _ = trial_inputs(spec, "elevon_loss", np.arange(8))
+    recs = {n: run_alone(setup, n, setup.det[n], inp, 64) for n in ("per", "same", "big")}
+    for f in recs["per"]._fields:
+        np.testing.assert_array_equal(getattr(recs["same"], f), getattr(recs["per"], f),
+                                      err_msg=f)
+    left = COST_U2 + LONGITUDINAL.inputs.index("elevon_left")
+    assert recs["big"].cost[left].sum() > recs["per"].cost[left].sum()
 
 
 def test_shared_start_with_a_policy_equals_running_alone():

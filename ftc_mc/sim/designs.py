@@ -31,8 +31,10 @@ fault or an output bias (:func:`_with_sensor_biases`).
 A design may also send excitation beyond the paper's requests on resets
 (``excitation_policy``, issue 25): its :attr:`Design.excitation` fills the
 policy fields of the kernels' :class:`~ftc_mc.core.longitudinal.settings.Excitation`
-(:data:`NO_POLICY` for the paper's, which leaves the kernels as before).  A
-policy changes the flight before any reset, so it is part of the design key.
+(:data:`NO_POLICY` for the paper's, which leaves the kernels as before), and
+the signals' amplitudes where the design sets its own (``doublet_amplitude``,
+``s3211_amplitude_rad``; else the config's ``excitation`` section).  A policy
+changes the flight before any reset, so it is part of the design key.
 
 A design changes only what the filter assumes: the truth noise of every trial
 comes from the config's ``estimator`` and ``noise`` sections, so all designs fly
@@ -65,18 +67,24 @@ under c2 scaled by ``1 - b1_left_hat`` as eq. 23 prints)."""
 
 
 def excitation_policy(dc: DesignConfig, dt: float) -> dict:
-    """The policy fields of the kernels' ``Excitation`` for the design ``dc``
-    (``dt``: the control period [s]); :data:`NO_POLICY` for ``none``, with the
-    design's ``s3211_floor`` (issue 25) either way."""
+    """The fields of the kernels' ``Excitation`` the design ``dc`` sets (``dt``:
+    the control period [s]): the policy's, :data:`NO_POLICY` for ``none``, with
+    the design's ``s3211_floor`` (issue 25) either way, and the signals'
+    amplitudes (``doublet_amp``, ``s3211_amp``) where the design sets its own."""
+    own = {"s3211_floor": float(dc.s3211_floor)}
+    if dc.doublet_amplitude is not None:
+        own["doublet_amp"] = float(dc.doublet_amplitude)
+    if dc.s3211_amplitude_rad is not None:
+        own["s3211_amp"] = float(dc.s3211_amplitude_rad)
     if dc.excitation_policy == "none":
-        return {**NO_POLICY, "s3211_floor": float(dc.s3211_floor)}
+        return {**NO_POLICY, **own}
     return {"policy": EXCITATION_POLICIES.index(dc.excitation_policy),
             "period": int(round(dc.excitation_period_s / dt)),
             "phase": int(round(dc.excitation_phase_s / dt)),
             "belief_max": float(dc.excitation_belief),
             "suspect": (math.inf if dc.excitation_residual is None
                         else float(dc.excitation_residual)),
-            "s3211_floor": float(dc.s3211_floor)}
+            **own}
 
 
 @dataclasses.dataclass(frozen=True)
@@ -106,7 +114,8 @@ class Design:
         Outputs whose sensor bias the design estimates, in the order of their
         states (the last ``len(biases)`` of the estimate).
     excitation : dict
-        The policy fields of the kernels' ``Excitation`` (:func:`excitation_policy`).
+        The fields of the kernels' ``Excitation`` the design sets: its policy,
+        ``s3211_floor`` and its own amplitudes (:func:`excitation_policy`).
     controller : str or None
         ``nominal`` or ``reconfiguring``: the design's own controller kind;
         None: the config's ``controller.kind``.
