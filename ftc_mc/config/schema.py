@@ -37,6 +37,10 @@ Pos = Annotated[float, NoBool, Field(gt=0, allow_inf_nan=False)]
 NonNeg = Annotated[float, NoBool, Field(ge=0, allow_inf_nan=False)]
 Fraction = Annotated[float, NoBool, Field(gt=0, lt=1, allow_inf_nan=False)]
 Finite = Annotated[float, NoBool, Field(allow_inf_nan=False)]
+DoubletAmplitude = Annotated[float, NoBool, Field(gt=0, le=0.5, allow_inf_nan=False)]
+"""An engine doublet amplitude [throttle fraction]: at most half the throttle range."""
+S3211Amplitude = Annotated[float, NoBool, Field(gt=0, le=0.3, allow_inf_nan=False)]
+"""An elevon 3211 amplitude [rad]."""
 
 
 class _Strict(BaseModel):
@@ -242,11 +246,11 @@ class ControllerConfig(_Strict):
 class ExcitationConfig(_Strict):
     """Excitation signals sent on covariance resets (sections 3.2.3, 4.1.1)."""
 
-    doublet_amplitude: Annotated[float, NoBool, Field(gt=0, le=0.5, allow_inf_nan=False)] = 0.1
+    doublet_amplitude: DoubletAmplitude = 0.1
     """Engine doublet amplitude [throttle fraction]."""
     doublet_half_period_s: Pos = 1.0
     """Duration of each half of the doublet [s] (engine time constant 0.3 s)."""
-    s3211_amplitude_rad: Annotated[float, NoBool, Field(gt=0, le=0.3, allow_inf_nan=False)] = 0.05
+    s3211_amplitude_rad: S3211Amplitude = 0.05
     """Elevon 3211 amplitude [rad], + on the left and - on the right elevon."""
     s3211_unit_s: Pos = 0.2
     """One unit of the 3211 [s] (the signal lasts 7 units)."""
@@ -586,9 +590,9 @@ class DesignConfig(_Strict):
     """Factor on the variances a covariance reset gives the reset block's fault parameters (section 3.2.2; both blocks): 1, the paper's ((u_max - u_min)/t)^2 for b0 and 1/t^2 for b1 (a standard deviation of 0.04 on b1 at t = 25, against a change of up to 1); t^2/12 (52.08 at t = 25), the variance of a uniform distribution over each parameter's range, which the paper says a reset should allow for ('all the possible values'). A larger reset lets one reset and its excitation carry the estimate the whole way to a recovered actuator (docs/recoveries.md)."""
     excitation_policy: Literal[EXCITATION_POLICIES] = "none"
     """Excitation beyond the paper's requests on resets (issue 25; docs/designs.md): none, the paper's (a doublet on a thrust reset, a 3211 on an elevon reset, the doublet re-check); periodic: also the engine doublet every excitation_period_s and the elevon 3211 half a period after each; ambiguous: also one of them (the other than the last sent) when the belief's most probable mode is below excitation_belief or r_q or r_nx reach excitation_residual, at most once per excitation_period_s. A signal is only sent while none runs; the excitation section sets both signals, but for the amplitudes a design sets itself (doublet_amplitude, s3211_amplitude_rad)."""
-    doublet_amplitude: Annotated[float, NoBool, Field(gt=0, le=0.5, allow_inf_nan=False)] | None = None
+    doublet_amplitude: DoubletAmplitude | None = None
     """This design's engine doublet amplitude [throttle fraction], on resets and by its policy alike; null: the excitation section's (issue 25: a larger periodic signal finds smaller losses, at a measured tracking cost, docs/designs.md)."""
-    s3211_amplitude_rad: Annotated[float, NoBool, Field(gt=0, le=0.3, allow_inf_nan=False)] | None = None
+    s3211_amplitude_rad: S3211Amplitude | None = None
     """This design's elevon 3211 amplitude [rad], on resets and by its policy alike; null: the excitation section's."""
     s3211_floor: Annotated[float, NoBool, Field(ge=0, le=1, allow_inf_nan=False)] = 0.0
     """Under c2 the elevon 3211 is scaled by max(1 - b1_left_hat, s3211_floor) (issue 25; docs/recoveries.md): 0, eq. 23 as printed, which sends nothing to a left elevon estimated locked (b1_left_hat ~ 1), so a lock that clears at its trim command is never seen; a floor keeps a share of the 3211 on it."""
