@@ -66,7 +66,7 @@ design without an excitation policy (the paper's: signals on resets only, the 32
 under c2 scaled by ``1 - b1_left_hat`` as eq. 23 prints)."""
 
 
-def excitation_policy(dc: DesignConfig, dt: float) -> dict:
+def design_excitation(dc: DesignConfig, dt: float) -> dict:
     """The fields of the kernels' ``Excitation`` the design ``dc`` sets (``dt``:
     the control period [s]): the policy's, :data:`NO_POLICY` for ``none``, with
     the design's ``s3211_floor`` (issue 25) either way, and the signals'
@@ -115,7 +115,7 @@ class Design:
         states (the last ``len(biases)`` of the estimate).
     excitation : dict
         The fields of the kernels' ``Excitation`` the design sets: its policy,
-        ``s3211_floor`` and its own amplitudes (:func:`excitation_policy`).
+        ``s3211_floor`` and its own amplitudes (:func:`design_excitation`).
     controller : str or None
         ``nominal`` or ``reconfiguring``: the design's own controller kind;
         None: the config's ``controller.kind``.
@@ -260,7 +260,7 @@ def build_design(name: str, dc: DesignConfig, plant: LinearPlant, est: Estimator
     key = dc.model_dump_json(exclude={"signature", "t_q", "t_nx"})
     return Design(name=name, est=s, fm=fm, det=det, P0=_c(P0), test=test, window=window,
                   key=key, biases=tuple(dc.sensor_biases),
-                  excitation=excitation_policy(dc, plant.dt), controller=dc.controller,
+                  excitation=design_excitation(dc, plant.dt), controller=dc.controller,
                   reset_scale=dc.reset_scale)
 
 
