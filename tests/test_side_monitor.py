@@ -152,7 +152,11 @@ def test_monitor_matches_its_twin(setup):
     faults = [1, 2, 0, 1, 2, None, 1, 2]
     u, z = flown_data(setup, mon, n_steps, rng, faults)
     st, rec = lanes(setup, mon)
-    refs = [SideMonitorRef(mon, setup.tim.k_fault, setup.truth) for _ in range(L)]
+    # the extended twin takes its Jacobians by differences of Python RK4 steps
+    # (about 0.1 s per lane and step): there, one lane of each fault, the
+    # fault-free one and the stopped one are compared (the others repeat a fault)
+    compared = (0, 1, 2, 5, L - 1) if mon.nonlinear == EXTENDED else tuple(range(L))
+    refs = {l: SideMonitorRef(mon, setup.tim.k_fault, setup.truth) for l in compared}
     # relative errors in the norm: the order of the sums differs; the extended
     # filter's forward differences (step 1e-6) turn the rounding of two
     # implementations of the equations (1e-16) into 1e-10 in its Jacobians,
@@ -160,12 +164,12 @@ def test_monitor_matches_its_twin(setup):
     tol = 1e-6 if mon.nonlinear == EXTENDED else 1e-10
     for k in range(n_steps):
         run_kernel(setup, mon, st, rec, u, z, k)
-        for l, ref in enumerate(refs):
+        for l, ref in refs.items():
             ref.step(k, u[k, :, l], z[k, :, l], bool(st.alive[l]))
             for got, want, what in ((st.mx[:, l], ref.X, "X"), (st.mP[:, :, l], ref.P, "P")):
                 err = np.linalg.norm(got - want) / np.linalg.norm(want)
                 assert err < tol, f"{what}, step {k}, lane {l}: {err:.1e}"
-    for l, ref in enumerate(refs):
+    for l, ref in refs.items():
         assert (rec.side_k[l], rec.side_block[l], rec.side_pre[l], rec.side_n[l]) == (
             ref.side_k, ref.side_block, ref.side_pre, ref.side_n), l
         np.testing.assert_allclose(rec.mon_b[:, l], ref.b, rtol=10 * tol, atol=1e-12)
