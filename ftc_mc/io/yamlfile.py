@@ -1,8 +1,16 @@
 """Reading a YAML file safely: parsed data, or one :class:`~ftc_mc.errors.UserError` line.
 
-``yaml.safe_load`` only, so no tag can construct a Python object.  Shared by
+PyYAML's safe loader only, so no tag can construct a Python object.  Shared by
 configs (:mod:`ftc_mc.config.load`) and airframe files
 (:mod:`ftc_mc.model.airframe_files`); the line names the file and the problem.
+
+The loader is :data:`SAFE_LOADER`: PyYAML's libyaml-backed ``CSafeLoader``
+where PyYAML was built with libyaml (its wheels are), else the pure-Python
+``SafeLoader``.  Both construct with ``SafeConstructor``, so they return the
+same data; the C scanner and parser read a config about 10 times faster (the
+test suite spent 27 s of 380 in the pure-Python scanner, measured stop 42), and
+refuse nesting deeper than libyaml's limit (1000 levels) with a scanner error
+where the Python parser recursed until ``RecursionError``.
 """
 
 from __future__ import annotations
@@ -13,6 +21,9 @@ from pathlib import Path
 import yaml
 
 from ..errors import UserError
+
+SAFE_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+"""The safe loader :func:`read_yaml` parses with (module docstring)."""
 
 _REPR = reprlib.Repr()
 _REPR.maxstring = _REPR.maxother = 80
@@ -37,7 +48,7 @@ def read_yaml(path):
     except OSError as exc:
         raise UserError(f"{path}: cannot read ({exc.strerror})") from None
     try:
-        return yaml.safe_load(text)
+        return yaml.load(text, Loader=SAFE_LOADER)  # noqa: S506 (a safe loader)
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
