@@ -25,6 +25,20 @@ def test_shipped_configs_are_current():
             assert load_config(path).campaign.trials == 1000
 
 
+def test_the_fast_loader_reads_what_pyyaml_s_python_loader_reads():
+    """``read_yaml`` parses with libyaml where PyYAML has it (its wheels do);
+    every shipped config reads to the same data as with the
+    pure-Python ``SafeLoader``."""
+    from ftc_mc.io.yamlfile import SAFE_LOADER, read_yaml
+
+    assert SAFE_LOADER is (yaml.CSafeLoader if yaml.__with_libyaml__ else yaml.SafeLoader)
+    files = sorted((ROOT / "configs").glob("*.yaml"))
+    assert len(files) > 10
+    for path in files:
+        assert read_yaml(path) == yaml.load(path.read_text(encoding="utf-8"),
+                                            Loader=yaml.SafeLoader), path
+
+
 def test_sweep_config():
     cfg = load_config(ROOT / "configs" / "sweep.yaml")
     assert len(cfg.campaign.transitions) == 8 and cfg.controller.kind == "nominal"
