@@ -251,3 +251,81 @@ def test_a_source_removed_while_a_process_runs_is_a_change(tmp_path):
     assert jit.sources_unchanged(core)
     (root / "ftc_mc" / "layouts.py").unlink()
     assert jit.sources_unchanged(core) is False
+
+
+HELPER = '''"""A test helper kernel (tests/helper.py of a copied tree)."""
+from ftc_mc.core.jit import kernel
+
+OFFSET = {offset}
+
+
+@kernel
+def shifted(x):
+    return x + OFFSET
+'''
+
+USER = '''"""A test-side kernel (tests/user.py) inlining a helper and a core kernel."""
+from ftc_mc.core.jit import kernel
+from ftc_mc.core.probe import probe
+from helper import shifted
+
+
+@kernel
+def used(x):
+    return shifted(probe(x))
+'''
+
+RUN_TREE = '''
+import json, sys
+sys.path.insert(0, "tests")
+from user import used
+value = used(1.5)
+print(json.dumps({"value": value, "hits": sum(used.stats.cache_hits.values()),
+                  "misses": sum(used.stats.cache_misses.values()),
+                  "cache": used._cache.cache_path}))
+'''
+
+
+def _tree(root: Path, offset: float = 1.0) -> Path:
+    """A source tree: a package copy with ``pyproject.toml`` and ``tests/``."""
+    _copy(root)
+    (root / "pyproject.toml").write_text("[project]\nname = 'copy'\n")
+    (root / "tests").mkdir()
+    (root / "tests" / "helper.py").write_text(HELPER.format(offset=offset))
+    (root / "tests" / "user.py").write_text(USER)
+    return root
+
+
+def _run_tree(root: Path, cache: Path) -> dict:
+    env = {k: v for k, v in os.environ.items()
+           if k not in ("NUMBA_CACHE_DIR", "FTC_MC_NUMBA_CACHE", "PYTHONPATH")}
+    env.update(PYTHONPATH=str(root), FTC_MC_CACHE_DIR=str(cache))
+    out = subprocess.run([sys.executable, "-c", RUN_TREE], cwd=root, env=env,
+                         capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr
+    return json.loads(out.stdout.splitlines()[-1])
+
+
+@pytest.mark.skipif(not jit.CACHE, reason="FTC_MC_NUMBA_CACHE=0")
+def test_a_test_kernel_is_keyed_on_the_tree_s_content_not_its_path(tmp_path):
+    """A kernel of a tree's ``tests/`` (jit.CloneFolderLocator): another clone of
+    the same files loads it; an edit of another file of ``tests/`` that it
+    inlines, or of a core kernel it inlines, compiles it again (Numba's own
+    locator stamped it with ``tests/user.py`` alone and loaded it stale)."""
+    cache = tmp_path / "cache"
+    first = _run_tree(_tree(tmp_path / "a"), cache)
+    assert first["misses"] == 1 and first["hits"] == 0
+    assert first["value"] == 2.0 * 1.5 + 9 + 1.0
+    assert "/clone/" in first["cache"] and str(tmp_path / "a") not in first["cache"]
+    b = _tree(tmp_path / "b")
+    second = _run_tree(b, cache)
+    assert second["hits"] == 1 and second["misses"] == 0 and second["cache"] == first["cache"]
+    (b / "tests" / "helper.py").write_text(HELPER.format(offset=5.0))
+    helper = _run_tree(b, cache)
+    assert helper["misses"] == 1 and helper["value"] == 2.0 * 1.5 + 9 + 5.0
+    (b / "ftc_mc" / "core" / "probe_parts" / "scale.py").write_text(SCALE.format(factor=3.0))
+    core = _run_tree(b, cache)
+    assert core["misses"] == 1 and core["value"] == 3.0 * 1.5 + 9 + 5.0
+    # without pyproject.toml (an installed package's neighbours): Numba's own locator
+    (b / "pyproject.toml").unlink()
+    assert "/clone/" not in _run_tree(b, cache)["cache"]

@@ -16,7 +16,10 @@ clone or install of identical sources loads the kernels, while any edit of a
 kernel source starts a new folder.  A process whose kernel sources change while
 it runs saves no kernel (:func:`sources_unchanged`), and a kernel whose cache
 folder cannot be written is not cached (Numba's own locators, keyed on the
-kernel's file alone, are not tried for the kernels of ``core/``).  ``NUMBA_CACHE_DIR`` in the environment takes
+kernel's file alone, are not tried for the kernels of ``core/``).  A kernel of a
+source tree's own ``tests/`` or ``scripts/`` is keyed the same way, on the kernel
+sources and on those folders' files (:class:`CloneFolderLocator`), so a new
+clone loads the test kernels too.  ``NUMBA_CACHE_DIR`` in the environment takes
 precedence over ``$FTC_MC_CACHE_DIR/numba`` (``$NUMBA_CACHE_DIR/<digest>``; the
 benchmarks point it at an empty folder), and ``FTC_MC_NUMBA_CACHE=0`` turns caching off.  ``fastmath`` stays
 off: it was no faster here (``scripts/bench_core.py``) and breaks bit-for-bit
@@ -166,6 +169,38 @@ def source_digest(core: Path | None = None) -> str:
     return full_source_digest(core)[:16]
 
 
+def clone_sources(root: Path) -> list[Path]:
+    """The ``.py`` files directly inside a source tree's ``root`` and inside
+    each of its folders whose name does not start with a dot (``tests/``,
+    ``scripts/``), not read recursively; the package (``ftc_mc/``) is left
+    out, its kernels being :func:`kernel_sources`.  Sorted by path."""
+    files = list(root.glob("*.py"))
+    for folder in root.iterdir():
+        if folder.is_dir() and not folder.name.startswith(".") and folder != CORE.parent:
+            files += folder.glob("*.py")
+    return sorted(files, key=lambda p: p.relative_to(root).as_posix())
+
+
+_CLONE_DIGESTS: dict = {}
+
+
+def clone_digest(root: Path) -> str:
+    """SHA-256 (hex) of the relative path and content of every file of
+    :func:`clone_sources`; read again only when a file's stamp (size,
+    modification time) or the list of files changes."""
+    files = clone_sources(root)
+    key = (str(root), tuple((str(p), st.st_size, st.st_mtime_ns)
+                            for p in files for st in [p.stat()]))
+    if key not in _CLONE_DIGESTS:
+        h = hashlib.sha256()
+        for path in files:
+            h.update(path.relative_to(root).as_posix().encode() + b"\0")
+            data = path.read_bytes()
+            h.update(len(data).to_bytes(8, "little") + data)
+        _CLONE_DIGESTS[key] = h.hexdigest()
+    return _CLONE_DIGESTS[key]
+
+
 def cache_root() -> Path:
     """The folder of every source's kernel cache: ``NUMBA_CACHE_DIR`` if set,
     else ``$FTC_MC_CACHE_DIR/numba``, else ``~/.cache/ftc-mc/numba``."""
@@ -238,6 +273,52 @@ class PythonTwinLocator(ContentCacheLocator):
         return super().get_disambiguator() + "-python"
 
 
+class CloneFolderLocator(ContentCacheLocator):
+    """Numba cache locator for the kernels of a source tree's own folders:
+    functions defined in a file of ``tests/`` or ``scripts/`` beside
+    ``ftc_mc/`` in a tree with ``pyproject.toml`` (a clone, not an install).
+
+    Numba's own locator keys such a kernel on its file's absolute path and its
+    file's stamp alone: a new clone compiles every test kernel again (15 s of
+    the test suite's CPU, measured stop 42), and an edit of a file it inlines
+    (``tests/single_trajectory.py`` from ``tests/test_soak.py``) would load it
+    stale.  Here the folder and the stamp follow the content of the kernel
+    sources (:func:`full_source_digest`) and of every file of
+    :func:`clone_sources`: ``cache_dir() / "clone" / <digest> / <folder>``.
+    """
+
+    def __init__(self, py_func, py_file: Path, core: Path):
+        self._lineno = py_func.__code__.co_firstlineno
+        self._core, self._root = core, core.parent.parent
+        clone = clone_digest(self._root)
+        self._stamp = full_source_digest(core) + clone
+        self._cache_path = str(cache_root() / self._stamp[:16] / "clone" / clone[:16]
+                               / py_file.parent.name)
+
+    def sources_unchanged(self) -> bool:
+        """Whether the kernel sources and the tree's own files still have the
+        content this locator was keyed on."""
+        return (sources_unchanged(self._core)
+                and self._stamp[64:] == clone_digest(self._root))
+
+    @classmethod
+    def from_function(cls, py_func, py_file):
+        try:
+            path = Path(py_file).resolve()
+        except (OSError, TypeError, ValueError):
+            return None
+        root = CORE.parent.parent
+        if (not path.is_file() or path.parent.parent != root or path.parent == CORE.parent
+                or path.parent.name.startswith(".") or not (root / "pyproject.toml").is_file()):
+            return None
+        self = cls(py_func, path, CORE)
+        try:
+            self.ensure_cache_path()
+        except OSError:
+            return None  # Numba's own locators, next in the list
+        return self
+
+
 class CacheUnavailable(RuntimeError):
     """The content-keyed cache folder of a kernel of :data:`CORE` cannot be
     written (:meth:`ContentCacheLocator.from_function`)."""
@@ -245,9 +326,10 @@ class CacheUnavailable(RuntimeError):
 
 class ContentCacheImpl(caching.FunctionCache._impl_class):
     """The cache implementation of Numba's ``FunctionCache``, with
-    :class:`ContentCacheLocator` tried before Numba's own locators."""
+    :class:`ContentCacheLocator` and :class:`CloneFolderLocator` tried before
+    Numba's own locators."""
 
-    _locator_classes = [ContentCacheLocator,
+    _locator_classes = [ContentCacheLocator, CloneFolderLocator,
                         *caching.FunctionCache._impl_class._locator_classes]
 
 
@@ -336,7 +418,9 @@ class ContentFunctionCache(caching.FunctionCache):
         kernel's index unlocked, so two processes saving overloads of one
         kernel at once (a compile helper and this one) could lose an entry or
         give two the same data file."""
-        if not sources_unchanged():
+        locator = self._impl.locator
+        if not (locator.sources_unchanged() if isinstance(locator, CloneFolderLocator)
+                else sources_unchanged()):
             if not ContentFunctionCache._warned:
                 import sys
                 print("ftc-mc: the kernel sources changed while this process ran; "
@@ -358,8 +442,9 @@ class ContentFunctionCache(caching.FunctionCache):
 if CACHE:
     full_source_digest()  # the stamps every later save is checked against
     if not os.environ.get("NUMBA_CACHE_DIR"):
-        # kernels compiled with cache=True outside core/ (tests, benchmarks)
-        # and the compile lock (sim.compiling) use Numba's own setting
+        # kernels compiled with cache=True outside core/ and outside a source
+        # tree's own folders, and the compile lock (sim.compiling), use Numba's
+        # own setting
         numba.config.CACHE_DIR = str(cache_dir())
 
 OPTIONS = dict(cache=CACHE, fastmath=False, nogil=True, error_model="numpy")
