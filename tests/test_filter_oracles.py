@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import math
 
-import numba
 import numpy as np
 import pytest
 import scipy.linalg
@@ -18,6 +17,7 @@ import scipy.stats
 from filterpy.kalman import KalmanFilter
 
 import naive
+from ftc_mc.core.jit import kernel
 from ftc_mc.core.shared.belief import belief_update
 from ftc_mc.core.shared.excitation import saturate, signal_3211
 from single_trajectory import predict, update
@@ -28,7 +28,7 @@ from ftc_mc.sim.estimator import (EstimatorSettings, belief_settings, detection,
 from ftc_mc.model.faults import augmented, effect
 from ftc_mc.model.linear import build_plant
 
-njit = numba.njit(cache=False, nogil=True)
+njit = kernel(error_model="python")  # cached by content (core/jit.py CloneFolderLocator)
 
 CHI2_95 = scipy.stats.chi2.ppf(0.95, 1)  # 3.841...
 

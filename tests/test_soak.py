@@ -2,14 +2,13 @@
 
 import numpy as np
 import pytest
-from numba import njit
-
+from ftc_mc.core.jit import kernel
 from ftc_mc.core.shared.belief import belief_update
 from single_trajectory import filter_step
 from ftc_mc.sim.estimator import (EstimatorSettings, belief_settings, detection, filter_model)
 
 
-@njit(cache=False)
+@kernel(error_model="python")  # cached by content (core/jit.py CloneFolderLocator)
 def soak(fm, det, bs, K, n, switch_every, seed, checks):
     """Closed loop on the linear plant; the truth fault changes every
     ``switch_every`` steps (nominal, engine lock/loss, left/right elevon
