@@ -216,6 +216,15 @@ def cache_dir() -> Path:
     return cache_root() / source_digest()
 
 
+def _resolved(py_file) -> Path | None:
+    """The resolved path of a kernel's file, or None when it is not a file."""
+    try:
+        path = Path(py_file).resolve()
+    except (OSError, TypeError, ValueError):
+        return None
+    return path if path.is_file() else None
+
+
 class ContentCacheLocator(caching._CacheLocator):
     """Numba cache locator for the kernels defined under :data:`CORE`.
 
@@ -244,12 +253,15 @@ class ContentCacheLocator(caching._CacheLocator):
 
     @classmethod
     def from_function(cls, py_func, py_file):
-        try:
-            path = Path(py_file).resolve()
-        except (OSError, TypeError, ValueError):
+        path = _resolved(py_file)
+        if path is None or not path.is_relative_to(CORE):
             return None
-        if not path.is_file() or not path.is_relative_to(CORE):
-            return None
+        return cls._writable(py_func, path)
+
+    @classmethod
+    def _writable(cls, py_func, path: Path):
+        """The locator of ``py_func`` (defined in ``path``), its folder created;
+        :class:`CacheUnavailable` when it cannot be written."""
         self = cls(py_func, path, CORE)
         try:
             self.ensure_cache_path()
@@ -285,6 +297,7 @@ class CloneFolderLocator(ContentCacheLocator):
     stale.  Here the folder and the stamp follow the content of the kernel
     sources (:func:`full_source_digest`) and of every file of
     :func:`clone_sources`: ``cache_dir() / "clone" / <digest> / <folder>``.
+    A folder that cannot be written leaves the kernel uncached, as for ``core/``.
     """
 
     def __init__(self, py_func, py_file: Path, core: Path):
@@ -303,20 +316,12 @@ class CloneFolderLocator(ContentCacheLocator):
 
     @classmethod
     def from_function(cls, py_func, py_file):
-        try:
-            path = Path(py_file).resolve()
-        except (OSError, TypeError, ValueError):
-            return None
+        path = _resolved(py_file)
         root = CORE.parent.parent
-        if (not path.is_file() or path.parent.parent != root or path.parent == CORE.parent
+        if (path is None or path.parent.parent != root or path.parent == CORE.parent
                 or path.parent.name.startswith(".") or not (root / "pyproject.toml").is_file()):
             return None
-        self = cls(py_func, path, CORE)
-        try:
-            self.ensure_cache_path()
-        except OSError:
-            return None  # Numba's own locators, next in the list
-        return self
+        return cls._writable(py_func, path)
 
 
 class CacheUnavailable(RuntimeError):
