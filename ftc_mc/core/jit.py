@@ -303,16 +303,16 @@ class CloneFolderLocator(ContentCacheLocator):
     def __init__(self, py_func, py_file: Path, core: Path):
         self._lineno = py_func.__code__.co_firstlineno
         self._core, self._root = core, core.parent.parent
-        clone = clone_digest(self._root)
-        self._stamp = full_source_digest(core) + clone
-        self._cache_path = str(cache_root() / self._stamp[:16] / "clone" / clone[:16]
+        self._clone = clone_digest(self._root)
+        self._stamp = full_source_digest(core) + self._clone
+        self._cache_path = str(cache_root() / self._stamp[:16] / "clone" / self._clone[:16]
                                / py_file.parent.name)
 
     def sources_unchanged(self) -> bool:
         """Whether the kernel sources and the tree's own files still have the
         content this locator was keyed on."""
         return (sources_unchanged(self._core)
-                and self._stamp[64:] == clone_digest(self._root))
+                and self._clone == clone_digest(self._root))
 
     @classmethod
     def from_function(cls, py_func, py_file):
