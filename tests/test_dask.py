@@ -1,4 +1,5 @@
-"""The Dask backend (a LocalCluster of 2 single-threaded workers) gives the same bytes."""
+"""The Dask backend (a LocalCluster of 2 single-threaded workers, started by ftc-mc or
+beforehand and named by ``--scheduler``) gives the same bytes."""
 
 import pandas as pd
 import pytest
@@ -24,10 +25,18 @@ def test_campaign_on_dask_equals_loky():
     pd.testing.assert_frame_equal(a.resets, b.resets, check_exact=True)
 
 
-def test_sweep_on_dask_equals_loky():
+def test_sweep_on_a_running_scheduler_equals_loky():
+    """``--scheduler``: the sweep runs on a cluster started beforehand (the
+    campaign test above covers the local cluster ftc-mc starts itself)."""
+    from dask.distributed import LocalCluster
+
     pts = threshold_points("8,25")
     a = run_sweep(CFG, pts, flights=4, jobs=1, progress=False)
-    b = run_sweep(CFG, pts, flights=4, jobs=2, progress=False, backend="dask")
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                      dashboard_address=":0") as cluster:
+        b = run_sweep(CFG, pts, flights=4, jobs=2, progress=False, backend="dask",
+                      scheduler=cluster.scheduler_address)
+        assert len(cluster.scheduler_info["workers"]) == 2  # still up: not closed by the run
     pd.testing.assert_frame_equal(a.table, b.table, check_exact=True)
 
 
