@@ -119,28 +119,38 @@ _FIRST_STATS: dict = {}
 them (:func:`sources_unchanged`)."""
 
 
+def _stats(files) -> tuple:
+    """(path, size, modification time) of each of ``files``."""
+    return tuple((str(p), st.st_size, st.st_mtime_ns) for p in files for st in [p.stat()])
+
+
 def _source_stats(core: Path) -> tuple:
-    """(path, size, modification time) of every file of :func:`kernel_sources`."""
-    return tuple((str(p), st.st_size, st.st_mtime_ns)
-                 for p in kernel_sources(core) for st in [p.stat()])
+    """:func:`_stats` of every file of :func:`kernel_sources`."""
+    return _stats(kernel_sources(core))
 
 
-def full_source_digest(core: Path | None = None) -> str:
-    """SHA-256 (hex) of the relative path and content of every file of
-    :func:`kernel_sources`.  Read again only when a file's stamp (size,
-    modification time) or the list of files changes."""
-    core = CORE if core is None else Path(core).resolve()
-    stats = _source_stats(core)
-    _FIRST_STATS.setdefault(str(core), stats)
-    key = (str(core), stats)
+def _content_digest(base: Path, stats: tuple) -> str:
+    """SHA-256 (hex) of the path relative to ``base`` and the content of every
+    file of ``stats`` (:func:`_stats`); read again only when a file's stamp
+    (size, modification time) or the list of files changes."""
+    key = (str(base), stats)
     if key not in _DIGESTS:
         h = hashlib.sha256()
         for path in (Path(name) for name, _, _ in stats):
-            h.update(path.relative_to(core.parent).as_posix().encode() + b"\0")
+            h.update(path.relative_to(base).as_posix().encode() + b"\0")
             data = path.read_bytes()
             h.update(len(data).to_bytes(8, "little") + data)
         _DIGESTS[key] = h.hexdigest()
     return _DIGESTS[key]
+
+
+def full_source_digest(core: Path | None = None) -> str:
+    """:func:`_content_digest` of every file of :func:`kernel_sources`, paths
+    relative to the package's parent folder."""
+    core = CORE if core is None else Path(core).resolve()
+    stats = _source_stats(core)
+    _FIRST_STATS.setdefault(str(core), stats)
+    return _content_digest(core.parent, stats)
 
 
 def sources_unchanged(core: Path | None = None) -> bool:
@@ -181,24 +191,10 @@ def clone_sources(root: Path) -> list[Path]:
     return sorted(files, key=lambda p: p.relative_to(root).as_posix())
 
 
-_CLONE_DIGESTS: dict = {}
-
-
 def clone_digest(root: Path) -> str:
-    """SHA-256 (hex) of the relative path and content of every file of
-    :func:`clone_sources`; read again only when a file's stamp (size,
-    modification time) or the list of files changes."""
-    files = clone_sources(root)
-    key = (str(root), tuple((str(p), st.st_size, st.st_mtime_ns)
-                            for p in files for st in [p.stat()]))
-    if key not in _CLONE_DIGESTS:
-        h = hashlib.sha256()
-        for path in files:
-            h.update(path.relative_to(root).as_posix().encode() + b"\0")
-            data = path.read_bytes()
-            h.update(len(data).to_bytes(8, "little") + data)
-        _CLONE_DIGESTS[key] = h.hexdigest()
-    return _CLONE_DIGESTS[key]
+    """:func:`_content_digest` of every file of :func:`clone_sources`, paths
+    relative to ``root``."""
+    return _content_digest(root, _stats(clone_sources(root)))
 
 
 def cache_root() -> Path:
@@ -238,9 +234,15 @@ class ContentCacheLocator(caching._CacheLocator):
 
     def __init__(self, py_func, py_file: Path, core: Path):
         self._lineno = py_func.__code__.co_firstlineno
+        self._core = core
         self._stamp = full_source_digest(core)
         sub = py_file.parent.relative_to(core.parent).as_posix()
         self._cache_path = str(cache_root() / self._stamp[:16] / sub)
+
+    def sources_unchanged(self) -> bool:
+        """Whether what this locator was keyed on is unchanged since the
+        process first read it (:func:`sources_unchanged`)."""
+        return sources_unchanged(self._core)
 
     def get_cache_path(self):
         return self._cache_path
@@ -311,8 +313,7 @@ class CloneFolderLocator(ContentCacheLocator):
     def sources_unchanged(self) -> bool:
         """Whether the kernel sources and the tree's own files still have the
         content this locator was keyed on."""
-        return (sources_unchanged(self._core)
-                and self._clone == clone_digest(self._root))
+        return super().sources_unchanged() and self._clone == clone_digest(self._root)
 
     @classmethod
     def from_function(cls, py_func, py_file):
@@ -424,7 +425,7 @@ class ContentFunctionCache(caching.FunctionCache):
         kernel at once (a compile helper and this one) could lose an entry or
         give two the same data file."""
         locator = self._impl.locator
-        if not (locator.sources_unchanged() if isinstance(locator, CloneFolderLocator)
+        if not (locator.sources_unchanged() if isinstance(locator, ContentCacheLocator)
                 else sources_unchanged()):
             if not ContentFunctionCache._warned:
                 import sys
