@@ -16,8 +16,6 @@ come from the same formula:
 
 from __future__ import annotations
 
-import importlib
-
 import numpy as np
 
 
@@ -25,7 +23,9 @@ def _scipy_stats():
     """``scipy.stats``, imported on first use: it takes 0.33 s, and the processes
     that import this module through the trial code (the parallel workers, the
     scenario) mostly never call it (measured stop 42)."""
-    return importlib.import_module("scipy.stats")
+    import scipy.stats
+
+    return scipy.stats
 
 
 def wilson(k: int, n: int, confidence: float = 0.95):
@@ -58,7 +58,7 @@ def wilson(k: int, n: int, confidence: float = 0.95):
     comparison of seven methods", Stat. Med. 17 (1998) 857-872.
     """
     ci = _scipy_stats().binomtest(int(k), int(n)).proportion_ci(confidence_level=confidence,
-                                                             method="wilson")
+                                                                method="wilson")
     return float(ci.low), float(ci.high)
 
 
