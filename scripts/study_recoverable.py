@@ -59,15 +59,18 @@ lock, ``docs/airframes.md``).
    26's "the reconfiguring loop at least doubles the time to leave" can reach
    for that lock.
 
-A lock is **recoverable** when question 2 flies the 60 s; **lost** when
-question 1's least excess over the short horizon is positive (the strongest
-evidence: fine nodes, short flights); **none found** when only the long
-horizon's is (its coarse nodes after 3 s may miss a history that exists);
-undecided otherwise.  Prints one
+A lock is **recoverable** when question 2 flies the 60 s.  Otherwise the
+longest stay any search found (question 4's, or the horizon of question 1
+when its least excess is not positive) decides: **lost** when it is shorter
+than the short horizon, **none found** when it is shorter than the long one
+(whose coarse nodes after 3 s may miss a history that exists), undecided
+otherwise.  Every search is local (SLSQP): on ``x8-gryte2018`` at -26 deg
+question 1 found no 3 s history where question 4's bisection found one of
+4.0 s, so a verdict is evidence, not proof.  Prints one
 line per lock and, last, the bands per side.
 
     PYTHONPATH=. python scripts/study_recoverable.py [--airframe x8-pyfly]
-        [--offsets -30:5:1] [--sides left,right] [--delay 0] [--jobs 2]
+        [--offsets -30:5:1,6,7,8,10,12,15,20,25] [--sides left,right] [--delay 0] [--jobs 2]
         [--json out.json]
 """
 
@@ -108,6 +111,8 @@ MARGIN = 0.3
 """Excess the constructive transient must stay below [m/s or deg]."""
 VERDICTS = ("recoverable", "lost", "none found", "undecided")
 """What the study says of a lock (module docstring)."""
+SEED = 26
+"""Root seed of the random starts (:func:`seed_of`)."""
 AGREE = 0.05
 """Starts whose least excess is within this of the best one agree with it."""
 
@@ -232,7 +237,7 @@ def fly_60(prob, design, z):
 
 def study_lock(airframe_name, side, offset_deg, horizon, delay, transient_s, long_horizon,
                seed):
-    """Both questions for one side and lock offset [deg]; a dict of results."""
+    """The four questions for one side and lock offset [deg]; a dict of results."""
     af = PRESETS[airframe_name].airframe
     plant = build_sixdof_plant(af)
     tp = plant.trim
@@ -270,22 +275,30 @@ def study_lock(airframe_name, side, offset_deg, horizon, delay, transient_s, lon
         long = Problem(plant, side, lock, long_horizon, delay, coarse=LONG_NODE)
         row["least_excess_long"] = min(least_excess(long, z0)[0] for z0 in
                                        long.starts(design_cmd, np.random.default_rng(seed)))
-    if row["survived_s"] == T_END:
-        row["verdict"] = "recoverable"
-    elif row["least_excess"] > 0.0:
-        row["verdict"] = "lost"
-    elif row["least_excess_long"] > 0.0:
-        row["verdict"] = "none found"
-    else:
-        row["verdict"] = "undecided"
     row["longest_stay_s"] = row["nominal_exit_s"] = None
-    if row["verdict"] != "recoverable":
+    if row["survived_s"] != T_END:
         row["longest_stay_s"] = longest_stay(plant, side, lock, delay, long_horizon,
                                              design_cmd, seed)
         gain = nominal_gain(airframe_name, plant)
         flown = fly(tp, gain, plant.u_lower, plant.u_upper, side, lock)
         row["nominal_exit_s"] = flown["t_leave"]
+    row["verdict"] = verdict(row, horizon, long_horizon)
     return row
+
+
+def verdict(row, horizon, long_horizon):
+    """What the study says of one lock (module docstring), from every search
+    that ran: a stay found by one search counts against another's failure."""
+    if row["survived_s"] == T_END:
+        return "recoverable"
+    stay = row["longest_stay_s"]
+    if row["least_excess"] <= 0.0:
+        stay = max(stay, horizon)
+    if row["least_excess_long"] is not None and row["least_excess_long"] <= 0.0:
+        stay = max(stay, long_horizon)
+    if stay < horizon:
+        return "lost"
+    return "none found" if stay < long_horizon else "undecided"
 
 
 def longest_stay(plant, side, lock, delay, limit, design_cmd, seed):
@@ -308,12 +321,22 @@ def longest_stay(plant, side, lock, delay, limit, design_cmd, seed):
     return lo * DT
 
 
+def seed_of(side, offset_deg):
+    """The random starts' seed of one lock: its side and offset only, so that
+    a lock's result does not depend on the other locks of the run."""
+    return [SEED, ("left", "right").index(side), int(round(1000 * offset_deg)) % 2**32]
+
+
 def parse_offsets(text):
-    """``a:b:step`` (inclusive) or a comma-separated list [deg]."""
-    if ":" in text:
-        a, b, step = (float(v) for v in text.split(":"))
-        return [round(v, 6) for v in np.arange(a, b + step / 2, step)]
-    return [float(v) for v in text.split(",")]
+    """Comma-separated offsets [deg], each a value or ``a:b:step`` (inclusive)."""
+    out = []
+    for part in text.split(","):
+        if ":" in part:
+            a, b, step = (float(v) for v in part.split(":"))
+            out += [round(float(v), 6) for v in np.arange(a, b + step / 2, step)]
+        else:
+            out.append(float(part))
+    return out
 
 
 def bands(rows, key):
@@ -348,7 +371,8 @@ def line_of(r, a):
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--airframe", default="x8-pyfly")
-    ap.add_argument("--offsets", default="-30:5:1", help="a:b:step or a list [deg]")
+    ap.add_argument("--offsets", default="-30:5:1,6,7,8,10,12,15,20,25",
+                    help="offsets from trim [deg], comma-separated, each a value or a:b:step")
     ap.add_argument("--sides", default="left,right")
     ap.add_argument("--horizon", type=float, default=3.0, help="question 1 [s]")
     ap.add_argument("--transient", type=float, default=8.0, help="question 2 [s]")
@@ -364,8 +388,8 @@ def main(argv=None):
     rows = []
     for r in Parallel(n_jobs=a.jobs, return_as="generator")(
             delayed(study_lock)(a.airframe, side, off, a.horizon, a.delay, a.transient,
-                                a.long_horizon, 26 + i)
-            for i, (side, off) in enumerate(tasks)):
+                                a.long_horizon, seed_of(side, off))
+            for side, off in tasks):
         rows.append(r)
         print(line_of(r, a), flush=True)
     for side in a.sides.split(","):
