@@ -20,7 +20,7 @@ its lock).  The envelope is the trials' (``validity`` defaults): airspeed
 ``12 - Va``, ``Va - 30`` [m/s], ``-8 - alpha``, ``alpha - 12``,
 ``|phi| - 60`` [deg]: one metre per second counts as one degree.
 
-Per side and lock offset from trim, two questions:
+Per side and lock offset from trim, four questions:
 
 1. **Lower bound: the least excess over the first ``--horizon`` seconds**
    (3 s by default).  ``min s`` subject to ``excess_k <= s`` at every sample,
@@ -37,13 +37,9 @@ Per side and lock offset from trim, two questions:
    bound (``WIDE``, not the controllers' ``DesignBox``), flown after an
    optimised transient: over the first ``--transient`` seconds (8 s) the
    commands minimise the LQR's cost-to-go ``dx' P dx`` at the hand-over,
-   subject to ``excess_k <= -0.3`` (SLSQP, from the three best starts of
-   question 1).  Then the 60 s are flown, the LQR after the transient, and
+   subject to ``excess_k <= -0.3`` (SLSQP, from the five structured starts
+   of question 1 in turn, until one flies).  Then the 60 s are flown, the LQR after the transient, and
    the flight counts only if it stays inside the envelope at every sample.
-
-``--delay`` holds the trim commands for that long before either (the
-detection's delay; the side monitor names the side a median 0.1 s after the
-lock, ``docs/airframes.md``).
 
 3. **Later exits.**  For a lock question 2 did not fly and question 1 did
    not lose, question 1 again over ``--long-horizon`` seconds (20 s), with
@@ -59,6 +55,10 @@ lock, ``docs/airframes.md``).
    26's "the reconfiguring loop at least doubles the time to leave" can reach
    for that lock.
 
+``--delay`` holds the trim commands for that long before every history (the
+detection's delay; the side monitor names the side a median 0.1 s after the
+lock, ``docs/airframes.md``).
+
 A lock is **recoverable** when question 2 flies the 60 s.  Otherwise the
 longest stay any search found (question 4's, or the horizon of question 1
 when its least excess is not positive) decides: **lost** when it is shorter
@@ -66,12 +66,12 @@ than the short horizon, **none found** when it is shorter than the long one
 (whose coarse nodes after 3 s may miss a history that exists), undecided
 otherwise.  Every search is local (SLSQP): on ``x8-gryte2018`` at -26 deg
 question 1 found no 3 s history where question 4's bisection found one of
-4.0 s, so a verdict is evidence, not proof.  Prints one
-line per lock and, last, the bands per side.
+4.0 s, so a verdict is evidence, not proof.  Prints one line per lock as it
+ends and, last, the bands per side.
 
-    PYTHONPATH=. python scripts/study_recoverable.py [--airframe x8-pyfly]
-        [--offsets -30:5:1,6,7,8,10,12,15,20,25] [--sides left,right] [--delay 0] [--jobs 2]
-        [--json out.json]
+    python scripts/study_recoverable.py [--airframe x8-pyfly]
+        [--offsets -30:5:1,6,7,8,10,12,15,20,25] [--sides left,right]
+        [--delay 0] [--jobs 2] [--json out.json]
 """
 
 from __future__ import annotations
