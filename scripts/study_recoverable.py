@@ -39,7 +39,8 @@ Per side and lock offset from trim, four questions:
    commands minimise the LQR's cost-to-go ``dx' P dx`` at the hand-over,
    subject to ``excess_k <= -0.3`` (SLSQP, from the five structured starts
    of question 1 in turn, until one flies).  Then the 60 s are flown, the LQR after the transient, and
-   the flight counts only if it stays inside the envelope at every sample.
+   the flight counts only if it stays inside the envelope at every sample
+   (``scripts/study_lock_turn.fly``, as the oracle study flies its runs).
 
 3. **Later exits.**  For a lock question 2 did not fly and question 1 did
    not lose, question 1 again over ``--long-horizon`` seconds (20 s), with
@@ -218,21 +219,17 @@ def transient(prob, design, z0):
     return z if prob.excess(z).max() <= 0.0 else None
 
 
-def fly_60(prob, design, z):
-    """The 60 s: the transient's commands, then the LQR.  Returns the time the
-    flight left the envelope [s] and the bound, or ``(None, "")``."""
-    x = prob.tp.x0.copy()
-    work = np.zeros((kernels.N_WORK, N_STATE))
-    cmds = prob.commands(z)
-    still = np.zeros(N_WIND)
-    names = ("airspeed low", "airspeed high", "alpha low", "alpha high", "bank")
-    for k in range(int(round(T_END / DT))):
-        u = cmds[k] if k < prob.n else design.command(x)
-        kernels.propagate(x, u, prob.tp.params, still, DT, N_SUB, work)
-        g = excess(x[None, :])
-        if g.max() > 0.0:
-            return (k + 1) * DT, names[int(np.argmax(g))]
-    return None, ""
+class Replay:
+    """Question 2's flight as ``scripts/study_lock_turn.fly`` flies a
+    controller: the transient's commands ``cmds`` (n, 3), then ``design``'s
+    law."""
+
+    def __init__(self, cmds, design):
+        self.cmds, self.design, self.k = cmds, design, 0
+
+    def command(self, x):
+        k, self.k = self.k, self.k + 1
+        return self.cmds[k].copy() if k < len(self.cmds) else self.design.command(x)
 
 
 def study_lock(airframe_name, side, offset_deg, horizon, delay, transient_s, long_horizon,
@@ -264,12 +261,13 @@ def study_lock(airframe_name, side, offset_deg, horizon, delay, transient_s, lon
             z = transient(long, design, z0)
             if z is None:
                 continue
-            t_left, why = fly_60(long, design, z)
-            if t_left is None:
+            flown = fly(tp, None, plant.u_lower, plant.u_upper, side, lock,
+                        Replay(long.commands(z), design), delay=0.0)
+            if flown["survived"]:
                 row["survived_s"] = T_END
                 break
-            if row["survived_s"] is None or t_left > row["survived_s"]:
-                row["survived_s"], row["left_by"] = t_left, why
+            if row["survived_s"] is None or flown["t_leave"] > row["survived_s"]:
+                row["survived_s"], row["left_by"] = flown["t_leave"], flown["why"]
     row["least_excess_long"] = None
     if row["survived_s"] != T_END and row["least_excess"] <= 0.0:
         long = Problem(plant, side, lock, long_horizon, delay, coarse=LONG_NODE)
