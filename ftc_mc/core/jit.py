@@ -38,6 +38,8 @@ import numba
 from numba.core import caching, sigutils
 from numba.core.registry import CPUDispatcher
 
+from .linking import ByAddressCacheImpl, route_calls
+
 CACHE = os.environ.get("FTC_MC_NUMBA_CACHE", "1") != "0"
 
 CORE = Path(__file__).resolve().parent
@@ -330,16 +332,17 @@ class CacheUnavailable(RuntimeError):
     written (:meth:`ContentCacheLocator.from_function`)."""
 
 
-class ContentCacheImpl(caching.FunctionCache._impl_class):
-    """The cache implementation of Numba's ``FunctionCache``, with
-    :class:`ContentCacheLocator` and :class:`CloneFolderLocator` tried before
-    Numba's own locators."""
+class ContentCacheImpl(ByAddressCacheImpl):
+    """The cache implementation of Numba's ``FunctionCache`` (with the stages
+    a kernel calls by address, :class:`~ftc_mc.core.linking.ByAddressCacheImpl`),
+    with :class:`ContentCacheLocator` and :class:`CloneFolderLocator` tried
+    before Numba's own locators."""
 
     _locator_classes = [ContentCacheLocator, CloneFolderLocator,
                         *caching.FunctionCache._impl_class._locator_classes]
 
 
-class PythonTwinCacheImpl(caching.FunctionCache._impl_class):
+class PythonTwinCacheImpl(ByAddressCacheImpl):
     """The cache implementation of an internal kernel's twin: only
     :class:`PythonTwinLocator` (outside :data:`CORE` no locator is found, and
     the twin is not cached)."""
@@ -463,7 +466,7 @@ with the kernel and again in every kernel that calls it (:func:`kernel`'s
 ``internal``)."""
 
 
-def kernel(func=None, *, internal=False, **overrides):
+def kernel(func=None, *, internal=False, by_address=False, **overrides):
     """``numba.njit`` with the project's defaults (see module docstring).
 
     Parameters
@@ -476,16 +479,22 @@ def kernel(func=None, *, internal=False, **overrides):
         path's cold compile (``docs/performance.md``, lesson 14).  A call
         from Python still works: it compiles a twin with its
         wrappers once (cached beside the kernel, :class:`InternalKernel`).
+    by_address : bool
+        An internal kernel (implied) that other kernels call by address,
+        without linking its code into theirs (:mod:`ftc_mc.core.linking`):
+        for a stage, called once per step, not for a helper called per lane
+        (a call that is not inlined passes its arrays with reference counts,
+        ``docs/performance.md`` lesson 12).
     **overrides
         Options that replace the defaults for this kernel.
     """
     opts = dict(OPTIONS, **overrides)
     if func is None:
-        return lambda f: _njit(f, opts, internal)
-    return _njit(func, opts, internal)
+        return lambda f: _njit(f, opts, internal or by_address, by_address=by_address)
+    return _njit(func, opts, internal or by_address, by_address=by_address)
 
 
-def _njit(func, opts, internal=False, python_twin=False):
+def _njit(func, opts, internal=False, python_twin=False, by_address=False):
     """``numba.njit(**opts)(func)``, its disk cache a :class:`ContentFunctionCache`
     (the twin of an internal kernel: :class:`PythonTwinCache`); an internal
     kernel without its wrappers, an :class:`InternalKernel`."""
@@ -495,6 +504,7 @@ def _njit(func, opts, internal=False, python_twin=False):
     if internal:
         dispatcher.__class__ = InternalKernel
         dispatcher._kernel_opts = dict(opts, cache=cache)
+        dispatcher._by_address = by_address
     if cache:
         try:
             # Dispatcher.enable_caching
@@ -523,7 +533,16 @@ class InternalKernel(CPUDispatcher):
     from Python (a test, a notebook), it hands the call to a twin compiled from
     the same function with the same options and its wrappers, made on the
     first such call: without them, Numba's dispatcher would call a null
-    entry point."""
+    entry point.  With ``kernel(by_address=True)``, every overload it compiles
+    or loads is called by address by the kernels compiled after it
+    (:func:`ftc_mc.core.linking.route_calls`)."""
+
+    _by_address = False
+
+    def add_overload(self, cres):
+        super().add_overload(cres)
+        if self._by_address and not cres.objectmode:
+            route_calls(self, cres)
 
     def __call__(self, *args, **kwargs):
         twin = self.__dict__.get("_python_twin")

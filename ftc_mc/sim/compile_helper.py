@@ -11,8 +11,9 @@ cache while this process compiles the other before it types ``advance``
 (:func:`compile_own`); when the typing reaches a stage the helper has done it
 loads it from the cache, and one the helper is still compiling it waits for
 (the *claims* of :class:`ftc_mc.core.jit.ContentFunctionCache`).  ``advance``'s
-own compile, which links every stage, stays in this process (measured:
-``docs/performance.md``, lessons 11 and 14).
+own compile, which calls its stages by address (:mod:`ftc_mc.core.linking`),
+stays in this process (measured: ``docs/performance.md``, lessons 11, 14 and
+17).
 
 The helper must know each stage's Numba signature before ``advance`` is typed.
 The *compile plan* (:data:`PLAN_FILE`, written by ``scripts/make_compile_plan.py``)

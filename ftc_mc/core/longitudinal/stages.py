@@ -23,11 +23,12 @@ it reads and writes.  Lane ``l`` of every array is one trial, lane index last.
 Each stage has a plain-NumPy twin in ``tests/naive.py`` (same name with
 ``_ref``), compared in ``tests/test_stages.py``.
 
-The stages are compiled inline into ``advance`` (``inline="always"``, Numba IR
-inlining), so the loop runs as one function (as separate calls the trial was
-slower, ``docs/performance.md`` lesson 6).  Where the compile paths part
-(``core/shared/paths.py``) a dispatcher compiles the one kernel its path
-reaches.  The stages remain callable on their own (the tests do).
+Each stage is a kernel of its own that ``advance`` calls by address
+(``kernel(by_address=True)``, :mod:`ftc_mc.core.linking`): compiled once, on its
+own, and not again inside ``advance`` (the cold compile and the trial speed:
+``docs/performance.md`` lesson 17).  Where the compile paths part (``core/shared/paths.py``) a
+dispatcher compiles the one kernel its path reaches.  The stages remain
+callable on their own (the tests do).
 """
 
 from __future__ import annotations
@@ -87,7 +88,7 @@ def controller_output(path, scheme, st, work):
     :func:`reconfiguring_output`."""
 
 
-@kernel(inline="always")
+@kernel(by_address=True)
 def commands(path, scheme, st, k, work):
     """Stage 1: the commands ``u_k`` of every lane (deviations from trim).
 
@@ -156,7 +157,7 @@ def commands(path, scheme, st, k, work):
 
 
 # ------------------------------------------------------------------ 2b. cost
-@kernel(inline="always")
+@kernel(by_address=True)
 def record_cost(track, k_switch, st, kn, work, rec):
     """After the truth step: the costs of flying the step (issue 25), and the
     height marks of the survivability study (issue 26).
@@ -289,7 +290,7 @@ def restart_window(path, block, ecount):
     """A reset restarts the lane's GLR window (on the GLR test's path)."""
 
 
-@kernel(inline="always")
+@kernel(by_address=True)
 def filter_update(path, scheme, st, k, work):
     """Stage 3: one step of every lane's augmented filter (eqs. 5-11, Table 1).
 
@@ -402,7 +403,7 @@ def is_psd(P, l, work):
     return True
 
 
-@kernel(inline="always")
+@kernel(by_address=True)
 def check_validity(validity, st, kn, work, rec):
     """Stage 4: stop trusting a lane that left the numerics or the envelope.
 
@@ -465,7 +466,7 @@ def check_validity(validity, st, kn, work, rec):
 
 
 # ------------------------------------------------------------------ 5. resets
-@kernel(inline="always")
+@kernel(by_address=True)
 def handle_resets(excitation, st, kn, work, rec):
     """Stage 5: record the resets and start the excitation they request.
 
@@ -582,7 +583,7 @@ def policy_signals(excitation, st, kn, work):
 
 
 # ------------------------------------------------------------------ 6. history
-@kernel(inline="always")
+@kernel(by_address=True)
 def record_step(k, st, work, rec):
     """Stage 6: the history of step ``k`` (only while ``k < n_hist``).
 
@@ -649,7 +650,7 @@ def select(path, scheme, st, work):
     c0 stays in use on the nominal one."""
 
 
-@kernel(inline="always")
+@kernel(by_address=True)
 def reconfigure(path, scheme, timing, inp, st, kn, period, work, rec):
     """Stage 7, every reconfiguration period: belief, controller, detection.
 
@@ -716,7 +717,7 @@ def reconfigure(path, scheme, timing, inp, st, kn, period, work, rec):
 
 
 # ------------------------------------------------------------------ end
-@kernel(inline="always")
+@kernel(by_address=True)
 def record_end(st, rec):
     """The final augmented estimate of every lane (``rec.xa_end``: its first
     ``rec.xa_end.shape[0]`` states)."""

@@ -111,7 +111,7 @@ def new_lane_selection_work(L, n):
         bvar=np.zeros(N_FAULT), bwork=np.zeros(2 * N_MODES))
 
 
-@kernel(internal=True)
+@kernel(by_address=True)
 def new_trial_work(L, n):
     """Zeroed :class:`TrialWork` for ``L`` lanes and augmented dimension ``n``.
 

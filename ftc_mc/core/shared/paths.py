@@ -46,6 +46,8 @@ from numba import types
 from numba.core.imputils import lower_builtin
 from numba.core.typing.templates import AbstractTemplate, infer_global, signature
 
+from .. import linking
+
 Path = namedtuple("Path", ["plant", "filter", "test", "control"])
 """The compile path of a trial kernel call: one marker per choice (module
 docstring)."""
@@ -142,10 +144,10 @@ def on_path(field: str, impls: dict, passes: str | None = None):
     ``@kernel`` functions of their own (cached on disk) that take no
     :class:`Path`: compiled once, whatever the path that calls them, and
     loaded from the cache by every later path.  The caller calls the chosen
-    kernel directly, as it calls any other kernel; nothing is IR-inlined
-    (Numba's typed inlining of overloads gave wrong results inside the trial
-    loop: lanes read as out of the envelope at the first step;
-    ``docs/performance.md`` lesson 11).
+    kernel by address (:mod:`ftc_mc.core.linking`: its code is not linked into
+    the caller's); nothing is IR-inlined (Numba's typed inlining of overloads
+    gave wrong results inside the trial loop: lanes read as out of the
+    envelope at the first step; ``docs/performance.md`` lesson 11).
 
     Parameters
     ----------
@@ -169,7 +171,8 @@ def on_path(field: str, impls: dict, passes: str | None = None):
 
 def _register_dispatch(stub, field: str, table: "_LazyTable", passes):
     """Type and lower ``stub(first, *rest)`` as a direct call of the chosen
-    kernel (``on_path``).
+    kernel (``on_path``), by address when it is a kernel
+    (:func:`ftc_mc.core.linking.call`).
 
     The call is lowered in the caller itself: no function of its own sits
     between the caller and the kernel.  (A ``numba.extending.overload``
@@ -225,7 +228,9 @@ def _register_dispatch(stub, field: str, table: "_LazyTable", passes):
             lead_values = list(args[:len(lead)])
         values = [context.cast(builder, v, t, want) for v, t, want
                   in zip(lead_values + list(args[1:]), lead + sig.args[1:], inner.args)]
-        return context.get_function(impl, inner)(builder, values)
+        if isinstance(impl, types.Dispatcher):  # a kernel: by address, not linked
+            return linking.call(context, builder, impl.dispatcher, inner, values)
+        return context.get_function(impl, inner)(builder, values)  # another stub
 
 
 class _LazyTable(dict):
