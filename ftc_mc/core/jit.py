@@ -482,9 +482,12 @@ def kernel(func=None, *, internal=False, by_address=False, **overrides):
     by_address : bool
         An internal kernel (implied) that other kernels call by address,
         without linking its code into theirs (:mod:`ftc_mc.core.linking`):
-        for a stage, called once per step, not for a helper called per lane
-        (a call that is not inlined passes its arrays with reference counts,
-        ``docs/performance.md`` lesson 12).
+        for a stage called once per step, not for a helper called per lane
+        or a small kernel LLVM would inline into its caller (the paper
+        filter's lane kernels ``project_lanes``, ``_symmetric_copy``,
+        ``reset_lanes`` and ``_normalised_lanes`` by address cost
+        ``bench_core``'s batch filter about 6 %; ``docs/performance.md``
+        lessons 12 and 17).
     **overrides
         Options that replace the defaults for this kernel.
     """

@@ -124,7 +124,7 @@ def _mirror_x(P, l0, l1):
                 P[k, i, l] = P[i, k, l]
 
 
-@kernel(by_address=True)
+@kernel(internal=True)
 def _symmetric_copy(P, Pout, L):
     """``Pout <- P`` from the upper triangle of ``P`` (both triangles written)."""
     n = P.shape[0]
@@ -279,7 +279,7 @@ def predict_lanes(xa, P, u, fm, phi, T):
 
 
 # ------------------------------------------------------------------ residuals
-@kernel(by_address=True)
+@kernel(internal=True)
 def _normalised_lanes(xa, P, z, fm, out, signed):
     """``mu_i^2 / S_ii`` (``signed`` false) or ``mu_i / sqrt(S_ii)`` (true) of the
     residual outputs of every lane into ``out`` (3, L); see :func:`residuals_lanes`.
@@ -363,7 +363,7 @@ def innovations_lanes(xa, P, z, fm, innov):
 
 
 # ------------------------------------------------------------------ signature
-@kernel(by_address=True)
+@kernel(internal=True)
 def reset_lanes(P, block, reset_var):
     """Reset the suspected fault block of each lane (section 3.2.2).
 
@@ -539,7 +539,7 @@ def update_lanes(xa, P, z, fm, h):
 
 
 # ------------------------------------------------------------------ projection
-@kernel(by_address=True)
+@kernel(internal=True)
 def project_lanes(xa, fm):
     """Active-set projection of every lane's fault parameters (eqs. 6-8).
 
