@@ -113,7 +113,9 @@ def split(stages, before_s: float) -> tuple[list, list]:
         qualname, argument types, seconds)``).
     before_s : float
         Seconds this process compiles besides the stages (the setup kernels
-        before ``advance``) [s].
+        before ``advance``, and the own work of the stages that call the
+        plan's stages by address, ``trial_step`` and ``reconfigure``, which
+        it compiles while it types ``advance``) [s].
 
     Returns
     -------

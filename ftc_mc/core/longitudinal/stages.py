@@ -23,11 +23,14 @@ it reads and writes.  Lane ``l`` of every array is one trial, lane index last.
 Each stage has a plain-NumPy twin in ``tests/naive.py`` (same name with
 ``_ref``), compared in ``tests/test_stages.py``.
 
-Each stage is a kernel of its own that ``advance`` calls by address
-(``kernel(by_address=True)``, :mod:`ftc_mc.core.linking`): compiled once, on its
-own, and not again inside ``advance`` (the cold compile and the trial speed:
-``docs/performance.md`` lesson 17).  Where the compile paths part (``core/shared/paths.py``) a
-dispatcher compiles the one kernel its path reaches.  The stages remain
+The stages of one step are compiled inline (``inline="always"``, Numba IR
+inlining) into one kernel, :func:`ftc_mc.core.longitudinal.trial.trial_step`,
+which ``advance`` calls by address (``kernel(by_address=True)``,
+:mod:`ftc_mc.core.linking`), as it calls :func:`reconfigure`: each is compiled
+once, on its own, not again inside ``advance``, and a step costs one call, not
+one per stage (``docs/performance.md`` lesson 17).  Where the compile paths
+part (``core/shared/paths.py``) a dispatcher compiles the one kernel its path
+reaches, also called by address.  The stages remain
 callable on their own (the tests do).
 """
 
@@ -88,7 +91,7 @@ def controller_output(path, scheme, st, work):
     :func:`reconfiguring_output`."""
 
 
-@kernel(by_address=True)
+@kernel(inline="always")
 def commands(path, scheme, st, k, work):
     """Stage 1: the commands ``u_k`` of every lane (deviations from trim).
 
@@ -157,7 +160,7 @@ def commands(path, scheme, st, k, work):
 
 
 # ------------------------------------------------------------------ 2b. cost
-@kernel(by_address=True)
+@kernel(inline="always")
 def record_cost(track, k_switch, st, kn, work, rec):
     """After the truth step: the costs of flying the step (issue 25), and the
     height marks of the survivability study (issue 26).
@@ -290,7 +293,7 @@ def restart_window(path, block, ecount):
     """A reset restarts the lane's GLR window (on the GLR test's path)."""
 
 
-@kernel(by_address=True)
+@kernel(inline="always")
 def filter_update(path, scheme, st, k, work):
     """Stage 3: one step of every lane's augmented filter (eqs. 5-11, Table 1).
 
@@ -403,7 +406,7 @@ def is_psd(P, l, work):
     return True
 
 
-@kernel(by_address=True)
+@kernel(inline="always")
 def check_validity(validity, st, kn, work, rec):
     """Stage 4: stop trusting a lane that left the numerics or the envelope.
 
@@ -466,7 +469,7 @@ def check_validity(validity, st, kn, work, rec):
 
 
 # ------------------------------------------------------------------ 5. resets
-@kernel(by_address=True)
+@kernel(inline="always")
 def handle_resets(excitation, st, kn, work, rec):
     """Stage 5: record the resets and start the excitation they request.
 
@@ -583,7 +586,7 @@ def policy_signals(excitation, st, kn, work):
 
 
 # ------------------------------------------------------------------ 6. history
-@kernel(by_address=True)
+@kernel(inline="always")
 def record_step(k, st, work, rec):
     """Stage 6: the history of step ``k`` (only while ``k < n_hist``).
 
