@@ -5,7 +5,11 @@ one fresh process with an empty Numba cache and no compile helper runs the
 path's warm-up (``ftc_mc.campaign.chunk.warm_up``) and records, through
 Numba's ``numba:compile`` events, the kernels of ``ftc_mc/core`` that
 ``advance`` compiles directly, in order, with their argument types and the
-seconds each took, and the seconds compiled before ``advance`` begins.
+seconds each took, and the seconds compiled before ``advance`` begins.  A
+stage that calls kernels by address (``core/linking.py``: ``trial_step``,
+``reconfigure``) is replaced by those kernels, and its own seconds count
+with the setup's, as this process's: it compiles that stage itself while it
+types ``advance``, and waits there for the kernels the helper has claimed.
 
 Run it after a change of what ``advance`` calls or of its stages' signatures
 (``tests/test_compile_helper.py`` fails when the default path's plan is stale),
@@ -64,6 +68,7 @@ def record(config: str, variant: str, out: str) -> None:
 
     from ftc_mc.campaign.chunk import chunk_spec, warm_up
     from ftc_mc.config import load_config
+    from ftc_mc.core import linking
 
     events, open_ = [], []
 
@@ -83,11 +88,23 @@ def record(config: str, variant: str, out: str) -> None:
     t_start = time.perf_counter()
     warm_up(spec, cfg.campaign.transitions[0])
     [adv] = [e for e in events if e[:2] == ("ftc_mc.core.longitudinal.trial", "advance")]
-    stages = [(m, q, a, round(t1 - t0, 2)) for m, q, a, t0, t1, depth in
-              sorted(events, key=lambda e: e[3])
-              if depth == adv[5] + 1 and adv[3] <= t0 <= adv[4] and m.startswith("ftc_mc.core.")]
+    inside = [e for e in sorted(events, key=lambda e: e[3])
+              if adv[3] <= e[3] <= adv[4] and e[0].startswith("ftc_mc.core.")]
+    by_address = {(m, q) for m, q, _ in linking._STAGES.values()}
+    stages, parents_s = [], 0.0
+    for e in (e for e in inside if e[5] == adv[5] + 1):
+        # a stage that calls kernels by address (trial_step, reconfigure):
+        # those are stages of their own, and its own seconds this process's
+        kids = [f for f in inside if f[5] == e[5] + 1 and e[3] <= f[3] <= e[4]
+                and f[:2] in by_address]
+        stages += [(m, q, a, round(t1 - t0, 2)) for m, q, a, t0, t1, _ in kids]
+        own = (e[4] - e[3]) - sum(f[4] - f[3] for f in kids)
+        if kids:
+            parents_s += own
+        else:
+            stages.append((e[0], e[1], e[2], round(own, 2)))
     with open(out, "wb") as f:
-        pickle.dump((round(adv[3] - t_start, 2), stages), f, protocol=4)
+        pickle.dump((round(adv[3] - t_start + parents_s, 2), stages), f, protocol=4)
 
 
 def main():
