@@ -47,18 +47,18 @@ def lock_path(dispatcher, path=None) -> Path:
     return Path(numba.config.CACHE_DIR) / f"{dispatcher.py_func.__name__}{tag}.compile.lock"
 
 
-EXPECTED_COMPILE = {LinearPlant: "1 min", NonlinearPlant: "1-1.5 min",
-                    SixdofPlant: "1-3.5 min", SixdofExtendedPlant: "1.5-4 min"}
+EXPECTED_COMPILE = {LinearPlant: "30 s", NonlinearPlant: "30 s",
+                    SixdofPlant: "30-45 s", SixdofExtendedPlant: "1 min"}
 """What the compile notice says a path's cold compile takes, by its plant marker
-(``core/shared/paths.py``), on 2 cores: the default (linear) path 48-61 s on
-an empty cache with the compile helper (:mod:`ftc_mc.sim.compile_helper`;
-``docs/performance.md``, lessons 11 and 14, stop 39), the longitudinal paths 52-92 s
-in one process; the 6-DOF paths 67-87 s when
-the kernels they share with a longitudinal path are cached (nominal and
-reconfiguring, measured at stop 35; 160 s beside another compile) and 166-208
-s on an empty cache (``scripts/bench_compile.py --only sixdof``,
-``docs/airframes.md``); the extended side monitor's kernel adds about 30 s of
-CPU to those (``docs/airframes.md``)."""
+(``core/shared/paths.py``), on 2 cores with the compile helper
+(:mod:`ftc_mc.sim.compile_helper`), each path on an empty cache
+(``scripts/bench_compile.py``, stop 44, once the stages were called by
+address: ``docs/performance.md`` lesson 17): the default (linear) path 22.8 s
+(``scripts/bench_campaign.py``'s ``compile_s``, setup included: 24.0-25.8 s),
+the paper's design on the nonlinear plant 21.8 s, ``robust`` 28.8 s, the
+paper's design on the 6-DOF plant 32.8 s.  The 6-DOF paths with the extended
+side monitor were not timed at stop 44; their compile plan holds about 15 s
+more of stages than the other 6-DOF paths'."""
 
 
 def expected_compile(path) -> str:
