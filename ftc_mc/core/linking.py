@@ -1,4 +1,4 @@
-"""How a kernel calls the stage a compile path chose: by address, not by linking.
+"""How a kernel calls a trial stage: by address, not by linking its code.
 
 Numba compiles every kernel as a code library of its own, and a kernel that
 calls another links the callee's library into its own: the callee's code is
@@ -7,10 +7,12 @@ optimised and emitted again inside every caller, up the chain to
 about 10 s of ``advance``'s 25 s of cold compile (``docs/performance.md``,
 lessons 14 and 15).
 
-A call that :func:`ftc_mc.core.shared.paths.on_path` dispatches to a stage
-kernel is lowered instead as a call of an external function with a stable
-symbol name (:func:`symbol_name`: the kernel's module, name and a digest of
-its argument types).  The stage is compiled (or loaded from the cache) once,
+A call of a kernel declared ``kernel(by_address=True)`` (the trial's stage
+kernels, :func:`route_calls`), or of one that
+:func:`ftc_mc.core.shared.paths.on_path` dispatches to, is lowered instead as
+a call of an external function with a stable symbol name
+(:func:`symbol_name`: the kernel's module, name and a digest of its argument
+types).  The stage is compiled (or loaded from the cache) once,
 on its own, and its native entry point is registered under that name with
 LLVM's symbol table (:func:`register`) before any caller is finalised, so the
 caller keeps no copy of its code.  The calling convention is Numba's own, so
