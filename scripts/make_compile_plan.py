@@ -6,7 +6,7 @@ path's warm-up (``ftc_mc.campaign.chunk.warm_up``) and records, through
 Numba's ``numba:compile`` events, the kernels of ``ftc_mc/core`` that
 ``advance`` compiles directly, in order, with their argument types and the
 seconds each took, and the seconds compiled before ``advance`` begins.  A
-stage that calls kernels by address (``core/linking.py``: ``trial_step``,
+stage that calls kernels by address (``core/linking.py``: ``trial_steps``,
 ``reconfigure``) is replaced by those kernels, and its own seconds count
 with the setup's, as this process's: it compiles that stage itself while it
 types ``advance``, and waits there for the kernels the helper has claimed.
@@ -93,7 +93,7 @@ def record(config: str, variant: str, out: str) -> None:
     by_address = {(m, q) for m, q, _ in linking._STAGES.values()}
     stages, parents_s = [], 0.0
     for e in (e for e in inside if e[5] == adv[5] + 1):
-        # a stage that calls kernels by address (trial_step, reconfigure):
+        # a stage that calls kernels by address (trial_steps, reconfigure):
         # those are stages of their own, and its own seconds this process's
         kids = [f for f in inside if f[5] == e[5] + 1 and e[3] <= f[3] <= e[4]
                 and f[:2] in by_address]

@@ -114,7 +114,7 @@ def split(stages, before_s: float) -> tuple[list, list]:
     before_s : float
         Seconds this process compiles besides the stages (the setup kernels
         before ``advance``, and the own work of the stages that call the
-        plan's stages by address, ``trial_step`` and ``reconfigure``, which
+        plan's stages by address, ``trial_steps`` and ``reconfigure``, which
         it compiles while it types ``advance``) [s].
 
     Returns

@@ -24,11 +24,12 @@ Each stage has a plain-NumPy twin in ``tests/naive.py`` (same name with
 ``_ref``), compared in ``tests/test_stages.py``.
 
 The stages of one step are compiled inline (``inline="always"``, Numba IR
-inlining) into one kernel, :func:`ftc_mc.core.longitudinal.trial.trial_step`,
-which ``advance`` calls by address (``kernel(by_address=True)``,
+inlining) into the loop of one kernel,
+:func:`ftc_mc.core.longitudinal.trial.trial_steps`, which ``advance`` calls by
+address once per reconfiguration period (``kernel(by_address=True)``,
 :mod:`ftc_mc.core.linking`), as it calls :func:`reconfigure`: each is compiled
-once, on its own, not again inside ``advance``, and a step costs one call, not
-one per stage (``docs/performance.md`` lesson 17).  Where the compile paths
+once, on its own, not again inside ``advance``, and a period costs one call,
+not one per stage or step (``docs/performance.md`` lesson 17).  Where the compile paths
 part (``core/shared/paths.py``) a dispatcher compiles the one kernel its path
 reaches, also called by address.  The stages remain
 callable on their own (the tests do).

@@ -13,8 +13,9 @@ Lane-last storage (``a[..., L]``) lets the inner loops vectorise across trials
 on its own seed.
 
 A step ``k -> k+1`` (time ``t = k dt``) is a sequence of stage kernels, each
-described where it is defined; stages 1-6 make one kernel, :func:`trial_step`,
-and :func:`advance` calls it and stage 7 by address (``core/linking.py``):
+described where it is defined; stages 1-6 of the steps between two
+reconfigurations make one kernel, :func:`trial_steps`, and :func:`advance`
+calls it and stage 7 by address (``core/linking.py``):
 
 1. :func:`ftc_mc.core.longitudinal.stages.commands` -- ``u_k = f(U(x_hat_k), s_k, A_k)``;
 2. :func:`ftc_mc.core.longitudinal.plant.truth` -- effect, gusts, plant, ``z_{k+1}``
@@ -108,34 +109,40 @@ def advance(path, scheme, flight, inp, rec, st, k0, k1):
     work = new_trial_work(st.xa.shape[1], st.xa.shape[0])
     every = flight.timing.reconf_every
     period = k0 // every
-    for k in range(k0, k1):
-        trial_step(path, scheme, flight, inp, k, st, work, rec)
-        if (k + 1) % every == 0:
-            reconfigure(path, scheme, flight.timing, inp, st, k + 1, period, work, rec)
+    k = k0
+    while k < k1:
+        k_end = min(k1, (k // every + 1) * every)  # the next reconfiguration
+        trial_steps(path, scheme, flight, inp, k, k_end, st, work, rec)
+        k = k_end
+        if k % every == 0:
+            reconfigure(path, scheme, flight.timing, inp, st, k, period, work, rec)
             period += 1
     record_end(st, rec)
 
 
 @kernel(by_address=True)
-def trial_step(path, scheme, flight, inp, k, st, work, rec):
-    """Stages 1-6 of step ``k -> k+1`` (module docstring), every lane.
+def trial_steps(path, scheme, flight, inp, k0, k1, st, work, rec):
+    """Stages 1-6 of the steps ``k0 -> k0+1`` to ``k1-1 -> k1`` (module
+    docstring), every lane; no reconfiguration falls inside them.
 
-    One kernel that ``advance`` calls by address: the stages are IR-inlined
-    into it, and the large kernels they reach (the truth plant, the filter's
-    prediction and correction, the side monitor) are called by address
-    (``core/linking.py``), so each is compiled once, and a step costs one call
-    of ``advance``'s, not one per stage (``docs/performance.md`` lesson 17).
-    Parameters as :func:`advance`'s; ``k`` is the step.
+    One kernel that ``advance`` calls by address once per reconfiguration
+    period: the stages are IR-inlined into its loop, and the large kernels
+    they reach (the truth plant, the filter's prediction and correction, the
+    side monitor) are called by address (``core/linking.py``), so each is
+    compiled once, and a period costs one call of ``advance``'s, not one per
+    stage or per step (``docs/performance.md`` lesson 17).  Parameters as
+    :func:`advance`'s.
     """
-    kn = k + 1
-    commands(path, scheme, st, k, work)
-    truth(path, scheme, flight, inp, k, st, work, rec)
-    record_cost(flight.track, flight.timing.k_fault, st, kn, work, rec)
-    side_monitor(path, scheme, flight, k, st, work, rec)
-    filter_update(path, scheme, st, k, work)
-    check_validity(flight.validity, st, kn, work, rec)
-    handle_resets(scheme.excitation, st, kn, work, rec)
-    record_step(k, st, work, rec)
+    for k in range(k0, k1):
+        kn = k + 1
+        commands(path, scheme, st, k, work)
+        truth(path, scheme, flight, inp, k, st, work, rec)
+        record_cost(flight.track, flight.timing.k_fault, st, kn, work, rec)
+        side_monitor(path, scheme, flight, k, st, work, rec)
+        filter_update(path, scheme, st, k, work)
+        check_validity(flight.validity, st, kn, work, rec)
+        handle_resets(scheme.excitation, st, kn, work, rec)
+        record_step(k, st, work, rec)
 
 
 @kernel
