@@ -298,6 +298,7 @@ class SideMonitorRef:
         self.side_k, self.side_block, self.side_pre, self.side_n = -1, 0, 0, 0
         self.b = np.zeros(9)
         self.side, self.pos = 0, 0.0  # the first elevon named and its position estimate
+        self.last = 0  # its latest decision
         self.turn_k = -1  # the step from which the lock-turn law may fly (k + 1 of that decision)
 
     def step(self, k, u, z, alive):
@@ -355,6 +356,7 @@ class SideMonitorRef:
                 self.P[i, :] = 0.0
                 self.P[:, i] = 0.0
                 self.P[i, i] = mon.reset_var[i - ns]
+            self.last = block
             if block > 1 and self.side == 0:
                 self.side, self.turn_k = block, kn
             if alive:
@@ -510,3 +512,21 @@ def lock_turn_law_ref(tab, s, p, xhat, lo_dev, hi_dev):
     x, u, K, k = at(tab.x[s]), at(tab.u[s]), at(tab.K[s]), at(tab.k[s])
     out[tab.cmd[s]] = u[tab.cmd[s]] - K @ (xhat - x) - k
     return np.clip(out, lo_dev, hi_dev)
+
+
+def side_blocks_ref(kind, mside, mlast, block):
+    """Twin of ``core/sixdof/lockturn.side_blocks``, from its docstring: in a
+    ``lock_turn`` design (``kind`` 2) each lane's Table 1 reset (``block`` 1
+    thrust or 2 elevons) goes to the block of the elevon the lane flies the
+    law about (``mside`` > 0), else of the monitor's latest decision
+    (``mlast``: 1 the throttle, 2 and 3 the elevons; 0 none: Table 1's
+    stays).  Returns the new blocks."""
+    out = np.array(block, copy=True)
+    if kind != 2:
+        return out
+    for l in range(len(out)):
+        named = mside[l] if mside[l] > 0 else mlast[l]
+        if out[l] != 0 and named != 0:
+            out[l] = 1 if named == 1 else 2
+    return out
+

@@ -8,6 +8,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from ftc_mc import api
@@ -17,7 +18,7 @@ from ftc_mc.model.presets import PRESETS
 from ftc_mc.sim.monitor import MEASURED, lock_turn_table
 from ftc_mc.sim.setup import CONTROLLER_KINDS, build_setup
 
-from naive_sixdof import lock_turn_law_ref, turn_probe_ref
+from naive_sixdof import lock_turn_law_ref, side_blocks_ref, turn_probe_ref
 
 AF = PRESETS["x8-pyfly"].airframe
 
@@ -88,6 +89,33 @@ def test_probe_matches_its_twin(probe, unit, check):
     assert sum(values) == pytest.approx(unit * probe, abs=1e-15)
 
 
+def test_side_blocks_match_their_twin():
+    """Every combination of Table 1's block, the elevon flown about (none,
+    either side, handed back) and the monitor's latest decision, under each
+    controller kind: the kernel's blocks equal the twin's, and only a
+    ``lock_turn`` design's move."""
+    from collections import namedtuple
+
+    from ftc_mc.core.shared.paths import SIXDOF_PLANT
+    from ftc_mc.core.sixdof.lockturn import LOCK_TURN, side_blocks
+
+    grid = np.array([(b, s, m) for b in (0, 1, 2) for s in (-3, -2, 0, 2, 3)
+                     for m in (0, 1, 2, 3)], dtype=np.int64).T
+    Reconfig = namedtuple("Reconfig", ["kind"])
+    Scheme = namedtuple("Scheme", ["reconfig"])
+    State = namedtuple("State", ["mside", "mlast"])
+    st = State(mside=grid[1].copy(), mlast=grid[2].copy())
+    moved = 0
+    for kind in (0, 1, LOCK_TURN):
+        block = grid[0].copy()
+        side_blocks(SIXDOF_PLANT, Scheme(Reconfig(kind)), st, block)
+        np.testing.assert_array_equal(block, side_blocks_ref(kind, st.mside, st.mlast, grid[0]))
+        moved += int((block != grid[0]).sum())
+        if kind != LOCK_TURN:
+            np.testing.assert_array_equal(block, grid[0])
+    assert moved > 0
+
+
 def build_empty_table(measured):
     """A table with no designs (its index maps only) on the default 6-DOF model."""
     from ftc_mc.model.sixdof import build_sixdof_plant
@@ -144,7 +172,9 @@ def test_lock_turn_design_flies_on(tmp_path):
     60 s after a lock within -4 to +1 deg of trim (issue 26's trimmable band;
     the oracle study flies -10 to +2 deg), where the paper's loop keeps at most
     half; both fly the same trials, and the monitor's first decision is the
-    same in both (the flights are the same until it)."""
+    same in both (the flights are the same until it).  From that decision on,
+    the lock-turn design resets only the elevon block, where the paper's
+    Table 1 resets the thrust block too."""
     trim = float(build_setup(api.campaign_config(
         {"plant": {"kind": "linear", "dof": 6}})).truth.u0[1])
     t = api.run_campaign(flies_on_config(trim), jobs=1, progress=False,
@@ -157,6 +187,18 @@ def test_lock_turn_design_flies_on(tmp_path):
     assert (six["status"] == "ok").all(), six["status"].value_counts()
     assert (paper["status"] == "ok").mean() <= 0.5
     assert "sixdof: stay in" in (tmp_path / "run" / "summary.md").read_text()
+    # from the monitor's decision on, the lock-turn design resets only the
+    # elevon block (core/sixdof/lockturn.side_blocks); the paper's Table 1 on
+    # the same flights does not
+    resets = pd.read_parquet(tmp_path / "run" / "resets.parquet")
+    wrong = {}
+    for v, trials in (("paper", paper), ("sixdof", six)):
+        named = trials[(trials["side_correct"] == 1) & (trials["side_false"] == 0)]
+        r = resets[resets["variant"] == v].join(named["side_s"], on=["transition", "trial_id"],
+                                                how="inner")
+        wrong[v] = int(((r["time_from_fault_s"] >= r["side_s"])
+                        & (r["block"] != "elevons")).sum())
+    assert wrong["sixdof"] == 0 and wrong["paper"] > 0, wrong
 
 
 def probe_config(probe_rad):

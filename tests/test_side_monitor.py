@@ -173,7 +173,7 @@ def test_monitor_matches_its_twin(setup):
         assert (rec.side_k[l], rec.side_block[l], rec.side_pre[l], rec.side_n[l]) == (
             ref.side_k, ref.side_block, ref.side_pre, ref.side_n), l
         np.testing.assert_allclose(rec.mon_b[:, l], ref.b, rtol=10 * tol, atol=1e-12)
-        assert st.mside[l] == ref.side and st.mturn[l] == ref.turn_k, l
+        assert (st.mside[l], st.mturn[l], st.mlast[l]) == (ref.side, ref.turn_k, ref.last), l
         np.testing.assert_allclose(st.mpos[l], ref.pos, rtol=10 * tol, atol=1e-12)
     # the stopped lane recorded nothing; without gusts in the data, the faulted
     # live lanes decided, on their own actuator

@@ -143,7 +143,8 @@ def random_lanes(setup, rng, k, L=L):
                      mx=np.zeros((0, L)), mP=np.zeros((0, 0, L)), mbuf=np.zeros((1, 3, L)),
                      mcount=np.zeros(L, dtype=np.int64), mside=np.zeros(L, dtype=np.int64),
                      mpos=np.zeros(L),
-                     mturn=np.full(L, -1, dtype=np.int64), **trim_jacobians(fm, L))
+                     mturn=np.full(L, -1, dtype=np.int64), mlast=np.zeros(L, dtype=np.int64),
+                     **trim_jacobians(fm, L))
 
 
 def trim_jacobians(fm, L=L):

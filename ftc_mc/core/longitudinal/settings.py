@@ -318,6 +318,7 @@ LaneState = namedtuple("LaneState", [
     "mpos",     # (L,) that elevon's estimated absolute position [rad] (core/sixdof/lockturn.py)
     "mturn",    # (L,) int64 the step from which the lock-turn law may fly (the monitor's
                 #        first elevon decision, k + 1), or -1; ``mside`` < 0 once handed back
+    "mlast",    # (L,) int64 its latest decision: 0 none, else its block code (1-3)
     # the extended filter's Jacobians about the lane's estimate (FilterModel.relin > 0;
     # the trim matrices otherwise, never read)
     "JA",       # (9, 9, L)  d x_{k+1} / d x_k of the one-period airframe map

@@ -54,7 +54,8 @@ from ..shared.excitation import (doublet, doublet_length, running, saturate, sig
                                  signal_3211_length)
 from ..jit import kernel
 from ..shared.paths import (DENSE_FILTER, EXTENDED_FILTER, GLR_TEST, NOMINAL_CONTROL,
-                            ONE_STEP_TEST, PAPER_FILTER, RECONFIGURING, on_path)
+                            ONE_STEP_TEST, PAPER_FILTER, RECONFIGURING, SIXDOF_EXTENDED_PLANT,
+                            SIXDOF_PLANT, on_path)
 from .workspace import EXC_3211, EXC_3211_START, EXC_DOUBLET, EXC_DOUBLET_START
 
 R_Q, R_NX = 0, 1
@@ -294,6 +295,16 @@ def restart_window(path, block, ecount):
     """A reset restarts the lane's GLR window (on the GLR test's path)."""
 
 
+@on_path("plant", {SIXDOF_PLANT: "ftc_mc.core.sixdof.lockturn:side_blocks",
+                   SIXDOF_EXTENDED_PLANT: "ftc_mc.core.sixdof.lockturn:side_blocks"},
+         passes="marker")
+def side_blocks(path, scheme, st, block):
+    """On the 6-DOF plant, a ``lock_turn`` design's side monitor decides which
+    block Table 1's decisions reset (:func:`ftc_mc.core.sixdof.lockturn.side_blocks`,
+    imported only by a path that flies the 6-DOF plant); nothing on the
+    longitudinal plants."""
+
+
 @kernel(inline="always")
 def filter_update(path, scheme, st, k, work):
     """Stage 3: one step of every lane's augmented filter (eqs. 5-11, Table 1).
@@ -304,7 +315,8 @@ def filter_update(path, scheme, st, k, work):
     the dense and extended filters' paths); on the GLR test's path the
     statistics of :func:`ftc_mc.core.shared.glr.glr_lanes` replace the one-step
     residuals; Table 1
-    on them, a decision for the other block withheld within
+    on them (on the 6-DOF plant, a ``lock_turn`` design's block from its side
+    monitor, :func:`side_blocks`), a decision for the other block withheld within
     ``detection.settle`` steps of a reset (:func:`settle_lanes`), and every
     decision before step ``detection.startup`` (then the GLR window is kept
     empty too: the test is armed after the start-up); reset, update
@@ -336,6 +348,7 @@ def filter_update(path, scheme, st, k, work):
     innovations(path, scheme, st, work)
     decision_statistics(path, det, st, k, work)
     signature_lanes(res, det, work.block)
+    side_blocks(path, scheme, st, work.block)
     if det.settle > 0:
         settle_lanes(work.block, st.last_k, st.last_block, k, det.settle)
     if k < det.startup:  # not armed yet: no reset, and the GLR window stays empty

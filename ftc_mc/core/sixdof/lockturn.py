@@ -65,8 +65,21 @@ for the rest of the flight (the monitor names no elevon after it).  In gusts
 the probe hardly moves ``b1`` (``docs/airframes.md``); its spread then keeps
 the lane turning.
 
+**Which block the paper's filter resets** (:func:`side_blocks`).  In a
+``lock_turn`` design the monitor also decides which block of the paper's
+longitudinal filter a reset opens: Table 1 still decides *when* (a residual
+statistic reaches its threshold), and the actuator the design acts on decides
+*which*: the elevon a lane flies the law about, else the actuator the monitor
+named last (``LaneState.mlast``), each mapped to the longitudinal filter's
+block (``conventions.LONGITUDINAL.actuator_block``: the throttle to the
+thrust block, either elevon to the elevon block).  Until the monitor's first
+decision Table 1 decides both.  The longitudinal filter sees a locked elevon
+through pitch only, and once the law banks the wing its model (wings level)
+reads the turn as a thrust change; the monitor reads roll and pitch together
+(issue 26, item 2: the side decided by the direction's GLR).
+
 Plain-NumPy twins: ``tests/naive_sixdof.py::lock_turn_law_ref``,
-``turn_probe_ref``.
+``turn_probe_ref``, ``side_blocks_ref``.
 """
 
 from __future__ import annotations
@@ -75,12 +88,18 @@ from collections import namedtuple
 
 import numpy as np
 
+from ...conventions import LONGITUDINAL, NO_RESET
 from ..jit import kernel
 from ..shared.excitation import signal_3211, signal_3211_length
 
 LOCK_TURN = 2
 """``Reconfig.kind`` of a ``controller: lock_turn`` design (after 0 nominal and
 1 reconfiguring, which it runs until the monitor names an elevon)."""
+
+DECISION_BLOCK = (NO_RESET,) + LONGITUDINAL.actuator_block
+"""The longitudinal filter's block of each monitor decision code (0: none, then
+the direction's index plus one; the directions are the commands, in the
+longitudinal actuators' order: ``layout.MONITOR_DIRECTIONS``)."""
 
 LockTurnTable = namedtuple("LockTurnTable", [
     "lo",    # (2,) absolute lock position [rad] of each side's first grid point (left, right)
@@ -188,3 +207,30 @@ def turn_law(tab, s, i, j1, w, mx, z, lat, l, lo_dev, hi_dev, u):
             dev = xr - ((1.0 - w) * tab.x[s, i, r] + w * tab.x[s, j1, r])
             v -= ((1.0 - w) * tab.K[s, i, c, r] + w * tab.K[s, j1, c, r]) * dev
         u[a, l] = min(hi_dev[a], max(lo_dev[a], v))
+
+
+@kernel(internal=True)
+def side_blocks(plant, scheme, st, block):
+    """Table 1's decisions of a ``lock_turn`` design, each moved to the block of
+    the actuator the design acts on (module docstring, "Which block the
+    paper's filter resets"); other designs' are left alone.
+
+    Parameters
+    ----------
+    plant : SixdofPlant or SixdofExtendedPlant
+        The path's plant marker (the dispatcher's calling convention).
+    scheme : Scheme
+        ``reconfig.kind`` (:data:`LOCK_TURN`: the monitor decides the block).
+    st : LaneState
+        ``mside`` (the elevon the lane flies the law about, if > 0) and
+        ``mlast`` (the monitor's latest decision, 0 none).
+    block : ndarray of int64, shape (L,)
+        Table 1's block per lane (``NO_RESET``, ``RESET_THRUST`` or
+        ``RESET_ELEVONS``), rewritten in place.
+    """
+    if scheme.reconfig.kind != LOCK_TURN:
+        return
+    for l in range(block.shape[0]):
+        named = st.mside[l] if st.mside[l] > 0 else st.mlast[l]
+        if block[l] != NO_RESET and named != 0:
+            block[l] = DECISION_BLOCK[named]

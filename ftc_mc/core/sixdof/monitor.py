@@ -650,6 +650,7 @@ def monitor_decide(mon, flight, k, st, work, rec, num, den):
                 P[pidx, j, l] = 0.0
                 P[j, pidx, l] = 0.0
             P[pidx, pidx, l] = mon.reset_var[pidx - ns]
+        st.mlast[l] = b
         if b > 1 and st.mside[l] == 0:  # the first elevon named (lockturn.py)
             st.mside[l] = b
             st.mturn[l] = kn
@@ -688,7 +689,8 @@ def sixdof_monitor(plant, scheme, flight, k, st, work, rec):
     st : LaneState
         ``mx`` (n, L), ``mP`` (n, n, L) (set at step 0: zero and ``P0``),
         the GLR window ``mbuf`` and ``mcount``, the first elevon named
-        ``mside`` and its position estimate ``mpos``, updated in place; ``lat``
+        ``mside`` and its position estimate ``mpos``, the latest decision
+        ``mlast``, updated in place; ``lat``
         the lateral loop's measurements of ``k + 1``.
     work : TrialWork
         ``u`` the commands sent over the step, ``z`` the 12 longitudinal
