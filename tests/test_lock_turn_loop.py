@@ -114,6 +114,15 @@ def test_side_blocks_match_their_twin():
         if kind != LOCK_TURN:
             np.testing.assert_array_equal(block, grid[0])
     assert moved > 0
+    # the decision codes follow the monitor's directions, named as the
+    # longitudinal commands
+    from ftc_mc.conventions import INPUT_NAMES, RESET_ELEVONS, RESET_THRUST
+    from ftc_mc.core.sixdof.layout import MONITOR_DIRECTIONS
+    from ftc_mc.core.sixdof.lockturn import DECISION_BLOCK
+
+    assert MONITOR_DIRECTIONS == tuple(n.replace("elevon_", "") for n in INPUT_NAMES)
+    assert [DECISION_BLOCK[1 + MONITOR_DIRECTIONS.index(d)] for d in ("throttle", "left", "right")
+            ] == [RESET_THRUST, RESET_ELEVONS, RESET_ELEVONS]
 
 
 def build_empty_table(measured):

@@ -24,7 +24,8 @@ calls it and stage 7 by address (``core/linking.py``):
    :func:`ftc_mc.core.longitudinal.stages.record_cost` -- tracking and command costs,
    then :func:`side_monitor` -- on the 6-DOF plant its side monitor
    (:func:`ftc_mc.core.sixdof.monitor.sixdof_monitor`), which records, and which a
-   ``lock_turn`` design's truth stage reads (``core/sixdof/lockturn.py``);
+   ``lock_turn`` design's truth stage and its choice of the block to reset
+   read (``core/sixdof/lockturn.py``);
 3. :func:`ftc_mc.core.longitudinal.stages.filter_update` -- the filter with ``u_k``, ``z_{k+1}``;
 4. :func:`ftc_mc.core.longitudinal.stages.check_validity`;
 5. :func:`ftc_mc.core.longitudinal.stages.handle_resets` -- resets, excitation requests
@@ -108,6 +109,8 @@ def advance(path, scheme, flight, inp, rec, st, k0, k1):
     """
     work = new_trial_work(st.xa.shape[1], st.xa.shape[0])
     every = flight.timing.reconf_every
+    if every <= 0:
+        raise ValueError("timing.reconf_every must be at least one step")
     period = k0 // every
     k = k0
     while k < k1:
