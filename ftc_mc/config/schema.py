@@ -227,7 +227,7 @@ class ControllerConfig(_Strict):
     """Controllers and their selection (sections 4.1-4.2, 5.1)."""
 
     kind: Literal["nominal", "reconfiguring", "lock_turn"] = "reconfiguring"
-    """``nominal``: c0 only; ``reconfiguring``: c0/c1/c2 chosen by eqs. 45-47; ``lock_turn`` (6-DOF plant, side monitor on): reconfiguring until the side monitor names an elevon, then the lock-turn controller of that side, scheduled on the monitor's lock estimate (``ftc_mc/core/sixdof/lockturn.py``)."""
+    """``nominal``: c0 only; ``reconfiguring``: c0/c1/c2 chosen by eqs. 45-47; ``lock_turn`` (6-DOF plant, side monitor on): reconfiguring until the side monitor names an elevon, then the lock-turn controller of that side, scheduled on the monitor's lock estimate; the monitor also decides which block Table 1's resets open (``ftc_mc/core/sixdof/lockturn.py``)."""
     discount: Annotated[float, NoBool, Field(gt=0, lt=1, allow_inf_nan=False)] = 0.999
     """Discount factor alpha (< 1: a locked engine needs it, section 4.1.2)."""
     r_lqr: Pos = 0.1
@@ -606,7 +606,7 @@ class DesignConfig(_Strict):
     """ambiguous: send when r_q or r_nx (the design's decision statistics: one-step residuals or GLR) reach this; null: never on the residuals. Below Table 1's thresholds it excites a suspected change before it is decided."""
 
     controller: Literal["nominal", "reconfiguring", "lock_turn"] | None = None
-    """Controller of this design's flights: nominal (c0 throughout), reconfiguring (c0/c1/c2 chosen by eqs. 45-47) or lock_turn (6-DOF plant: reconfiguring until the side monitor names an elevon, then the lock-turn controller of that side), so one campaign compares them on the same trials; null: the controller section's kind."""
+    """Controller of this design's flights: nominal (c0 throughout), reconfiguring (c0/c1/c2 chosen by eqs. 45-47) or lock_turn (6-DOF plant: reconfiguring until the side monitor names an elevon, then the lock-turn controller of that side; the monitor also decides which block Table 1's resets open), so one campaign compares them on the same trials; null: the controller section's kind."""
 
     @model_validator(mode="after")
     def _biases(self):
