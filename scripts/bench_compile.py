@@ -40,6 +40,8 @@ PATHS = {
     "dense_glr": ("designs.yaml", "gust_glr", {}),
     "robust": ("robust_moderate.yaml", "robust", {}),
     "sixdof": ("sixdof_tables.yaml", "paper", {}),  # issue 24: the 6-DOF plant's path
+    # the 6-DOF plant in moderate turbulence: its side monitor the extended filter
+    "sixdof_extended": ("sixdof_moderate.yaml", "paper", {}),
 }
 
 CHILD = r"""
