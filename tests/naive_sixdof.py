@@ -514,6 +514,41 @@ def lock_turn_law_ref(tab, s, p, xhat, lo_dev, hi_dev):
     return np.clip(out, lo_dev, hi_dev)
 
 
+def rocking_law_ref(tab, pl, s, p, x, lo_dev, hi_dev):
+    """The rocking law of one lane (``ftc_mc/core/sixdof/lockturn.py``), written
+    from that module's docstring: from the absolute 6-DOF state ``x`` (15,),
+    every candidate history (its first pair for ``ro_first`` periods, its
+    second after, the named elevon at ``p``) flies ``ro_steps`` periods of
+    :func:`rk4_ref` (``ro_sub`` sub-steps, still air); the envelope's excess
+    after each period, in m/s and degrees, from ``u, v, w`` and ``phi``; the
+    candidate that stays in longest, then the one with the least largest
+    excess before it leaves, the first on a tie.  Returns the commands of
+    the throttle and the healthy elevon (2,) less the longitudinal trim
+    ``pl.monitor.u0``, and the chosen candidate's index."""
+    env = tab.ro_env
+    scores = []
+    for c in range(len(tab.ro_first)):
+        xs = np.array(x, dtype=float)
+        excess = []
+        for k in range(tab.ro_steps):
+            pair = tab.ro_u[s, c, 0 if k < tab.ro_first[c] else 1]
+            cmd = np.zeros(3)
+            cmd[tab.cmd[s]] = pl.monitor.u0[tab.cmd[s]] + pair
+            cmd[tab.locked[s]] = p
+            xs = rk4_ref(xs, cmd, pl.p, np.zeros(6), pl.dt, tab.ro_sub)
+            u, v, w = (xs[LAYOUT.states.index(n)] for n in ("u", "v", "w"))
+            va = np.sqrt(u * u + v * v + w * w)
+            alpha = np.degrees(np.arctan2(w, u))
+            bank = np.degrees(abs(xs[LAYOUT.states.index("phi")]))
+            e = max(env[0] - va, va - env[1], env[2] - alpha, alpha - env[3], bank - env[4])
+            excess.append(e if np.isfinite([va, alpha, bank]).all() else np.inf)
+        out = next((k for k, e in enumerate(excess) if e > 0), tab.ro_steps)
+        scores.append((out, -max(excess[:out], default=-np.inf)))
+    best = max(range(len(scores)), key=lambda c: (scores[c], -c))
+    cmd = np.clip(tab.ro_u[s, best, 0], lo_dev[tab.cmd[s]], hi_dev[tab.cmd[s]])
+    return cmd, best
+
+
 def side_blocks_ref(kind, mside, mlast, block):
     """Twin of ``core/sixdof/lockturn.side_blocks``, from its docstring: in a
     ``lock_turn`` design (``kind`` 2) each lane's Table 1 reset (``block`` 1

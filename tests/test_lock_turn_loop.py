@@ -18,7 +18,7 @@ from ftc_mc.model.presets import PRESETS
 from ftc_mc.sim.monitor import MEASURED, lock_turn_table
 from ftc_mc.sim.setup import CONTROLLER_KINDS, build_setup
 
-from naive_sixdof import lock_turn_law_ref, side_blocks_ref, turn_probe_ref
+from naive_sixdof import lock_turn_law_ref, rocking_law_ref, side_blocks_ref, turn_probe_ref
 
 AF = PRESETS["x8-pyfly"].airframe
 
@@ -48,11 +48,12 @@ def test_law_matches_its_twin(measured):
     z = rng.normal(0, 0.2, (12, L))
     lat = rng.normal(0, 0.2, (7, L))
     lo, hi = np.array([-0.4, -0.5, -0.5]), np.array([0.6, 0.5, 0.5])
+    pl = rocking_setup(measured)[1]  # read by the rocking law only (off here: the trim held)
     for s in (0, 1):
         for p in (-0.3, -0.1, -0.07, 0.0, 0.0999, 0.1, 0.5):
             u = np.zeros((3, L))
             for l in range(L):
-                lock_turn_law(tab, s, p, mx, z, lat, l, lo, hi, u)
+                lock_turn_law(tab, pl, s, p, mx, z, lat, l, lo, hi, u)
                 meas = np.concatenate([z[:, l], lat[:5, l]])
                 xhat = np.where(tab.meas[s] >= 0, meas[np.maximum(tab.meas[s], 0)],
                                 mx[tab.rows[s], l])
@@ -123,6 +124,73 @@ def test_side_blocks_match_their_twin():
     assert MONITOR_DIRECTIONS == tuple(n.replace("elevon_", "") for n in INPUT_NAMES)
     assert [DECISION_BLOCK[1 + MONITOR_DIRECTIONS.index(d)] for d in ("throttle", "left", "right")
             ] == [RESET_THRUST, RESET_ELEVONS, RESET_ELEVONS]
+
+
+def rocking_setup(measured):
+    """A table with the rocking law's candidates (0.6 s horizon, switches at 0.1
+    and 0.3 s, 2 RK4 sub-steps, the trials' envelope) on the default 6-DOF
+    model, and the truth plant fields it reads (``p``, ``x0``, ``dt``,
+    ``monitor.states``, ``monitor.u0``)."""
+    from collections import namedtuple
+
+    from ftc_mc.core.sixdof.layout import MONITOR_STATES, STATE
+    from ftc_mc.model.sixdof import build_sixdof_plant
+    from ftc_mc.sim.monitor import rocking_table
+
+    six = build_sixdof_plant(AF, 20.0, -3.0, 0.1)
+    u0 = six.u0 - np.array([0.0, 0.004, -0.002])  # a longitudinal trim beside the 6-DOF one
+    lo, hi = six.u_lower - u0, six.u_upper - u0
+    tab = build_empty_table(measured)._replace(
+        **rocking_table(lo, hi, 6, (1, 3), 2, (12.0, 30.0, -8.0, 12.0, 60.0)))
+    Mon = namedtuple("Mon", ["states", "u0"])
+    Pl = namedtuple("Pl", ["p", "x0", "dt", "monitor"])
+    pl = Pl(p=six.trim.params, x0=six.trim.x0, dt=0.1,
+            monitor=Mon(states=np.array([STATE[n] for n in MONITOR_STATES]), u0=u0))
+    return tab, pl, lo, hi
+
+
+@pytest.mark.parametrize("measured", [True, False])
+def test_rocking_law_matches_its_twin(measured):
+    """Locks beyond the steady band either side, from trim and from rolled,
+    pitched and slowed states: the kernel sends the first pair of the
+    candidate the twin chooses, and the choices differ (throttle and elevon,
+    held and switching) from state to state."""
+    from ftc_mc.core.sixdof.layout import MONITOR_STATES
+    from ftc_mc.core.sixdof.lockturn import rocking_law
+    from ftc_mc.sim.monitor import MEASURED
+
+    tab, pl, lo, hi = rocking_setup(measured)
+    assert tab.ro_first.shape == (66,) and tab.ro_u.shape == (2, 66, 2, 2)
+    rng = np.random.default_rng(26)
+    nm, L = len(MONITOR_STATES), 3
+    index = {n: i for i, n in enumerate(MONITOR_STATES)}
+    chosen = set()
+    for s in (0, 1):
+        for off in (-20.0, 6.0, 14.0):
+            p = pl.monitor.u0[1 + s] + math.radians(off)
+            mx = np.zeros((nm + 6, L))
+            mx[index["phi"], 1] = math.radians(35.0 * (1 - 2 * s))
+            mx[index["theta"], 1] = math.radians(-20.0)
+            mx[index["u"], 2] = -5.0
+            mx[:nm, 2] += rng.normal(0, 0.02, nm)
+            z = rng.normal(0, 0.01, (12, L))
+            lat = rng.normal(0, 0.01, (7, L))
+            u = np.zeros((3, L))
+            for l in range(L):
+                rocking_law(tab, pl, s, p, mx, z, lat, l, lo, hi, u)
+                x = pl.x0.copy()
+                x[pl.monitor.states] += mx[:nm, l]
+                meas = np.concatenate([z[:, l], lat[:5, l]])
+                for r, o in enumerate(tab.meas[s]):
+                    if o >= 0:
+                        j = pl.monitor.states[tab.rows[s, r]]
+                        x[j] = pl.x0[j] + meas[o]
+                        assert MEASURED[o] == MONITOR_STATES[tab.rows[s, r]]
+                want, best = rocking_law_ref(tab, pl, s, p, x, lo, hi)
+                np.testing.assert_allclose(u[tab.cmd[s], l], want, rtol=0, atol=1e-15)
+                chosen.add(best)
+    assert len({tuple(tab.ro_u[0, c, 0]) for c in chosen}) >= 2, chosen
+    assert any(tab.ro_first[c] < tab.ro_steps for c in chosen), chosen
 
 
 def build_empty_table(measured):
@@ -210,6 +278,33 @@ def test_lock_turn_design_flies_on(tmp_path):
     assert wrong["sixdof"] == 0 and wrong["paper"] > 0, wrong
 
 
+def test_the_rocking_law_outlasts_the_held_trim(tmp_path):
+    """Locks 5-12 deg above trim, beyond the steady band (no steady flight
+    exists there with the healthy elevon and the throttle): with the trim
+    held (``turn_beyond: hold``) every trial leaves the envelope within 15 s
+    of the lock; the rocking law keeps every one of the same trials inside
+    for the 30 s flown (docs/airframes.md has the campaign)."""
+    trim = float(build_setup(api.campaign_config(
+        {"plant": {"kind": "linear", "dof": 6}})).truth.u0[1])
+    out = {}
+    for beyond in ("hold", "rollout"):
+        cfg = flies_on_config(trim)
+        cfg["campaign"].update(transitions=["elevon_lock", "right_elevon_lock"], trials=2,
+                               chunk_size=2, signature="none")
+        cfg["draws"] = {"elevon_lock_range_rad": [trim + math.radians(5.0),
+                                                  trim + math.radians(12.0)]}
+        cfg["timing"]["duration_s"] = 30.0
+        cfg["monitor"].update(turn_beyond=beyond, turn_offsets_deg=[-2.0, 6.0])
+        t = api.run_campaign(cfg, jobs=1, progress=False, out=tmp_path / beyond).trials
+        out[beyond] = t.set_index(["transition", "trial_id"])
+    hold, rock = out["hold"], out["rollout"]
+    assert (hold["lock_position"] == rock["lock_position"]).all()
+    assert (rock["side_correct"] == 1).all()
+    assert (hold["status"] != "ok").all(), hold["status"].value_counts()
+    assert (hold["stop_s"] < 5.0 + 15.0).all(), hold["stop_s"]
+    assert (rock["status"] == "ok").all(), rock[["status", "stop_s"]]
+
+
 def probe_config(probe_rad):
     """Nonlinear 6-DOF, still air: left-elevon losses of 10-40 % at 5 s (which
     the monitor names like locks) and locks within 1 deg of trim, 30 s flown."""
@@ -255,6 +350,11 @@ def test_the_probe_hands_a_loss_back_and_keeps_a_lock(tmp_path):
     ({"monitor": {"turn_step_deg": 0.7}}, "turn_step_deg: must divide"),
     ({"monitor": {"turn_probe_rad": 0.03, "hand_back_after_s": 1.0}},
      "hand_back_after_s: must be at least the probe's length (1.4 s)"),
+    ({"monitor": {"rollout_switch_s": [0.2, 3.0]}},
+     "rollout_switch_s: each must be below rollout_horizon_s (3 s), got 3"),
+    ({"monitor": {"rollout_horizon_s": 3.05}},
+     "monitor.rollout_horizon_s: must be a positive multiple of model.dt_s"),
+    ({"monitor": {"turn_beyond": "rock"}}, "monitor.turn_beyond"),
 ])
 def test_configs_that_cannot_fly_it_are_one_line(tmp_path, change, field):
     """A lock-turn design on the longitudinal plant or without the monitor, and

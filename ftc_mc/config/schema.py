@@ -80,18 +80,22 @@ def _shared_periods(cfg) -> list:
     """``(name, seconds)`` of the periods in the sections a campaign and a scenario
     share (excitation, controller, validity, monitor)."""
     e = cfg.excitation
-    return [("excitation.doublet_half_period_s", e.doublet_half_period_s),
-            ("excitation.s3211_unit_s", e.s3211_unit_s),
-            ("excitation.resend_delay_s", e.resend_delay_s),
-            ("controller.horizon_s", cfg.controller.horizon_s),
-            ("controller.terminal_horizon_s", cfg.controller.terminal_horizon_s),
-            ("validity.psd_check_period_s", cfg.validity.psd_check_period_s),
-            ("monitor.window_s", cfg.monitor.window_s),
-            ("monitor.min_window_s", cfg.monitor.min_window_s),
-            ("monitor.startup_s", cfg.monitor.startup_s),
-            ("monitor.estimate_after_s", cfg.monitor.estimate_after_s),
-            ("monitor.turn_probe_unit_s", cfg.monitor.turn_probe_unit_s),
-            ("monitor.hand_back_after_s", cfg.monitor.hand_back_after_s)]
+    m = cfg.monitor
+    periods = [("excitation.doublet_half_period_s", e.doublet_half_period_s),
+               ("excitation.s3211_unit_s", e.s3211_unit_s),
+               ("excitation.resend_delay_s", e.resend_delay_s),
+               ("controller.horizon_s", cfg.controller.horizon_s),
+               ("controller.terminal_horizon_s", cfg.controller.terminal_horizon_s),
+               ("validity.psd_check_period_s", cfg.validity.psd_check_period_s),
+               ("monitor.window_s", m.window_s),
+               ("monitor.min_window_s", m.min_window_s),
+               ("monitor.startup_s", m.startup_s),
+               ("monitor.estimate_after_s", m.estimate_after_s),
+               ("monitor.turn_probe_unit_s", m.turn_probe_unit_s),
+               ("monitor.hand_back_after_s", m.hand_back_after_s),
+               ("monitor.rollout_horizon_s", m.rollout_horizon_s)]
+    return periods + [(f"monitor.rollout_switch_s.{i}", t)
+                      for i, t in enumerate(m.rollout_switch_s)]
 
 
 def _check_airframe_use(cfg) -> tuple:
@@ -395,7 +399,7 @@ class MonitorConfig(_Strict):
     """Time after the first decision at or after the switch at which the
     monitor's estimate (lock position, b0, b1) is recorded [s]."""
     turn_offsets_deg: tuple[Finite, Finite] = (-14.0, 4.0)
-    """Lock offsets from trim [deg] the lock-turn table of a ``controller: lock_turn`` design spans, each side (``ftc_mc/design/lock_turn.py``; an estimate beyond them flies the end's design). Where neither design bracketing the estimate has a steady flight of its own, the law holds the trim commands instead. Designed once per airframe and cached (about 1-10 s per lock)."""
+    """Lock offsets from trim [deg] the lock-turn table of a ``controller: lock_turn`` design spans, each side (``ftc_mc/design/lock_turn.py``; an estimate beyond them flies the end's design). Where neither design bracketing the estimate has a steady flight of its own, the law holds the trim commands instead, or flies the rocking law (turn_beyond). Designed once per airframe and cached (about 1-10 s per lock)."""
     turn_step_deg: Pos = 1.0
     """Step of that table [deg]: its range must hold a whole number of steps."""
     turn_feedback: Literal["measured", "estimate"] = "measured"
@@ -410,6 +414,14 @@ class MonitorConfig(_Strict):
     """A probed lane whose monitor then estimates the named elevon's b1 (the share of its effectiveness lost) below this hands back: it flies the paper's reconfiguring loop and lateral autopilot again for the rest of the flight."""
     hand_back_sd: NonNeg = 2.0
     """Standard deviations of the monitor's b1 estimate (its covariance) by which b1 must lie below hand_back_b1 to hand back: in gusts the probe hardly moves b1, and its spread keeps a lock turning."""
+    turn_beyond: Literal["hold", "rollout"] = "hold"
+    """What the lock-turn law flies where no steady flight exists about the lock estimate (beyond the steady band of the design box): ``hold``, the 6-DOF trim commands; ``rollout``, the rocking law, which every step flies the airframe's equations over rollout_horizon_s under each of 66 bang-bang histories of the throttle and the healthy elevon and sends the first command of the one that stays inside the validity envelope longest (``ftc_mc/core/sixdof/lockturn.py``; about 4,000 RK4 steps per lane and step while it flies)."""
+    rollout_horizon_s: Pos = 3.0
+    """rollout: how far ahead each candidate history is flown [s] (a multiple of model.dt_s)."""
+    rollout_switch_s: tuple[Pos, ...] = (0.2, 1.0)
+    """rollout: times at which a candidate history switches from its first (throttle, healthy elevon) pair to its second [s] (multiples of model.dt_s, below rollout_horizon_s); each adds 30 candidates to the 6 held pairs."""
+    rollout_substeps: Annotated[int, NoBool, Field(ge=1, le=100)] = 2
+    """rollout: RK4 sub-steps per control period of those flights (the trials' truth uses 10; 2 keep the roll mode stable at dt = 0.1 s, h lambda = 1.9 inside RK4's 2.8)."""
 
     @model_validator(mode="after")
     def _ordered(self):
@@ -419,6 +431,10 @@ class MonitorConfig(_Strict):
         if self.turn_probe_rad > 0 and self.hand_back_after_s < probe_s * (1 - 1e-9):
             raise ValueError(f"hand_back_after_s: must be at least the probe's length "
                              f"({probe_s:g} s), got {self.hand_back_after_s:g}")
+        late = [t for t in self.rollout_switch_s if not t < self.rollout_horizon_s]
+        if late:
+            raise ValueError(f"rollout_switch_s: each must be below rollout_horizon_s "
+                             f"({self.rollout_horizon_s:g} s), got {late[0]:g}")
         lo, hi = self.turn_offsets_deg
         if not lo < hi:
             raise ValueError(f"turn_offsets_deg: the first must be below the second, got "

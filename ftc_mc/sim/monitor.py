@@ -47,6 +47,11 @@ NO_PROBE = dict(probe=0.0, probe_unit=1, check=0, hand_back=0.0, hand_back_sd=0.
 """The ``LockTurnTable`` fields of no probe and no hand-back (the same types as a
 configured probe's, so that both compile to one signature)."""
 
+NO_ROLLOUT = dict(ro_on=0, ro_steps=1, ro_sub=1, ro_first=np.ones(1, dtype=np.int64),
+                  ro_u=np.zeros((2, 1, 2, 2)), ro_env=np.zeros(5))
+"""The ``LockTurnTable`` fields of no rocking law (``monitor.turn_beyond: hold``;
+the same types as the law's, one signature)."""
+
 MEASURED = LONGITUDINAL.outputs + MONITOR_LATERAL
 """The monitor's measured outputs in its order (``CAS`` and ``Va`` both the
 6-DOF airspeed): the 12 longitudinal ones, then the lateral loop's."""
@@ -94,6 +99,12 @@ class MonitorSpec:
         the nonlinear plant with gust states; ``nonlinear`` is then True too).
     state_noise_scale : float
         Multiplies the process noise variance ``q_x`` of the 6-DOF states.
+    turn_rollout : dict or None
+        The rocking law (``monitor.turn_beyond: rollout``): ``steps`` (its
+        horizon), ``switches`` (the candidates' switch times) [periods],
+        ``sub`` (RK4 sub-steps per period) and ``env`` (the envelope: airspeed
+        [m/s], angle of attack and bank [deg], :func:`rocking_table`'s
+        order); None: the trim is held (``hold``).
     """
 
     threshold: float
@@ -115,6 +126,7 @@ class MonitorSpec:
     substeps: int = 5
     extended: bool = False
     state_noise_scale: float = 1.0
+    turn_rollout: dict | None = None
 
 
 def monitor_spec(cfg, fm, det, lock_turn: bool = False) -> MonitorSpec | None:
@@ -161,7 +173,14 @@ def monitor_spec(cfg, fm, det, lock_turn: bool = False) -> MonitorSpec | None:
         extended=(mc.prediction == "extended" or
                   (mc.prediction == "auto" and cfg.plant.kind == "nonlinear"
                    and mc.design_turbulence != "none")),
-        state_noise_scale=float(mc.state_noise_scale))
+        state_noise_scale=float(mc.state_noise_scale),
+        turn_rollout=None if mc.turn_beyond == "hold" else dict(
+            steps=cfg.steps(mc.rollout_horizon_s),
+            switches=tuple(cfg.steps(t) for t in mc.rollout_switch_s),
+            sub=int(mc.rollout_substeps),
+            env=(cfg.validity.airspeed_min_mps, cfg.validity.airspeed_max_mps,
+                 cfg.validity.alpha_min_deg, cfg.validity.alpha_max_deg,
+                 cfg.validity.bank_max_deg)))
 
 
 def gust_block(six, spec: MonitorSpec, span: float):
@@ -190,8 +209,49 @@ def gust_block(six, spec: MonitorSpec, span: float):
             block_diag(lon.P0, lat.P0), W)
 
 
+def rocking_table(lo_dev, hi_dev, steps: int, switches, sub: int, env) -> dict:
+    """The ``LockTurnTable`` fields of the rocking law (``ro_*``; module
+    docstring of :mod:`ftc_mc.core.sixdof.lockturn`).
+
+    The pairs (throttle, healthy elevon) are the throttle's two limits by the
+    healthy elevon's two limits and their midpoint (throttle-major); the
+    candidates are each pair held for the whole horizon, then, per switch
+    time in ``switches``, every ordered pair of two different pairs (first
+    pair-major).
+
+    Parameters
+    ----------
+    lo_dev, hi_dev : array_like, shape (3,)
+        Command limits less the longitudinal trim ``u0``.
+    steps : int
+        Horizon [periods].
+    switches : sequence of int
+        Switch times [periods], each in ``1 .. steps - 1``.
+    sub : int
+        RK4 sub-steps per period.
+    env : sequence of 5 float
+        Airspeed min, max [m/s], angle of attack min, max [deg], largest bank [deg].
+    """
+    from ..design.lock_turn import SIDES, healthy
+
+    lo = np.asarray(lo_dev, dtype=float)
+    hi = np.asarray(hi_dev, dtype=float)
+    pairs = []
+    for s, side in enumerate(SIDES):
+        t, h = COMMAND["throttle"], COMMAND[healthy(side)]
+        pairs.append([(a, b) for a in (lo[t], hi[t]) for b in (lo[h], 0.5 * (lo[h] + hi[h]), hi[h])])
+    n_p = len(pairs[0])
+    order = [(i, i, steps) for i in range(n_p)]
+    order += [(i, j, k) for k in switches for i in range(n_p) for j in range(n_p) if i != j]
+    ro_u = np.array([[[pairs[s][i], pairs[s][j]] for i, j, _ in order] for s in range(2)])
+    return dict(ro_on=1, ro_steps=int(steps), ro_sub=int(sub),
+                ro_first=np.array([k for _, _, k in order], dtype=np.int64),
+                ro_u=np.ascontiguousarray(ro_u, dtype=np.float64),
+                ro_env=np.asarray(env, dtype=np.float64))
+
+
 def lock_turn_table(six, u0: np.ndarray, offsets=(), airframe=None,
-                    measured: bool = True, probe=None) -> LockTurnTable:
+                    measured: bool = True, probe=None, rollout=None) -> LockTurnTable:
     """The kernels' :class:`LockTurnTable` (empty, ``x`` of shape ``(2, 0, 10)``,
     when ``offsets`` is).
 
@@ -216,6 +276,9 @@ def lock_turn_table(six, u0: np.ndarray, offsets=(), airframe=None,
     probe : dict, optional
         The table's probe fields (:attr:`MonitorSpec.turn_probe`); default
         :data:`NO_PROBE`.
+    rollout : dict, optional
+        The table's rocking-law fields (:func:`rocking_table`); default
+        :data:`NO_ROLLOUT`.
 
     Designs the cache does not hold are computed with a notice on stderr and
     their duration.
@@ -231,7 +294,8 @@ def lock_turn_table(six, u0: np.ndarray, offsets=(), airframe=None,
     seen = list(MEASURED) if measured else []
     meas = np.array([[seen.index(n) if n in seen else -1 for n in turn_states(side)]
                      for side in SIDES], dtype=np.int64)
-    pr = NO_PROBE if probe is None else probe
+    pr = dict(NO_PROBE if probe is None else probe)
+    pr.update(NO_ROLLOUT if rollout is None else rollout)
     off = np.asarray(offsets, dtype=float)
     if off.size == 0:
         z = np.zeros
@@ -313,6 +377,9 @@ def side_monitor(six, u_ff: np.ndarray, u_lower, u_upper, lon_out: np.ndarray,
     u_lower = np.asarray(u_lower, dtype=float)
     u_upper = np.asarray(u_upper, dtype=float)
     u0 = six.u0 - u_ff
+    ro = spec.turn_rollout
+    rollout = None if ro is None else rocking_table(
+        u_lower - u0, u_upper - u0, ro["steps"], ro["switches"], ro["sub"], ro["env"])
     return SideMonitor(
         on=1, A=c(A), B=c(B), C=c(C), u0=c(u0, dtype=np.float64),
         u_ff=c(u_ff, dtype=np.float64), lo=c(u_lower), hi=c(u_upper), P0=c(P0), Q=c(Q),
@@ -320,6 +387,6 @@ def side_monitor(six, u_ff: np.ndarray, u_lower, u_upper, lon_out: np.ndarray,
         threshold=float(spec.threshold), window=int(spec.window),
         min_window=int(spec.min_window), startup=int(spec.startup), snap=int(spec.snap),
         turn=lock_turn_table(six, u0, spec.turn_offsets, airframe, spec.turn_measured,
-                             spec.turn_probe),
+                             spec.turn_probe, rollout),
         nonlinear=EXTENDED if spec.extended else int(spec.nonlinear),
         states=c(states, dtype=np.int64), outs=outs, n_sub=int(spec.substeps), wind=c(W))

@@ -20,11 +20,35 @@ the gain ``K`` and the bias ``k`` of Theorem 4.1.
 **No steady flight.**  Where neither grid point bracketing ``p`` (the last
 two beyond the grid's end) has a steady flight of its own in the design box
 (``LockTurnTable.steady``: their designs are about the nearest lock that has
-one, with Theorem 4.1's bias), the throttle and the healthy elevon hold the
-6-DOF trim commands instead (``LockTurnTable.hold``): the oracle study
+one, with Theorem 4.1's bias), no linear law about a steady flight applies.
+There the throttle and the healthy elevon either hold the 6-DOF trim commands
+(``LockTurnTable.hold``; ``monitor.turn_beyond: hold``): the oracle study
 (``scripts/study_lock_turn.py``) found that holding them keeps such locks in
 the envelope longer than the biased designs (+3 deg from trim: 12.7 s against
-6.8 s; ``docs/airframes.md`` has the campaign's figures).
+6.8 s); or they fly the **rocking law** (``turn_beyond: rollout``,
+:func:`rocking_law`).
+
+**Rocking law** (a receding-horizon choice among bang-bang histories).  Each
+step, from the lane's state (the monitor's estimate on its rows, the law's
+fed-back states from their sensors where ``meas`` says so, the rest of the
+6-DOF trim), the airframe's equations (:func:`~ftc_mc.core.sixdof.plant.propagate`,
+``ro_sub`` RK4 sub-steps per period, still air, the named elevon at ``p``)
+fly each candidate command history for ``ro_steps`` periods.  A candidate
+holds one pair (throttle, healthy elevon) for its first ``ro_first`` periods
+and a second pair after (``ro_u``; a pair from the throttle's two limits and
+the healthy elevon's two limits and their midpoint: 6 held pairs and, per
+switch time, the 30 ordered pairs of two different ones).  The envelope's
+excess after each period is the largest of ``Va_min - Va``, ``Va - Va_max``
+[m/s], ``alpha_min - alpha``, ``alpha - alpha_max``, ``|phi| - phi_max``
+[deg] (``ro_env``; one m/s counts as one degree, as
+``scripts/study_recoverable.py`` counts it).  The candidate that stays inside
+longest wins; among those that stay equally long, the one whose largest
+excess before leaving is least (the widest margin); the first in the table
+on a tie.  Its first pair is sent, and the choice is made again at the next
+step.  With no steady flight the lock rolls the wing at about 2.8 deg/s per
+degree of offset; the histories that last swing it: roll with the lock while
+pitching up, then mirror the lock with the healthy elevon and dive back to
+wings level, trading height for time (``docs/airframes.md``).
 
 **Law** (:func:`lock_turn_law`), on ``x_hat``: the ten fed-back states (bank,
 pitch, body velocities and rates, the throttle and the healthy elevon), each
@@ -79,11 +103,12 @@ reads the turn as a thrust change; the monitor reads roll and pitch together
 (issue 26, item 2: the side decided by the direction's GLR).
 
 Plain-NumPy twins: ``tests/naive_sixdof.py::lock_turn_law_ref``,
-``turn_probe_ref``, ``side_blocks_ref``.
+``rocking_law_ref``, ``turn_probe_ref``, ``side_blocks_ref``.
 """
 
 from __future__ import annotations
 
+import math
 from collections import namedtuple
 
 import numpy as np
@@ -91,6 +116,8 @@ import numpy as np
 from ...conventions import LONGITUDINAL, NO_RESET
 from ..jit import kernel
 from ..shared.excitation import signal_3211, signal_3211_length
+from .layout import N_COMMAND, N_STATE, N_WIND, X_PHI, X_U, X_V, X_W
+from .plant import N_WORK, propagate
 
 LOCK_TURN = 2
 """``Reconfig.kind`` of a ``controller: lock_turn`` design (after 0 nominal and
@@ -120,6 +147,13 @@ LockTurnTable = namedtuple("LockTurnTable", [
     "check",   # steps after the law took over at which the hand-back is judged
     "hand_back",  # the lane hands back when the monitor's b1 of the named elevon is below,
     "hand_back_sd",  # by at least this many of its standard deviations
+    "ro_on",   # 1: the rocking law flies where no steady flight exists; 0: the trim is held
+    "ro_steps",  # periods each candidate history is flown
+    "ro_sub",  # RK4 sub-steps per period of those flights
+    "ro_first",  # (n_c,) int64: periods of each candidate's first pair
+    "ro_u",    # (2, n_c, 2, 2) per side and candidate, the first and the second pair
+               # (throttle, healthy elevon) less the longitudinal trim u0
+    "ro_env",  # (5,) envelope: Va min, max [m/s], alpha min, max [deg], |bank| max [deg]
 ])
 """The lock-turn designs of both sides over a grid of lock positions (module
 docstring); ``x`` of shape ``(2, 0, n_f)`` when no design flies it.  Built by
@@ -127,13 +161,16 @@ docstring); ``x`` of shape ``(2, 0, n_f)`` when no design flies it.  Built by
 
 
 @kernel(inline="always")
-def lock_turn_law(tab, s, p, mx, z, lat, l, lo_dev, hi_dev, u):
+def lock_turn_law(tab, pl, s, p, mx, z, lat, l, lo_dev, hi_dev, u):
     """Commands of lane ``l`` under the lock-turn law of side ``s`` (0 left,
     1 right) at the estimated lock position ``p`` [rad] (module docstring).
 
     Parameters
     ----------
     tab : LockTurnTable
+    pl : SixDofTruth
+        The airframe's equations (``p``, ``x0``, ``dt``) and the monitor
+        (``monitor.states``, ``monitor.u0``), for the rocking law.
     s : int
         Side: 0 left, 1 right.
     p : float
@@ -156,14 +193,85 @@ def lock_turn_law(tab, s, p, mx, z, lat, l, lo_dev, hi_dev, u):
     i = min(int(f), max(n - 2, 0))
     w = f - i
     j1 = min(i + 1, n - 1)
-    if tab.steady[s, i] == 0.0 and tab.steady[s, j1] == 0.0:  # hold the trim commands
-        for c in range(2):
-            a = tab.cmd[s, c]
-            u[a, l] = min(hi_dev[a], max(lo_dev[a], tab.hold[a]))
+    if tab.steady[s, i] == 0.0 and tab.steady[s, j1] == 0.0:  # no steady flight
+        if tab.ro_on != 0:
+            rocking_law(tab, pl, s, p, mx, z, lat, l, lo_dev, hi_dev, u)
+        else:  # hold the trim commands
+            for c in range(2):
+                a = tab.cmd[s, c]
+                u[a, l] = min(hi_dev[a], max(lo_dev[a], tab.hold[a]))
     else:
         turn_law(tab, s, i, j1, w, mx, z, lat, l, lo_dev, hi_dev, u)
     a = tab.locked[s]
     u[a, l] = min(hi_dev[a], max(lo_dev[a], tab.hold[a]))
+
+
+@kernel(internal=True)
+def rocking_law(tab, pl, s, p, mx, z, lat, l, lo_dev, hi_dev, u):
+    """The throttle and healthy elevon commands of lane ``l`` under the rocking
+    law (module docstring): the first pair of the candidate history that
+    the airframe's equations keep inside the envelope longest.  Arguments as
+    :func:`lock_turn_law`'s."""
+    mon = pl.monitor
+    x6 = np.empty(N_STATE)
+    for i in range(N_STATE):
+        x6[i] = pl.x0[i]
+    for i in range(mon.states.shape[0]):
+        x6[mon.states[i]] += mx[i, l]
+    nz = z.shape[0]
+    for r in range(tab.meas.shape[1]):
+        o = tab.meas[s, r]
+        if o >= 0:
+            j = mon.states[tab.rows[s, r]]
+            x6[j] = pl.x0[j] + (z[o, l] if o < nz else lat[o - nz, l])
+    xs = np.empty(N_STATE)
+    cmd = np.empty(N_COMMAND)
+    wd = np.zeros(N_WIND)
+    rk = np.empty((N_WORK, N_STATE))
+    a_thr = tab.cmd[s, 0]
+    a_free = tab.cmd[s, 1]
+    best = 0
+    best_k = -1
+    best_e = np.inf
+    for c in range(tab.ro_first.shape[0]):
+        for i in range(N_STATE):
+            xs[i] = x6[i]
+        cmd[tab.locked[s]] = p
+        k_out = tab.ro_steps
+        worst = -np.inf
+        for k in range(tab.ro_steps):
+            ph = 0 if k < tab.ro_first[c] else 1
+            cmd[a_thr] = mon.u0[a_thr] + tab.ro_u[s, c, ph, 0]
+            cmd[a_free] = mon.u0[a_free] + tab.ro_u[s, c, ph, 1]
+            propagate(xs, cmd, pl.p, wd, pl.dt, tab.ro_sub, rk)
+            e = envelope_excess(tab.ro_env, xs)
+            if e > 0.0:
+                k_out = k
+                break
+            worst = max(worst, e)
+        if k_out > best_k or (k_out == best_k and worst < best_e):
+            best = c
+            best_k = k_out
+            best_e = worst
+    u[a_thr, l] = min(hi_dev[a_thr], max(lo_dev[a_thr], tab.ro_u[s, best, 0, 0]))
+    u[a_free, l] = min(hi_dev[a_free], max(lo_dev[a_free], tab.ro_u[s, best, 0, 1]))
+
+
+@kernel(inline="always")
+def envelope_excess(env, x):
+    """The envelope's excess at the 6-DOF state ``x`` (absolute, still air):
+    the largest of ``env[0] - Va``, ``Va - env[1]`` [m/s], ``env[2] - alpha``,
+    ``alpha - env[3]``, ``|phi| - env[4]`` [deg]; ``inf`` where the state is
+    not finite."""
+    uu = x[X_U]
+    vv = x[X_V]
+    ww = x[X_W]
+    va = math.sqrt(uu * uu + vv * vv + ww * ww)
+    alpha = math.degrees(math.atan2(ww, uu))
+    bank = math.degrees(abs(x[X_PHI]))
+    if not (math.isfinite(va) and math.isfinite(alpha) and math.isfinite(bank)):
+        return np.inf
+    return max(env[0] - va, va - env[1], env[2] - alpha, alpha - env[3], bank - env[4])
 
 
 @kernel(inline="always")

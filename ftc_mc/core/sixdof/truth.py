@@ -236,7 +236,7 @@ def sixdof_truth(plant, scheme, flight, inp, k, st, work, rec):
             # the monitor's lock estimate holds the probe sent last step; the law
             # is scheduled on the position without it
             p = st.mpos[l] - (1.0 - b1) * turn_probe(turn, t - 1)
-            lock_turn_law(turn, st.mside[l] - 2, p, st.mx, work.z, st.lat, l,
+            lock_turn_law(turn, pl, st.mside[l] - 2, p, st.mx, work.z, st.lat, l,
                           ctl.lo_dev, ctl.hi_dev, u)
             v = u[named, l] + turn_probe(turn, t)
             u[named, l] = min(ctl.hi_dev[named], max(ctl.lo_dev[named], v))
