@@ -203,6 +203,15 @@ def campaign_configs() -> dict:
              "the lock-turn controller once the side monitor names the elevon), on the "
              "same trials; --dof 3 --design paper --design paper_nominal for the "
              "longitudinal plant", omit=six)
+    cfg = cfg.model_copy(update={"monitor": cfg.monitor.model_copy(
+        update={"turn_beyond": "rollout"})})
+    files["sixdof_rocking.yaml"] = render_yaml(
+        cfg, "ftc-mc run configs/sixdof_rocking.yaml -- configs/sixdof_survival.yaml's "
+             "trials with the rocking law (monitor.turn_beyond: rollout): where no steady "
+             "flight exists about the lock estimate, sixdof chooses every step, by flying "
+             "the airframe's equations 3 s ahead, among 66 bang-bang histories of the "
+             "throttle and the healthy elevon, instead of holding the trim commands "
+             "(issue 26; several times slower than sixdof_survival.yaml)", omit=six)
     designs = excitation_designs()
     cfg = Config.model_validate({
         "campaign": {"transitions": list(EXCITATION_ROWS), "signature": "swapped",
