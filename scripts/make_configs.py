@@ -209,7 +209,7 @@ def campaign_configs() -> dict:
         cfg, "ftc-mc run configs/sixdof_rocking.yaml -- configs/sixdof_survival.yaml's "
              "trials with the rocking law (monitor.turn_beyond: rollout): where no steady "
              "flight exists about the lock estimate, sixdof chooses every step, by flying "
-             "the airframe's equations 3 s ahead, among 66 bang-bang histories of the "
+             "the airframe's equations 3 s ahead, among 190 bang-bang histories of the "
              "throttle and the healthy elevon, instead of holding the trim commands "
              "(issue 26; several times slower than sixdof_survival.yaml)", omit=six)
     designs = excitation_designs()

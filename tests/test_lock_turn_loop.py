@@ -149,6 +149,33 @@ def rocking_setup(measured):
     return tab, pl, lo, hi
 
 
+@pytest.mark.parametrize("levels, switches", [(2, ()), (3, (2, 10)), (5, (2, 10)), (4, (3,))])
+def test_rocking_candidates(levels, switches):
+    """The rocking law's candidates: the throttle's two limits by ``levels``
+    elevon positions from limit to limit, each pair held, then per switch time
+    every ordered pair of two different pairs switching there; the same pairs
+    on both sides (each side's healthy elevon)."""
+    from ftc_mc.sim.monitor import rocking_table
+
+    lo, hi = np.array([-0.3, -0.5, -0.45]), np.array([0.7, 0.45, 0.5])
+    ro = rocking_table(lo, hi, 30, switches, 2, (12.0, 30.0, -8.0, 12.0, 60.0), levels)
+    n_p = 2 * levels
+    assert ro["ro_first"].shape == (n_p * (1 + len(switches) * (n_p - 1)),)
+    assert ro["ro_u"].shape == (2, len(ro["ro_first"]), 2, 2)
+    held = ro["ro_first"] == 30
+    assert held.sum() == n_p
+    for s, h in ((0, 2), (1, 1)):  # the left elevon locked flies the right one, and back
+        pairs = {tuple(p) for p in ro["ro_u"][s, held, 0]}
+        want = {(a, b) for a in (lo[0], hi[0]) for b in np.linspace(lo[h], hi[h], levels)}
+        assert pairs == want
+        first, second = ro["ro_u"][s, ~held, 0], ro["ro_u"][s, ~held, 1]
+        assert not (first == second).all(axis=1).any()
+        for k in switches:
+            at = ro["ro_first"][~held] == k
+            assert len({(tuple(a), tuple(b)) for a, b in zip(first[at], second[at])}) == \
+                n_p * (n_p - 1)
+
+
 @pytest.mark.parametrize("measured", [True, False])
 def test_rocking_law_matches_its_twin(measured):
     """Locks beyond the steady band either side, from trim and from rolled,

@@ -415,11 +415,13 @@ class MonitorConfig(_Strict):
     hand_back_sd: NonNeg = 2.0
     """Standard deviations of the monitor's b1 estimate (its covariance) by which b1 must lie below hand_back_b1 to hand back: in gusts the probe hardly moves b1, and its spread keeps a lock turning."""
     turn_beyond: Literal["hold", "rollout"] = "hold"
-    """What the lock-turn law flies where no steady flight exists about the lock estimate (beyond the steady band of the design box): ``hold``, the 6-DOF trim commands; ``rollout``, the rocking law, which every step flies the airframe's equations over rollout_horizon_s under each of 66 bang-bang histories of the throttle and the healthy elevon and sends the first command of the one that stays inside the validity envelope longest (``ftc_mc/core/sixdof/lockturn.py``; about 4,000 RK4 steps per lane and step while it flies)."""
+    """What the lock-turn law flies where no steady flight exists about the lock estimate (beyond the steady band of the design box): ``hold``, the 6-DOF trim commands; ``rollout``, the rocking law, which every step flies the airframe's equations over rollout_horizon_s under each of a set of bang-bang histories of the throttle and the healthy elevon (rollout_elevon_levels, rollout_switch_s) and sends the first command of the one that stays inside the validity envelope longest (``ftc_mc/core/sixdof/lockturn.py``; with the default 5 levels, 190 histories, about 11,400 RK4 steps per lane and step while it flies)."""
     rollout_horizon_s: Pos = 3.0
     """rollout: how far ahead each candidate history is flown [s] (a multiple of model.dt_s)."""
     rollout_switch_s: tuple[Pos, ...] = (0.2, 1.0)
-    """rollout: times at which a candidate history switches from its first (throttle, healthy elevon) pair to its second [s] (multiples of model.dt_s, below rollout_horizon_s); each adds 30 candidates to the 6 held pairs."""
+    """rollout: times at which a candidate history switches from its first (throttle, healthy elevon) pair to its second [s] (multiples of model.dt_s, below rollout_horizon_s); each adds 2 levels (2 levels - 1) candidates to the 2 levels held pairs (30 to 6 with 3 levels)."""
+    rollout_elevon_levels: Annotated[int, NoBool, Field(ge=2, le=9)] = 5
+    """rollout: positions of the healthy elevon in the candidates, evenly spaced from its lower to its upper limit (with the throttle's two limits, 2 x levels pairs: each held, and per switch time every ordered pair of two; 3 levels give 66 candidates, 5 give 190; on x8-pyfly 5 keep 38 of 312 locks from -20 to -10 deg in, where 3 keep 6, docs/airframes.md)."""
     rollout_substeps: Annotated[int, NoBool, Field(ge=1, le=100)] = 2
     """rollout: RK4 sub-steps per control period of those flights (the trials' truth uses 10; 2 keep the roll mode stable at dt = 0.1 s, h lambda = 1.9 inside RK4's 2.8)."""
 

@@ -102,7 +102,8 @@ class MonitorSpec:
     turn_rollout : dict or None
         The rocking law (``monitor.turn_beyond: rollout``): ``steps`` (its
         horizon), ``switches`` (the candidates' switch times) [periods],
-        ``sub`` (RK4 sub-steps per period) and ``env`` (the envelope: airspeed
+        ``sub`` (RK4 sub-steps per period), ``levels`` (the healthy elevon's
+        positions) and ``env`` (the envelope: airspeed
         [m/s], angle of attack and bank [deg], :func:`rocking_table`'s
         order); None: the trim is held (``hold``).
     """
@@ -177,7 +178,7 @@ def monitor_spec(cfg, fm, det, lock_turn: bool = False) -> MonitorSpec | None:
         turn_rollout=None if mc.turn_beyond == "hold" else dict(
             steps=cfg.steps(mc.rollout_horizon_s),
             switches=tuple(cfg.steps(t) for t in mc.rollout_switch_s),
-            sub=int(mc.rollout_substeps),
+            sub=int(mc.rollout_substeps), levels=int(mc.rollout_elevon_levels),
             env=(cfg.validity.airspeed_min_mps, cfg.validity.airspeed_max_mps,
                  cfg.validity.alpha_min_deg, cfg.validity.alpha_max_deg,
                  cfg.validity.bank_max_deg)))
@@ -209,15 +210,17 @@ def gust_block(six, spec: MonitorSpec, span: float):
             block_diag(lon.P0, lat.P0), W)
 
 
-def rocking_table(lo_dev, hi_dev, steps: int, switches, sub: int, env) -> dict:
+def rocking_table(lo_dev, hi_dev, steps: int, switches, sub: int, env,
+                  levels: int = 3) -> dict:
     """The ``LockTurnTable`` fields of the rocking law (``ro_*``; module
     docstring of :mod:`ftc_mc.core.sixdof.lockturn`).
 
-    The pairs (throttle, healthy elevon) are the throttle's two limits by the
-    healthy elevon's two limits and their midpoint (throttle-major); the
-    candidates are each pair held for the whole horizon, then, per switch
-    time in ``switches``, every ordered pair of two different pairs (first
-    pair-major).
+    The pairs (throttle, healthy elevon) are the throttle's two limits by
+    ``levels`` positions of the healthy elevon evenly spaced from its lower
+    to its upper limit (throttle-major); the candidates are each pair held
+    for the whole horizon, then, per switch time in ``switches``, every
+    ordered pair of two different pairs (first pair-major): ``2 levels (1 +
+    len(switches) (2 levels - 1))`` in all.
 
     Parameters
     ----------
@@ -231,6 +234,8 @@ def rocking_table(lo_dev, hi_dev, steps: int, switches, sub: int, env) -> dict:
         RK4 sub-steps per period.
     env : sequence of 5 float
         Airspeed min, max [m/s], angle of attack min, max [deg], largest bank [deg].
+    levels : int
+        Positions of the healthy elevon, at least 2 (its two limits).
     """
     from ..design.lock_turn import SIDES, healthy
 
@@ -239,7 +244,7 @@ def rocking_table(lo_dev, hi_dev, steps: int, switches, sub: int, env) -> dict:
     pairs = []
     for s, side in enumerate(SIDES):
         t, h = COMMAND["throttle"], COMMAND[healthy(side)]
-        pairs.append([(a, b) for a in (lo[t], hi[t]) for b in (lo[h], 0.5 * (lo[h] + hi[h]), hi[h])])
+        pairs.append([(a, b) for a in (lo[t], hi[t]) for b in np.linspace(lo[h], hi[h], levels)])
     n_p = len(pairs[0])
     order = [(i, i, steps) for i in range(n_p)]
     order += [(i, j, k) for k in switches for i in range(n_p) for j in range(n_p) if i != j]
@@ -379,7 +384,8 @@ def side_monitor(six, u_ff: np.ndarray, u_lower, u_upper, lon_out: np.ndarray,
     u0 = six.u0 - u_ff
     ro = spec.turn_rollout
     rollout = None if ro is None else rocking_table(
-        u_lower - u0, u_upper - u0, ro["steps"], ro["switches"], ro["sub"], ro["env"])
+        u_lower - u0, u_upper - u0, ro["steps"], ro["switches"], ro["sub"], ro["env"],
+        ro["levels"])
     return SideMonitor(
         on=1, A=c(A), B=c(B), C=c(C), u0=c(u0, dtype=np.float64),
         u_ff=c(u_ff, dtype=np.float64), lo=c(u_lower), hi=c(u_upper), P0=c(P0), Q=c(Q),

@@ -36,8 +36,9 @@ fed-back states from their sensors where ``meas`` says so, the rest of the
 fly each candidate command history for ``ro_steps`` periods.  A candidate
 holds one pair (throttle, healthy elevon) for its first ``ro_first`` periods
 and a second pair after (``ro_u``; a pair from the throttle's two limits and
-the healthy elevon's two limits and their midpoint: 6 held pairs and, per
-switch time, the 30 ordered pairs of two different ones).  The envelope's
+``monitor.rollout_elevon_levels`` positions of the healthy elevon from limit
+to limit: with 5, 10 held pairs and, per switch time, the 90 ordered pairs of
+two different ones).  The envelope's
 excess after each period is the largest of ``Va_min - Va``, ``Va - Va_max``
 [m/s], ``alpha_min - alpha``, ``alpha - alpha_max``, ``|phi| - phi_max``
 [deg] (``ro_env``; one m/s counts as one degree, as
