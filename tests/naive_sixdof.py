@@ -522,9 +522,11 @@ def rocking_law_ref(tab, pl, s, p, x, lo_dev, hi_dev):
     :func:`rk4_ref` (``ro_sub`` sub-steps, still air); the envelope's excess
     after each period, in m/s and degrees, from ``u, v, w`` and ``phi``; the
     candidate that stays in longest, then the one with the least largest
-    excess before it leaves, the first on a tie.  Returns the commands of
-    the throttle and the healthy elevon (2,) less the longitudinal trim
-    ``pl.monitor.u0``, and the chosen candidate's index."""
+    excess before it leaves, the first on a tie; the trim commands ``hold``
+    when every candidate leaves within the first period.  Returns the
+    commands of the throttle and the healthy elevon (2,) less the
+    longitudinal trim ``pl.monitor.u0``, and the chosen candidate's index
+    (-1: the trim held)."""
     env = tab.ro_env
     scores = []
     for c in range(len(tab.ro_first)):
@@ -545,6 +547,8 @@ def rocking_law_ref(tab, pl, s, p, x, lo_dev, hi_dev):
         out = next((k for k, e in enumerate(excess) if e > 0), tab.ro_steps)
         scores.append((out, -max(excess[:out], default=-np.inf)))
     best = max(range(len(scores)), key=lambda c: (scores[c], -c))
+    if scores[best][0] == 0:
+        return np.clip(tab.hold[tab.cmd[s]], lo_dev[tab.cmd[s]], hi_dev[tab.cmd[s]]), -1
     cmd = np.clip(tab.ro_u[s, best, 0], lo_dev[tab.cmd[s]], hi_dev[tab.cmd[s]])
     return cmd, best
 

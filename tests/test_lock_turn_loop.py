@@ -141,6 +141,7 @@ def rocking_setup(measured):
     u0 = six.u0 - np.array([0.0, 0.004, -0.002])  # a longitudinal trim beside the 6-DOF one
     lo, hi = six.u_lower - u0, six.u_upper - u0
     tab = build_empty_table(measured)._replace(
+        hold=six.u0 - u0,
         **rocking_table(lo, hi, 6, (1, 3), 2, (12.0, 30.0, -8.0, 12.0, 60.0)))
     Mon = namedtuple("Mon", ["states", "u0"])
     Pl = namedtuple("Pl", ["p", "x0", "dt", "monitor"])
@@ -181,7 +182,8 @@ def test_rocking_law_matches_its_twin(measured):
     """Locks beyond the steady band either side, from trim and from rolled,
     pitched and slowed states: the kernel sends the first pair of the
     candidate the twin chooses, and the choices differ (throttle and elevon,
-    held and switching) from state to state."""
+    held and switching) from state to state; from a state already outside
+    the envelope, or one not finite, both hold the trim commands."""
     from ftc_mc.core.sixdof.layout import MONITOR_STATES
     from ftc_mc.core.sixdof.lockturn import rocking_law
     from ftc_mc.sim.monitor import MEASURED
@@ -189,7 +191,7 @@ def test_rocking_law_matches_its_twin(measured):
     tab, pl, lo, hi = rocking_setup(measured)
     assert tab.ro_first.shape == (66,) and tab.ro_u.shape == (2, 66, 2, 2)
     rng = np.random.default_rng(26)
-    nm, L = len(MONITOR_STATES), 3
+    nm, L = len(MONITOR_STATES), 5
     index = {n: i for i, n in enumerate(MONITOR_STATES)}
     chosen = set()
     for s in (0, 1):
@@ -202,6 +204,13 @@ def test_rocking_law_matches_its_twin(measured):
             mx[:nm, 2] += rng.normal(0, 0.02, nm)
             z = rng.normal(0, 0.01, (12, L))
             lat = rng.normal(0, 0.01, (7, L))
+            # lane 3 already banked past the envelope, estimated and measured;
+            # lane 4 with a diverged estimate of an actuator (never measured)
+            mx[index["phi"], 3] = math.radians(75.0)
+            o = tab.meas[s, list(MONITOR_STATES[i] for i in tab.rows[s]).index("phi")]
+            if o >= 0:
+                (z if o < 12 else lat)[o if o < 12 else o - 12, 3] = math.radians(75.0)
+            mx[index["throttle"], 4] = np.nan
             u = np.zeros((3, L))
             for l in range(L):
                 rocking_law(tab, pl, s, p, mx, z, lat, l, lo, hi, u)
@@ -215,9 +224,29 @@ def test_rocking_law_matches_its_twin(measured):
                         assert MEASURED[o] == MONITOR_STATES[tab.rows[s, r]]
                 want, best = rocking_law_ref(tab, pl, s, p, x, lo, hi)
                 np.testing.assert_allclose(u[tab.cmd[s], l], want, rtol=0, atol=1e-15)
+                assert (best == -1) == (l >= 3), (s, off, l, best)
                 chosen.add(best)
+    chosen.discard(-1)
     assert len({tuple(tab.ro_u[0, c, 0]) for c in chosen}) >= 2, chosen
     assert any(tab.ro_first[c] < tab.ro_steps for c in chosen), chosen
+    # lock_turn_law flies it where neither design bracketing the estimate is
+    # steady (and the trim without it), the locked elevon at its trim command
+    designs = tab._replace(
+        lo=np.array([pl.monitor.u0[1], pl.monitor.u0[2]]) - 0.1, step=0.1,
+        x=np.zeros((2, 2, tab.rows.shape[1])), u=np.zeros((2, 2, 3)),
+        K=np.zeros((2, 2, 2, tab.rows.shape[1])), k=np.zeros((2, 2, 2)),
+        steady=np.zeros((2, 2)))
+    for on in (1, 0):
+        t = designs._replace(ro_on=on)
+        u, want = np.zeros((3, L)), np.zeros((3, L))
+        for l in range(L):
+            lock_turn_law(t, pl, 0, p, mx, z, lat, l, lo, hi, u)
+            if on:
+                rocking_law(t, pl, 0, p, mx, z, lat, l, lo, hi, want)
+            else:
+                want[tab.cmd[0], l] = tab.hold[tab.cmd[0]]
+            want[tab.locked[0], l] = tab.hold[tab.locked[0]]
+        np.testing.assert_array_equal(u, np.clip(want, lo[:, None], hi[:, None]))
 
 
 def build_empty_table(measured):
@@ -379,9 +408,15 @@ def test_the_probe_hands_a_loss_back_and_keeps_a_lock(tmp_path):
      "hand_back_after_s: must be at least the probe's length (1.4 s)"),
     ({"monitor": {"rollout_switch_s": [0.2, 3.0]}},
      "rollout_switch_s: each must be below rollout_horizon_s (3 s), got 3"),
-    ({"monitor": {"rollout_horizon_s": 3.05}},
+    ({"monitor": {"rollout_horizon_s": 3.05, "turn_beyond": "rollout"}},
      "monitor.rollout_horizon_s: must be a positive multiple of model.dt_s"),
     ({"monitor": {"turn_beyond": "rock"}}, "monitor.turn_beyond"),
+    ({"monitor": {"rollout_switch_s": [0.2, 0.2]}}, "rollout_switch_s: the times must differ"),
+    ({"monitor": {"rollout_switch_s": [0.25], "turn_beyond": "rollout"}},
+     "monitor.rollout_switch_s.0: must be a positive multiple of model.dt_s"),
+    ({"monitor": {"rollout_substeps": 1, "turn_beyond": "rollout"}},
+     "monitor.rollout_substeps: a sub-step of 0.1 s (model.dt_s / rollout_substeps) is "
+     "longer than 0.05 s, where RK4 flies the roll mode unstably; use at least 2"),
 ])
 def test_configs_that_cannot_fly_it_are_one_line(tmp_path, change, field):
     """A lock-turn design on the longitudinal plant or without the monitor, and
@@ -402,6 +437,17 @@ def test_configs_that_cannot_fly_it_are_one_line(tmp_path, change, field):
     assert field in r.output and "Traceback" not in r.output
     assert len(r.output.strip().splitlines()) == 1
     assert not out.exists()
+
+
+def test_rocking_fields_are_checked_only_when_it_flies():
+    """A config that holds the trim is not refused for the rocking law's
+    settings (a sub-step over 0.05 s, a switch time off the sampling grid)."""
+    cfg = flies_on_config(0.05)
+    cfg["monitor"].update(rollout_substeps=1, rollout_switch_s=[0.25])
+    api.campaign_config(cfg)
+    cfg["monitor"]["turn_beyond"] = "rollout"
+    with pytest.raises(Exception, match="monitor.rollout_switch_s.0"):
+        api.campaign_config(cfg)
 
 
 def test_designs_do_not_depend_on_the_blas_threads(tmp_path):

@@ -69,6 +69,25 @@ def _check_periods(dt: float, periods) -> None:
                              f"({dt:g} s), got {value:g}")
 
 
+ROLLOUT_MAX_SUBSTEP_S = 0.05
+"""Longest RK4 sub-step of the rocking law's flights [s]: x8-pyfly's roll mode,
+-38.5 1/s, gives h lambda = 1.9 there, inside RK4's stability bound of 2.8."""
+
+
+def _check_rollout(cfg) -> None:
+    """The rocking law's RK4 sub-step must be at most :data:`ROLLOUT_MAX_SUBSTEP_S`
+    (when ``monitor.turn_beyond`` is ``rollout``)."""
+    m = cfg.monitor
+    if m.turn_beyond != "rollout":
+        return
+    h = cfg.model.dt_s / m.rollout_substeps
+    if h > ROLLOUT_MAX_SUBSTEP_S * (1 + 1e-9):
+        need = math.ceil(cfg.model.dt_s / ROLLOUT_MAX_SUBSTEP_S - 1e-9)
+        raise ValueError(f"monitor.rollout_substeps: a sub-step of {h:g} s (model.dt_s / "
+                         f"rollout_substeps) is longer than {ROLLOUT_MAX_SUBSTEP_S:g} s, "
+                         f"where RK4 flies the roll mode unstably; use at least {need}")
+
+
 def _check_length(name: str, duration_s: float, dt: float) -> None:
     """A run of ``duration_s`` must take at most :data:`MAX_STEPS` steps."""
     n_steps = round(duration_s / dt)
@@ -78,7 +97,8 @@ def _check_length(name: str, duration_s: float, dt: float) -> None:
 
 def _shared_periods(cfg) -> list:
     """``(name, seconds)`` of the periods in the sections a campaign and a scenario
-    share (excitation, controller, validity, monitor)."""
+    share (excitation, controller, validity, monitor; the rocking law's only
+    when ``monitor.turn_beyond`` is ``rollout``)."""
     e = cfg.excitation
     m = cfg.monitor
     periods = [("excitation.doublet_half_period_s", e.doublet_half_period_s),
@@ -92,10 +112,11 @@ def _shared_periods(cfg) -> list:
                ("monitor.startup_s", m.startup_s),
                ("monitor.estimate_after_s", m.estimate_after_s),
                ("monitor.turn_probe_unit_s", m.turn_probe_unit_s),
-               ("monitor.hand_back_after_s", m.hand_back_after_s),
-               ("monitor.rollout_horizon_s", m.rollout_horizon_s)]
-    return periods + [(f"monitor.rollout_switch_s.{i}", t)
-                      for i, t in enumerate(m.rollout_switch_s)]
+               ("monitor.hand_back_after_s", m.hand_back_after_s)]
+    if m.turn_beyond != "rollout":
+        return periods
+    return periods + [("monitor.rollout_horizon_s", m.rollout_horizon_s)] + [
+        (f"monitor.rollout_switch_s.{i}", t) for i, t in enumerate(m.rollout_switch_s)]
 
 
 def _check_airframe_use(cfg) -> tuple:
@@ -415,15 +436,15 @@ class MonitorConfig(_Strict):
     hand_back_sd: NonNeg = 2.0
     """Standard deviations of the monitor's b1 estimate (its covariance) by which b1 must lie below hand_back_b1 to hand back: in gusts the probe hardly moves b1, and its spread keeps a lock turning."""
     turn_beyond: Literal["hold", "rollout"] = "hold"
-    """What the lock-turn law flies where no steady flight exists about the lock estimate (beyond the steady band of the design box): ``hold``, the 6-DOF trim commands; ``rollout``, the rocking law, which every step flies the airframe's equations over rollout_horizon_s under each of a set of bang-bang histories of the throttle and the healthy elevon (rollout_elevon_levels, rollout_switch_s) and sends the first command of the one that stays inside the validity envelope longest (``ftc_mc/core/sixdof/lockturn.py``; with the default 5 levels, 190 histories, about 11,400 RK4 steps per lane and step while it flies)."""
+    """What the lock-turn law flies where no steady flight exists about the lock estimate (beyond the steady band of the design box): ``hold``, the 6-DOF trim commands; ``rollout``, the rocking law, which every step flies the airframe's equations over rollout_horizon_s under each of a set of bang-bang histories of the throttle and the healthy elevon (rollout_elevon_levels, rollout_switch_s) and sends the first command of the one that stays inside the validity envelope longest (``ftc_mc/core/sixdof/lockturn.py``; with the default 5 levels, 190 histories, at most 11,400 RK4 steps per lane and step while it flies)."""
     rollout_horizon_s: Pos = 3.0
     """rollout: how far ahead each candidate history is flown [s] (a multiple of model.dt_s)."""
     rollout_switch_s: tuple[Pos, ...] = (0.2, 1.0)
-    """rollout: times at which a candidate history switches from its first (throttle, healthy elevon) pair to its second [s] (multiples of model.dt_s, below rollout_horizon_s); each adds 2 levels (2 levels - 1) candidates to the 2 levels held pairs (30 to 6 with 3 levels)."""
+    """rollout: times at which a candidate history switches from its first (throttle, healthy elevon) pair to its second [s] (distinct multiples of model.dt_s, below rollout_horizon_s; []: the held pairs only); each adds 2 levels (2 levels - 1) candidates to the 2 levels held pairs (30 to 6 with 3 levels)."""
     rollout_elevon_levels: Annotated[int, NoBool, Field(ge=2, le=9)] = 5
     """rollout: positions of the healthy elevon in the candidates, evenly spaced from its lower to its upper limit (with the throttle's two limits, 2 x levels pairs: each held, and per switch time every ordered pair of two; 3 levels give 66 candidates, 5 give 190; on x8-pyfly 5 keep 38 of 312 locks from -20 to -10 deg in, where 3 keep 6, docs/airframes.md)."""
     rollout_substeps: Annotated[int, NoBool, Field(ge=1, le=100)] = 2
-    """rollout: RK4 sub-steps per control period of those flights (the trials' truth uses 10; 2 keep the roll mode stable at dt = 0.1 s, h lambda = 1.9 inside RK4's 2.8)."""
+    """rollout: RK4 sub-steps per control period of those flights (the trials' truth uses 10); a sub-step (model.dt_s / rollout_substeps) must be at most 0.05 s: x8-pyfly's roll mode, -38.5 1/s, then gives h lambda = 1.9, inside RK4's 2.8."""
 
     @model_validator(mode="after")
     def _ordered(self):
@@ -433,6 +454,9 @@ class MonitorConfig(_Strict):
         if self.turn_probe_rad > 0 and self.hand_back_after_s < probe_s * (1 - 1e-9):
             raise ValueError(f"hand_back_after_s: must be at least the probe's length "
                              f"({probe_s:g} s), got {self.hand_back_after_s:g}")
+        if len(set(self.rollout_switch_s)) < len(self.rollout_switch_s):
+            raise ValueError(f"rollout_switch_s: the times must differ, got "
+                             f"{list(self.rollout_switch_s)}")
         late = [t for t in self.rollout_switch_s if not t < self.rollout_horizon_s]
         if late:
             raise ValueError(f"rollout_switch_s: each must be below rollout_horizon_s "
@@ -794,6 +818,7 @@ class Config(_Sampled):
                             ("timing.reconfiguration_period_s",
                              t.reconfiguration_period_s),
                             *_shared_periods(self)])
+        _check_rollout(self)
         if self.controller.horizon_s > t.duration_s:
             raise ValueError("controller.horizon_s: must not exceed timing.duration_s "
                              f"({t.duration_s:g} s), got {self.controller.horizon_s:g}")
@@ -971,5 +996,6 @@ class ScenarioConfig(_Sampled):
                                  f"scenario.duration_s ({sc.duration_s:g} s), got "
                                  f"{sf.time_s:g}")
         _check_periods(dt, _shared_periods(self))
+        _check_rollout(self)
         _check_length("scenario.duration_s", sc.duration_s, dt)
         return self

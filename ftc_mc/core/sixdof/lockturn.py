@@ -46,7 +46,8 @@ excess after each period is the largest of ``Va_min - Va``, ``Va - Va_max``
 longest wins; among those that stay equally long, the one whose largest
 excess before leaving is least (the widest margin); the first in the table
 on a tie.  Its first pair is sent, and the choice is made again at the next
-step.  With no steady flight the lock rolls the wing at about 2.8 deg/s per
+step.  When every candidate leaves within the first period (or the state is
+not finite), the trim commands are held, as without the law.  With no steady flight the lock rolls the wing at about 2.8 deg/s per
 degree of offset; the histories that last swing it: roll with the lock while
 pitching up, then mirror the lock with the healthy elevon and dive back to
 wings level, trading height for time (``docs/airframes.md``).
@@ -142,7 +143,8 @@ LockTurnTable = namedtuple("LockTurnTable", [
     "locked",  # (2,) int64: command index of the locked elevon
     "steady",  # (2, n) 1.0: the lock has its own steady flight in the design box; 0.0: not
     "hold",    # (3,) the 6-DOF trim commands less u0: the locked elevon's command, and
-               # the others' where neither lock bracketing the estimate is steady
+               # the others' where neither lock bracketing the estimate is steady (unless
+               # the rocking law flies there and a history stays in for a period)
     "probe",   # amplitude of the 3211 on the named elevon [rad]; 0.0: no probe, no hand-back
     "probe_unit",  # steps of one unit of that 3211
     "check",   # steps after the law took over at which the hand-back is judged
@@ -254,6 +256,11 @@ def rocking_law(tab, pl, s, p, mx, z, lat, l, lo_dev, hi_dev, u):
             best = c
             best_k = k_out
             best_e = worst
+    if best_k == 0:  # every history leaves within a period (or the state is not finite)
+        for c in range(2):
+            a = tab.cmd[s, c]
+            u[a, l] = min(hi_dev[a], max(lo_dev[a], tab.hold[a]))
+        return
     u[a_thr, l] = min(hi_dev[a_thr], max(lo_dev[a_thr], tab.ro_u[s, best, 0, 0]))
     u[a_free, l] = min(hi_dev[a_free], max(lo_dev[a_free], tab.ro_u[s, best, 0, 1]))
 
