@@ -211,7 +211,7 @@ def campaign_configs() -> dict:
              "flight exists about the lock estimate, sixdof chooses every step, by flying "
              "the airframe's equations 3 s ahead, among 190 bang-bang histories of the "
              "throttle and the healthy elevon, instead of holding the trim commands "
-             "(issue 26; 16 times as long as sixdof_survival.yaml on 2 cores)", omit=six)
+             "(issue 26; 16-18 times as long as sixdof_survival.yaml on 2 cores)", omit=six)
     designs = excitation_designs()
     cfg = Config.model_validate({
         "campaign": {"transitions": list(EXCITATION_ROWS), "signature": "swapped",
