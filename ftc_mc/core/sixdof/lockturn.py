@@ -38,19 +38,20 @@ holds one pair (throttle, healthy elevon) for its first ``ro_first`` periods
 and a second pair after (``ro_u``; a pair from the throttle's two limits and
 ``monitor.rollout_elevon_levels`` positions of the healthy elevon from limit
 to limit: with 5, 10 held pairs and, per switch time, the 90 ordered pairs of
-two different ones).  The envelope's
-excess after each period is the largest of ``Va_min - Va``, ``Va - Va_max``
-[m/s], ``alpha_min - alpha``, ``alpha - alpha_max``, ``|phi| - phi_max``
-[deg] (``ro_env``; one m/s counts as one degree, as
-``scripts/study_recoverable.py`` counts it).  The candidate that stays inside
+two different ones).  The envelope's excess after each period is the
+largest of ``Va_min - Va``, ``Va - Va_max`` [m/s], ``alpha_min - alpha``,
+``alpha - alpha_max``, ``|phi| - phi_max`` [deg] (``ro_env``; one m/s counts
+as one degree, as ``scripts/study_recoverable.py`` counts it).  The
+candidate that stays inside
 longest wins; among those that stay equally long, the one whose largest
 excess before leaving is least (the widest margin); the first in the table
 on a tie.  Its first pair is sent, and the choice is made again at the next
 step.  When every candidate leaves within the first period (or the state is
-not finite), the trim commands are held, as without the law.  With no steady flight the lock rolls the wing at about 2.8 deg/s per
-degree of offset; the histories that last swing it: roll with the lock while
-pitching up, then mirror the lock with the healthy elevon and dive back to
-wings level, trading height for time (``docs/airframes.md``).
+not finite), the trim commands are held, as without the law.  With no steady
+flight the lock rolls the wing at about 2.8 deg/s per degree of offset; the
+histories that last swing it: roll with the lock while pitching up, then
+mirror the lock with the healthy elevon and dive back to wings level, trading
+height for time (``docs/airframes.md``).
 
 **Law** (:func:`lock_turn_law`), on ``x_hat``: the ten fed-back states (bank,
 pitch, body velocities and rates, the throttle and the healthy elevon), each
