@@ -120,6 +120,7 @@ from ...conventions import LONGITUDINAL, NO_RESET
 from ..jit import kernel
 from ..shared.excitation import signal_3211, signal_3211_length
 from .layout import N_COMMAND, N_STATE, N_WIND, X_PHI, X_U, X_V, X_W
+from .monitor import on_trim
 from .plant import N_WORK, propagate
 
 LOCK_TURN = 2
@@ -198,10 +199,9 @@ def lock_turn_law(tab, pl, s, p, mx, z, lat, l, lo_dev, hi_dev, u):
     w = f - i
     j1 = min(i + 1, n - 1)
     if tab.steady[s, i] == 0.0 and tab.steady[s, j1] == 0.0:  # no steady flight
-        if tab.ro_on != 0:
-            rocking_law(tab, pl, s, p, mx, z, lat, l, lo_dev, hi_dev, u)
-        else:  # hold the trim commands
-            for c in range(2):
+        if tab.ro_on == 0 or not rocking_law(tab, pl, s, p, mx, z, lat, l, lo_dev, hi_dev,
+                                             u):
+            for c in range(2):  # hold the trim commands
                 a = tab.cmd[s, c]
                 u[a, l] = min(hi_dev[a], max(lo_dev[a], tab.hold[a]))
     else:
@@ -215,13 +215,11 @@ def rocking_law(tab, pl, s, p, mx, z, lat, l, lo_dev, hi_dev, u):
     """The throttle and healthy elevon commands of lane ``l`` under the rocking
     law (module docstring): the first pair of the candidate history that
     the airframe's equations keep inside the envelope longest.  Arguments as
-    :func:`lock_turn_law`'s."""
+    :func:`lock_turn_law`'s.  Returns False, writing nothing, when every
+    candidate leaves within the first period (or the state is not finite)."""
     mon = pl.monitor
     x6 = np.empty(N_STATE)
-    for i in range(N_STATE):
-        x6[i] = pl.x0[i]
-    for i in range(mon.states.shape[0]):
-        x6[mon.states[i]] += mx[i, l]
+    on_trim(mon, pl, mx[:, l], x6)
     nz = z.shape[0]
     for r in range(tab.meas.shape[1]):
         o = tab.meas[s, r]
@@ -258,12 +256,10 @@ def rocking_law(tab, pl, s, p, mx, z, lat, l, lo_dev, hi_dev, u):
             best_k = k_out
             best_e = worst
     if best_k == 0:  # every history leaves within a period (or the state is not finite)
-        for c in range(2):
-            a = tab.cmd[s, c]
-            u[a, l] = min(hi_dev[a], max(lo_dev[a], tab.hold[a]))
-        return
+        return False
     u[a_thr, l] = min(hi_dev[a_thr], max(lo_dev[a_thr], tab.ro_u[s, best, 0, 0]))
     u[a_free, l] = min(hi_dev[a_free], max(lo_dev[a_free], tab.ro_u[s, best, 0, 1]))
+    return True
 
 
 @kernel(inline="always")
