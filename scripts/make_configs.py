@@ -212,6 +212,16 @@ def campaign_configs() -> dict:
              "the airframe's equations 3 s ahead, among 190 bang-bang histories of the "
              "throttle and the healthy elevon, instead of holding the trim commands "
              "(issue 26; 16-18 times as long as sixdof_survival.yaml on 2 cores)", omit=six)
+    cfg = cfg.model_copy(update={"monitor": cfg.monitor.model_copy(
+        update={"turn_beyond": "guarded", "turn_offsets_deg": (-20.0, 4.0)})})
+    files["sixdof_guarded.yaml"] = render_yaml(
+        cfg, "ftc-mc run configs/sixdof_guarded.yaml -- configs/sixdof_rocking.yaml's "
+             "trials with the rollout guard (monitor.turn_beyond: guarded): locks whose "
+             "steady flights lie outside the design box but inside the envelope (x8-pyfly: "
+             "about -29 to -10 deg of trim) fly an LQR about their own, every lock-turn LQR "
+             "flies under a guard that flies it 3 s ahead and, where it would leave the "
+             "envelope, holds a throttle and elevon pair first; the rocking law beyond "
+             "(issue 26)", omit=six)
     designs = excitation_designs()
     cfg = Config.model_validate({
         "campaign": {"transitions": list(EXCITATION_ROWS), "signature": "swapped",

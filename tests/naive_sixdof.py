@@ -553,6 +553,59 @@ def rocking_law_ref(tab, pl, s, p, x, lo_dev, hi_dev):
     return cmd, best
 
 
+def guarded_law_ref(tab, pl, s, p, x, lo_dev, hi_dev):
+    """The rollout guard on the lock-turn LQR of one lane
+    (``ftc_mc/core/sixdof/lockturn.py``), written from that module's
+    docstring: the LQR of :func:`lock_turn_law_ref` (at ``p``), its fed-back
+    states read from the flown absolute state by name (:func:`turn_states`
+    less the 6-DOF trim ``pl.x0``), flies ``ro_steps`` periods of
+    :func:`rk4_ref` from ``x`` (15,), the named elevon at ``p``; if that stays
+    in the envelope the LQR flies.  Else each candidate (one of the first
+    ``gd_pairs`` held pairs of ``ro_u`` for ``gd_holds`` periods, then the
+    LQR) flies too; the longest stay, then the least largest excess, wins,
+    the LQR's own flight first and the candidates pair-major on a tie.
+    Returns ``None`` when the LQR flies, else the winning pair's commands
+    (2,) less ``pl.monitor.u0`` and ``(pair, hold)``."""
+    from ftc_mc.design.lock_turn import SIDES, turn_states
+
+    idx = [LAYOUT.states.index(n) for n in turn_states(SIDES[s])]
+    env = tab.ro_env
+
+    def lqr(xs):
+        full = lock_turn_law_ref(tab, s, p, xs[idx] - pl.x0[idx], lo_dev, hi_dev)
+        return full[tab.cmd[s]]
+
+    def fly(pair, hold):
+        xs = np.array(x, dtype=float)
+        excess = []
+        for k in range(tab.ro_steps):
+            cmd = np.zeros(3)
+            cmd[tab.cmd[s]] = pl.monitor.u0[tab.cmd[s]] + (pair if k < hold else lqr(xs))
+            cmd[tab.locked[s]] = p
+            xs = rk4_ref(xs, cmd, pl.p, np.zeros(6), pl.dt, tab.ro_sub)
+            u, v, w = (xs[LAYOUT.states.index(n)] for n in ("u", "v", "w"))
+            va = np.sqrt(u * u + v * v + w * w)
+            alpha = np.degrees(np.arctan2(w, u))
+            bank = np.degrees(abs(xs[LAYOUT.states.index("phi")]))
+            e = max(env[0] - va, va - env[1], env[2] - alpha, alpha - env[3], bank - env[4])
+            excess.append(e if np.isfinite([va, alpha, bank]).all() else np.inf)
+        out = next((k for k, e in enumerate(excess) if e > 0), tab.ro_steps)
+        return out, -max(excess[:out], default=-np.inf)
+
+    own = fly(None, 0)
+    if own[0] == tab.ro_steps:
+        return None
+    scores = [(own, None)]
+    for c in range(tab.gd_pairs):
+        for h in tab.gd_holds:
+            scores.append((fly(tab.ro_u[s, c, 0], h), (c, int(h))))
+    best = max(range(len(scores)), key=lambda i: (scores[i][0], -i))
+    if scores[best][1] is None:
+        return None
+    c, h = scores[best][1]
+    return np.clip(tab.ro_u[s, c, 0], lo_dev[tab.cmd[s]], hi_dev[tab.cmd[s]]), (c, h)
+
+
 def side_blocks_ref(kind, mside, mlast, block):
     """Twin of ``core/sixdof/lockturn.side_blocks``, from its docstring: in a
     ``lock_turn`` design (``kind`` 2) each lane's Table 1 reset (``block`` 1

@@ -18,7 +18,8 @@ from ftc_mc.model.presets import PRESETS
 from ftc_mc.sim.monitor import MEASURED, lock_turn_table
 from ftc_mc.sim.setup import CONTROLLER_KINDS, build_setup
 
-from naive_sixdof import lock_turn_law_ref, rocking_law_ref, side_blocks_ref, turn_probe_ref
+from naive_sixdof import (guarded_law_ref, lock_turn_law_ref, rocking_law_ref, side_blocks_ref,
+                          turn_probe_ref)
 
 AF = PRESETS["x8-pyfly"].airframe
 
@@ -254,6 +255,75 @@ def test_rocking_law_matches_its_twin(measured):
         np.testing.assert_array_equal(u, np.clip(want, lo[:, None], hi[:, None]))
 
 
+@pytest.mark.parametrize("measured", [True, False])
+def test_guarded_law_matches_its_twin(measured):
+    """The rollout guard on designs about steady flights (random gains and
+    design states near trim, guard candidates holding for 1 and 3 periods of
+    a 0.6 s horizon): from trim, rolled either way, slowed, and past the
+    envelope, the kernel leaves the LQR to fly exactly where the twin does,
+    sends the twin's pair elsewhere, and ``lock_turn_law`` sends one or the
+    other; both branches and more than one hold are taken."""
+    from ftc_mc.core.sixdof.layout import MONITOR_STATES
+    from ftc_mc.core.sixdof.lockturn import guarded_law
+    from ftc_mc.sim.monitor import rocking_table
+
+    tab, pl, lo, hi = rocking_setup(measured)
+    tab = tab._replace(**{k: v for k, v in rocking_table(
+        lo, hi, 6, (1, 3), 2, (12.0, 30.0, -8.0, 12.0, 60.0), 3, holds=(1, 3)).items()
+        if k.startswith("gd_")})
+    assert tab.gd_on == 1 and tab.gd_pairs == 6 and list(tab.gd_holds) == [1, 3]
+    rng = np.random.default_rng(27)
+    nf, n = tab.rows.shape[1], 3
+    nm, L = len(MONITOR_STATES), 6
+    index = {k: i for i, k in enumerate(MONITOR_STATES)}
+    hold_dev = np.broadcast_to(tab.hold, (2, n, 3))
+    flew, held, holds = 0, 0, set()
+    for s in (0, 1):
+        t = tab._replace(lo=pl.monitor.u0[1:] - math.radians(16.0), step=math.radians(2.0), x=rng.normal(0, 0.01, (2, n, nf)),
+                         u=hold_dev + rng.normal(0, 0.01, (2, n, 3)),
+                         K=rng.normal(0, 0.05, (2, n, 2, nf)), k=np.zeros((2, n, 2)),
+                         steady=np.ones((2, n)))
+        for off in (-14.5, -12.0):
+            p = pl.monitor.u0[1 + s] + math.radians(off)
+            mx = np.zeros((nm + 6, L))
+            mx[index["phi"], 1] = math.radians(50.0)
+            mx[index["phi"], 2] = math.radians(-50.0)
+            mx[index["u"], 3] = -6.0
+            mx[index["phi"], 4] = math.radians(75.0)
+            mx[:nm, 5] += rng.normal(0, 0.02, nm)
+            z = np.zeros((12, L))
+            lat = np.zeros((7, L))
+            for r, o in enumerate(t.meas[s]):  # the sensors read the estimate's states
+                if o >= 0:
+                    (z if o < 12 else lat)[o if o < 12 else o - 12] = mx[t.rows[s, r]]
+            u = np.zeros((3, L))
+            law = np.zeros((3, L))
+            for l in range(L):
+                f = min(n - 1.0, (p - t.lo[s]) / t.step)  # lock_turn_law's bracket
+                i = min(int(f), n - 2)
+                ran = guarded_law(t, pl, s, i, i + 1, f - i, p, mx, z, lat, l, lo, hi, u)
+                x = pl.x0.copy()
+                x[pl.monitor.states] += mx[:nm, l]
+                ref = guarded_law_ref(t, pl, s, p, x, lo, hi)
+                lock_turn_law(t, pl, s, p, mx, z, lat, l, lo, hi, law)
+                if ref is None:
+                    assert not ran, (s, off, l)
+                    np.testing.assert_array_equal(u[:, l], 0.0)
+                    xhat = x[[pl.monitor.states[r] for r in t.rows[s]]] - \
+                        pl.x0[[pl.monitor.states[r] for r in t.rows[s]]]
+                    np.testing.assert_allclose(law[:, l], lock_turn_law_ref(t, s, p, xhat, lo, hi),
+                                               rtol=1e-12, atol=1e-14)
+                    held += 1
+                else:
+                    assert ran, (s, off, l)
+                    np.testing.assert_allclose(u[t.cmd[s], l], ref[0], rtol=0, atol=1e-15)
+                    np.testing.assert_array_equal(law[t.cmd[s], l], u[t.cmd[s], l])
+                    flew += 1
+                    holds.add(ref[1][1])
+    assert flew > 0 and held > 0, (flew, held)
+    assert len(holds) >= 1
+
+
 def build_empty_table(measured):
     """A table with no designs (its index maps only) on the default 6-DOF model."""
     from ftc_mc.model.sixdof import build_sixdof_plant
@@ -366,6 +436,37 @@ def test_the_rocking_law_outlasts_the_held_trim(tmp_path):
     assert (rock["status"] == "ok").all(), rock[["status", "stop_s"]]
 
 
+def test_the_guard_flies_locks_the_design_box_cannot(tmp_path):
+    """Locks 11.5-13 deg below trim have steady turns in the envelope (at up
+    to 50 deg of bank and 13-14 m/s) but none in the design box: with the
+    trim held (``turn_beyond: hold``) every trial leaves the envelope within
+    5 s of the lock; with the guard (``guarded``), which designs about those
+    turns and flies the LQR under its rollouts, every one of the same trials
+    stays inside for the 30 s flown (docs/airframes.md has the campaign)."""
+    trim = float(build_setup(api.campaign_config(
+        {"plant": {"kind": "linear", "dof": 6}})).truth.u0[1])
+    out = {}
+    for beyond in ("hold", "guarded"):
+        cfg = flies_on_config(trim)
+        cfg["campaign"].update(transitions=["elevon_lock", "right_elevon_lock"], trials=2,
+                               chunk_size=2, signature="none")
+        cfg["draws"] = {"elevon_lock_range_rad": [trim + math.radians(-13.0),
+                                                  trim + math.radians(-11.5)]}
+        cfg["timing"]["duration_s"] = 35.0
+        # the table reaches the trim side too: the monitor's first lock
+        # estimates lie there (with it cut at -4 deg, a right lock at -12.5
+        # deg left after 3.8 s)
+        cfg["monitor"].update(turn_beyond=beyond, turn_offsets_deg=[-14.0, 4.0])
+        t = api.run_campaign(cfg, jobs=1, progress=False, out=tmp_path / beyond).trials
+        out[beyond] = t.set_index(["transition", "trial_id"])
+    hold, guard = out["hold"], out["guarded"]
+    assert (hold["lock_position"] == guard["lock_position"]).all()
+    assert (guard["side_correct"] == 1).all()
+    assert (hold["status"] != "ok").all(), hold["status"].value_counts()
+    assert (hold["stop_s"] < 5.0 + 5.0).all(), hold["stop_s"]
+    assert (guard["status"] == "ok").all(), guard[["status", "stop_s"]]
+
+
 def probe_config(probe_rad):
     """Nonlinear 6-DOF, still air: left-elevon losses of 10-40 % at 5 s (which
     the monitor names like locks) and locks within 1 deg of trim, 30 s flown."""
@@ -422,6 +523,18 @@ def test_the_probe_hands_a_loss_back_and_keeps_a_lock(tmp_path):
     ({"monitor": {"rollout_substeps": 1, "turn_beyond": "rollout"}},
      "monitor.rollout_substeps: a sub-step of 0.1 s (model.dt_s / rollout_substeps) is "
      "longer than 0.05 s, where RK4 flies the roll mode unstably; use at least 2"),
+    ({"monitor": {"rollout_substeps": 1, "turn_beyond": "guarded"}},
+     "monitor.rollout_substeps: a sub-step of 0.1 s"),
+    ({"monitor": {"turn_beyond": "guarded", "rollout_guard_holds_s": []}},
+     "rollout_guard_holds_s: the guard needs at least one time"),
+    ({"monitor": {"turn_beyond": "guarded", "rollout_guard_holds_s": [0.5, 0.5]}},
+     "rollout_guard_holds_s: the times must differ"),
+    ({"monitor": {"turn_beyond": "guarded", "rollout_guard_holds_s": [0.2, 3.0]}},
+     "rollout_guard_holds_s: each must be below rollout_horizon_s (3 s), got 3"),
+    ({"monitor": {"turn_beyond": "guarded", "rollout_guard_holds_s": [0.25]}},
+     "monitor.rollout_guard_holds_s.0: must be a positive multiple of model.dt_s"),
+    ({"monitor": {"rollout_guard_bank_margin_deg": 0.1}},
+     "monitor.rollout_guard_bank_margin_deg"),
 ])
 def test_configs_that_cannot_fly_it_are_one_line(tmp_path, change, field):
     """A lock-turn design on the longitudinal plant or without the monitor, and
@@ -446,12 +559,19 @@ def test_configs_that_cannot_fly_it_are_one_line(tmp_path, change, field):
 
 def test_rocking_fields_are_checked_only_when_it_flies():
     """A config that holds the trim is not refused for the rocking law's
-    settings (a sub-step over 0.05 s, a switch time off the sampling grid)."""
+    settings (a sub-step over 0.05 s, a switch time off the sampling grid),
+    nor one that rocks for the guard's."""
     cfg = flies_on_config(0.05)
-    cfg["monitor"].update(rollout_substeps=1, rollout_switch_s=[0.25])
+    cfg["monitor"].update(rollout_substeps=1, rollout_switch_s=[0.25],
+                          rollout_guard_holds_s=[0.25, 0.25])
     api.campaign_config(cfg)
     cfg["monitor"]["turn_beyond"] = "rollout"
     with pytest.raises(Exception, match="monitor.rollout_switch_s.0"):
+        api.campaign_config(cfg)
+    cfg["monitor"].update(rollout_switch_s=[0.2], rollout_substeps=2)
+    api.campaign_config(cfg)  # the guard's holds are read only when it flies
+    cfg["monitor"]["turn_beyond"] = "guarded"
+    with pytest.raises(Exception, match="rollout_guard_holds_s: the times must differ"):
         api.campaign_config(cfg)
 
 

@@ -76,9 +76,9 @@ ROLLOUT_MAX_SUBSTEP_S = 0.05
 
 def _check_rollout(cfg) -> None:
     """The rocking law's RK4 sub-step must be at most :data:`ROLLOUT_MAX_SUBSTEP_S`
-    (when ``monitor.turn_beyond`` is ``rollout``)."""
+    (when ``monitor.turn_beyond`` is ``rollout`` or ``guarded``)."""
     m = cfg.monitor
-    if m.turn_beyond != "rollout":
+    if m.turn_beyond == "hold":
         return
     h = cfg.model.dt_s / m.rollout_substeps
     if h > ROLLOUT_MAX_SUBSTEP_S * (1 + 1e-9):
@@ -98,7 +98,8 @@ def _check_length(name: str, duration_s: float, dt: float) -> None:
 def _shared_periods(cfg) -> list:
     """``(name, seconds)`` of the periods in the sections a campaign and a scenario
     share (excitation, controller, validity, monitor; the rocking law's only
-    when ``monitor.turn_beyond`` is ``rollout``)."""
+    when ``monitor.turn_beyond`` is ``rollout`` or ``guarded``, the guard's
+    only when it is ``guarded``)."""
     e = cfg.excitation
     m = cfg.monitor
     periods = [("excitation.doublet_half_period_s", e.doublet_half_period_s),
@@ -113,10 +114,14 @@ def _shared_periods(cfg) -> list:
                ("monitor.estimate_after_s", m.estimate_after_s),
                ("monitor.turn_probe_unit_s", m.turn_probe_unit_s),
                ("monitor.hand_back_after_s", m.hand_back_after_s)]
-    if m.turn_beyond != "rollout":
+    if m.turn_beyond == "hold":
         return periods
-    return periods + [("monitor.rollout_horizon_s", m.rollout_horizon_s)] + [
+    periods = periods + [("monitor.rollout_horizon_s", m.rollout_horizon_s)] + [
         (f"monitor.rollout_switch_s.{i}", t) for i, t in enumerate(m.rollout_switch_s)]
+    if m.turn_beyond != "guarded":
+        return periods
+    return periods + [(f"monitor.rollout_guard_holds_s.{i}", t)
+                      for i, t in enumerate(m.rollout_guard_holds_s)]
 
 
 def _check_airframe_use(cfg) -> tuple:
@@ -435,14 +440,18 @@ class MonitorConfig(_Strict):
     """A probed lane whose monitor then estimates the named elevon's b1 (the share of its effectiveness lost) below this hands back: it flies the paper's reconfiguring loop and lateral autopilot again for the rest of the flight."""
     hand_back_sd: NonNeg = 2.0
     """Standard deviations of the monitor's b1 estimate (its covariance) by which b1 must lie below hand_back_b1 to hand back: in gusts the probe hardly moves b1, and its spread keeps a lock turning."""
-    turn_beyond: Literal["hold", "rollout"] = "hold"
-    """What the lock-turn law flies where no steady flight exists about the lock estimate (beyond the steady band of the design box): ``hold``, the 6-DOF trim commands; ``rollout``, the rocking law, which every step flies the airframe's equations over rollout_horizon_s under each of a set of bang-bang histories of the throttle and the healthy elevon (rollout_elevon_levels, rollout_switch_s) and sends the first command of the one that stays inside the validity envelope longest (``ftc_mc/core/sixdof/lockturn.py``; with the default 5 levels, 190 histories, at most 11,400 RK4 steps per lane and step while it flies). It flies only where the table's two designs about the estimate (its last two beyond its ends) have no steady flight, so turn_offsets_deg must reach past the airframe's steady band (x8-gryte2018: [-20, 10])."""
+    turn_beyond: Literal["hold", "rollout", "guarded"] = "hold"
+    """What the lock-turn law flies where no steady flight exists about the lock estimate (beyond the steady band of the design box): ``hold``, the 6-DOF trim commands; ``guarded``, first a design about the lock's own steady flight in the validity envelope less 0.5 of each bound and rollout_guard_bank_margin_deg of bank, where it has one (on x8-pyfly, locks from -15 to -11 deg of trim: turns at 50 deg of bank and 12.5-14.7 m/s; the table needs turn_offsets_deg to reach there, e.g. [-20, 4]), and every LQR of the table flown under a rollout guard: each step the airframe's equations fly the LQR over rollout_horizon_s, and if it leaves the envelope, candidates that hold a (throttle, healthy elevon) pair for rollout_guard_holds_s and then fly the LQR are flown too, and the best one's first command is sent; beyond the wide box, as rollout; ``rollout``, the rocking law, which every step flies the airframe's equations over rollout_horizon_s under each of a set of bang-bang histories of the throttle and the healthy elevon (rollout_elevon_levels, rollout_switch_s) and sends the first command of the one that stays inside the validity envelope longest (``ftc_mc/core/sixdof/lockturn.py``; with the default 5 levels, 190 histories, at most 11,400 RK4 steps per lane and step while it flies). It flies only where the table's two designs about the estimate (its last two beyond its ends) have no steady flight, so turn_offsets_deg must reach past the airframe's steady band (x8-gryte2018: [-20, 10])."""
     rollout_horizon_s: Pos = 3.0
     """rollout: how far ahead each candidate history is flown [s] (a multiple of model.dt_s)."""
     rollout_switch_s: tuple[Pos, ...] = (0.2, 1.0)
     """rollout: times at which a candidate history switches from its first (throttle, healthy elevon) pair to its second [s] (distinct multiples of model.dt_s, below rollout_horizon_s; []: the held pairs only); each adds 2 levels (2 levels - 1) candidates to the 2 levels held pairs (30 to 6 with 3 levels)."""
     rollout_elevon_levels: Annotated[int, NoBool, Field(ge=2, le=9)] = 5
     """rollout: positions of the healthy elevon in the candidates, evenly spaced from its lower to its upper limit (with the throttle's two limits, 2 x levels pairs: each held, and per switch time every ordered pair of two; 3 levels give 66 candidates, 5 give 190; on x8-pyfly 5 keep 38 of 312 locks from -20 to -10 deg in, where 3 keep 6, docs/airframes.md)."""
+    rollout_guard_holds_s: tuple[Pos, ...] = (0.2, 0.5, 1.0)
+    """guarded: how long each of the guard's candidates holds its (throttle, healthy elevon) pair before the LQR takes over [s] (distinct multiples of model.dt_s, below rollout_horizon_s; at least one); with 5 elevon levels, 10 pairs each."""
+    rollout_guard_bank_margin_deg: Annotated[float, NoBool, Field(ge=0.5, le=30, allow_inf_nan=False)] = 10.0
+    """guarded: room the designs about steady flights outside the design box leave below validity.bank_max_deg [deg] (the other bounds keep 0.5 m/s or deg). On x8-pyfly, locks from -15 to -10 deg, 150 per side: 0.5 keeps 214 of 300 in for 60 s (designs at 59.5 deg of bank, which the noise tips over 60), 2 to 8 keep 244-255, 10 keeps 258 (245 on another seed, against 195 with 0.5), 12 keeps 241, 15 (the design box's 45 deg) 172 (docs/airframes.md)."""
     rollout_substeps: Annotated[int, NoBool, Field(ge=1, le=100)] = 2
     """rollout: RK4 sub-steps per control period of those flights (the trials' truth uses 10); a sub-step (model.dt_s / rollout_substeps) must be at most 0.05 s: x8-pyfly's roll mode, -38.5 1/s, then gives h lambda = 1.9, inside RK4's 2.8."""
 
@@ -461,6 +470,17 @@ class MonitorConfig(_Strict):
         if late:
             raise ValueError(f"rollout_switch_s: each must be below rollout_horizon_s "
                              f"({self.rollout_horizon_s:g} s), got {late[0]:g}")
+        if self.turn_beyond == "guarded":
+            holds = list(self.rollout_guard_holds_s)
+            if not holds:
+                raise ValueError("rollout_guard_holds_s: the guard needs at least one time")
+            if len(set(holds)) < len(holds):
+                raise ValueError(f"rollout_guard_holds_s: the times must differ, got {holds}")
+            late = [t for t in holds if not t < self.rollout_horizon_s]
+            if late:
+                raise ValueError(f"rollout_guard_holds_s: each must be below "
+                                 f"rollout_horizon_s ({self.rollout_horizon_s:g} s), "
+                                 f"got {late[0]:g}")
         lo, hi = self.turn_offsets_deg
         if not lo < hi:
             raise ValueError(f"turn_offsets_deg: the first must be below the second, got "

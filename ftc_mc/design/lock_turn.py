@@ -32,6 +32,10 @@ controller that flies such a turn:
    enters the linear model as a constant input ``F`` (Theorem 4.1,
    :func:`ftc_mc.design.theorem41.biased_discounted_lqr`): the law then holds
    what it can (pitch, bank) and lets the rest (height, heading) go.
+   With a *wide box* (:func:`envelope_box`, the validity envelope less 0.5
+   of each bound and a margin of bank; ``monitor.turn_beyond: guarded``),
+   such a lock is first designed about its own steady flight in that box, if
+   it has one.
 3. **Linear model**: scipy's adaptive finite differences of the authors'
    equations (:func:`ftc_mc.model.linear.jacobian` of
    :func:`ftc_mc.model.sixdof.derivatives`) at the design point, reduced to
@@ -142,6 +146,40 @@ class DesignBox:
         hi = np.array([self.airspeed[1], self.alpha[1], self.sideslip, self.bank, 1.2,
                        2.0, self.throttle[1], self.elevon])
         return lo, hi
+
+
+def envelope_box(airspeed, alpha_deg, bank_deg, margin: float = 0.5,
+                 bank_margin: float | None = None) -> DesignBox:
+    """The validity envelope less ``margin`` of each bound, as a design box.
+
+    Where the design box (:class:`DesignBox`) holds no steady flight of a lock,
+    the envelope may still hold one: on ``x8-pyfly`` the steady turns closest
+    to the nominal glide of locks from about -29 to -10 deg of trim lie at
+    12.5-16.5 m/s and 58-60 deg of bank (``scripts/study_recoverable.py``,
+    docs/airframes.md); with 10 deg of room below the bank bound, those of
+    -15 to -11 deg at 12.5-14.7 m/s and 50 deg.  The air-path
+    angle may then lie from -45 to +30 deg; the throttle, elevon and
+    sideslip bounds are the design box's.
+
+    Parameters
+    ----------
+    airspeed : (float, float)
+        The envelope's airspeed bounds [m/s].
+    alpha_deg : (float, float)
+        Its angle-of-attack bounds [deg].
+    bank_deg : float
+        Its largest bank [deg].
+    margin : float
+        Room left inside each bound [m/s or deg].
+    bank_margin : float, optional
+        Room left below the largest bank [deg]; default ``margin``.
+    """
+    return DesignBox(airspeed=(airspeed[0] + margin, airspeed[1] - margin),
+                     alpha=(math.radians(alpha_deg[0] + margin),
+                            math.radians(alpha_deg[1] - margin)),
+                     bank=math.radians(bank_deg - (margin if bank_margin is None
+                                                   else bank_margin)),
+                     gamma=(math.radians(-45.0), math.radians(30.0)))
 
 
 @dataclasses.dataclass(frozen=True)
@@ -516,8 +554,9 @@ class LockTurnDesigns:
     k : ndarray, shape (2, n, 2)
         Theorem 4.1's constant term.
     steady : ndarray of bool, shape (2, n)
-        The lock has its own steady flight in the design box (else the design
-        is about the nearest lock that has one).
+        The lock has its own steady flight in the design box, or in the wide
+        box where one was given (else the design is about the nearest lock
+        that has one in the design box).
     """
 
     offsets: np.ndarray
@@ -534,7 +573,8 @@ SIDES = ("left", "right")
 
 
 def lock_turn_designs(airframe: Airframe, offsets, V0: float = 20.0,
-                      gamma0_deg: float = -3.0, dt: float = 0.1) -> LockTurnDesigns:
+                      gamma0_deg: float = -3.0, dt: float = 0.1,
+                      wide: DesignBox | None = None) -> LockTurnDesigns:
     """:func:`lock_turn_lqr` of both sides at each lock offset from trim.
 
     Parameters
@@ -547,6 +587,11 @@ def lock_turn_designs(airframe: Airframe, offsets, V0: float = 20.0,
         The nominal glide [m/s], [deg]: the trim and the design point's target.
     dt : float
         Sampling period [s].
+    wide : DesignBox, optional
+        Where a lock has no steady flight in the design box, its design is
+        about its own steady flight in this box if it has one
+        (:func:`envelope_box`; ``monitor.turn_beyond: guarded``); else, and
+        without it, about the nearest lock that has one in the design box.
 
     Returns
     -------
@@ -561,10 +606,10 @@ def lock_turn_designs(airframe: Airframe, offsets, V0: float = 20.0,
     """
     offsets = np.asarray(offsets, dtype=float)
     with threadpool_limits(limits=1, user_api="blas"):
-        return _designs(airframe, offsets, V0, gamma0_deg, dt)
+        return _designs(airframe, offsets, V0, gamma0_deg, dt, wide)
 
 
-def _designs(airframe, offsets, V0, gamma0_deg, dt) -> LockTurnDesigns:
+def _designs(airframe, offsets, V0, gamma0_deg, dt, wide=None) -> LockTurnDesigns:
     """:func:`lock_turn_designs` on the threads in force."""
     n = offsets.size
     trim_cmd = trim6(airframe, V0, gamma0_deg).u0
@@ -579,6 +624,10 @@ def _designs(airframe, offsets, V0, gamma0_deg, dt) -> LockTurnDesigns:
             lock[s, i] = trim_cmd[COMMAND[side]] + off
             d = lock_turn_lqr(airframe, side, float(lock[s, i]), dt, V0=V0,
                               gamma0_deg=gamma0_deg)
+            if wide is not None and not d.point.steady:
+                dw = lock_turn_lqr(airframe, side, float(lock[s, i]), dt, V0=V0,
+                                   gamma0_deg=gamma0_deg, box=wide)
+                d = dw if dw.point.steady else d
             x[s, i], cmd[s, i] = d.point.x, d.point.cmd
             K[s, i], k[s, i] = d.K, d.k
             steady[s, i] = d.point.lock == d.point.design_lock
@@ -587,15 +636,18 @@ def _designs(airframe, offsets, V0, gamma0_deg, dt) -> LockTurnDesigns:
 
 
 def lock_turn_designs_key(airframe: Airframe, offsets, V0: float, gamma0_deg: float,
-                          dt: float) -> str:
+                          dt: float, wide: DesignBox | None = None) -> str:
     """SHA-256 cache key of every input of :func:`lock_turn_designs`: the packed
     6-DOF parameters and command limits of the airframe, the grid, the glide,
-    the period, the default design box and weights, :data:`LOCK_TURN_TABLE_VERSION`
-    and the OpenBLAS kernels in force (``ftc_mc/blas.py``)."""
+    the period, the default design box and weights, the wide box if any,
+    :data:`LOCK_TURN_TABLE_VERSION` and the OpenBLAS kernels in force
+    (``ftc_mc/blas.py``)."""
     h = hashlib.sha256()
     h.update(LOCK_TURN_TABLE_VERSION.encode())
     h.update(f"blas:{os.environ.get('OPENBLAS_CORETYPE')}".encode())
     h.update(repr((DesignBox(), DesignWeights(), TurnWeights(), ALPHA, LOCK_TOLERANCE)).encode())
+    if wide is not None:
+        h.update(f"wide:{wide!r}".encode())
     for a in (trim6(airframe, V0, gamma0_deg).params, airframe.command_lower,
               airframe.command_upper, offsets, [V0, gamma0_deg, dt]):
         b = np.ascontiguousarray(a, dtype=np.float64)
@@ -606,14 +658,15 @@ def lock_turn_designs_key(airframe: Airframe, offsets, V0: float, gamma0_deg: fl
 
 def cached_lock_turn_designs(airframe: Airframe, offsets, V0: float = 20.0,
                              gamma0_deg: float = -3.0, dt: float = 0.1,
-                             cache_dir=None, stream=None) -> LockTurnDesigns:
+                             cache_dir=None, stream=None,
+                             wide: DesignBox | None = None) -> LockTurnDesigns:
     """:func:`lock_turn_designs`, cached on disk as ``.npz``
     (``<cache_dir>/lock_turn/<sha256>.npz``, key :func:`lock_turn_designs_key`,
     written atomically; an unreadable or mismatching file is recomputed).
 
     Parameters
     ----------
-    airframe, offsets, V0, gamma0_deg, dt
+    airframe, offsets, V0, gamma0_deg, dt, wide
         As :func:`lock_turn_designs`.
     cache_dir : str or Path, optional
         Cache root; default :func:`ftc_mc.design.cache.default_cache_dir`.
@@ -626,7 +679,7 @@ def cached_lock_turn_designs(airframe: Airframe, offsets, V0: float = 20.0,
     LockTurnDesigns
     """
     offsets = np.asarray(offsets, dtype=float)
-    key = lock_turn_designs_key(airframe, offsets, V0, gamma0_deg, dt)
+    key = lock_turn_designs_key(airframe, offsets, V0, gamma0_deg, dt, wide)
     folder = Path(cache_dir) if cache_dir is not None else default_cache_dir()
     path = folder / "lock_turn" / f"{key}.npz"
     fields = [f.name for f in dataclasses.fields(LockTurnDesigns)]
@@ -641,7 +694,7 @@ def cached_lock_turn_designs(airframe: Airframe, offsets, V0: float = 20.0,
         print(f"ftc-mc: designing the lock-turn controllers ({offsets.size} lock positions "
               "per elevon; cached afterwards)", file=stream, flush=True)
     t0 = time.perf_counter()
-    d = lock_turn_designs(airframe, offsets, V0, gamma0_deg, dt)
+    d = lock_turn_designs(airframe, offsets, V0, gamma0_deg, dt, wide)
     if stream is not None:
         print(f"ftc-mc: lock-turn controllers designed in {time.perf_counter() - t0:.1f} s",
               file=stream, flush=True)
@@ -650,7 +703,7 @@ def cached_lock_turn_designs(airframe: Airframe, offsets, V0: float = 20.0,
     return d
 
 
-__all__ = ["TURN_RIGID", "LOCK_TOLERANCE", "healthy", "turn_states", "DesignBox",
+__all__ = ["TURN_RIGID", "LOCK_TOLERANCE", "healthy", "turn_states", "DesignBox", "envelope_box",
            "DesignWeights", "TurnWeights", "DesignPoint", "design_point",
            "LockTurnDesign", "lock_turn_lqr", "LOCK_TURN_TABLE_VERSION", "LockTurnDesigns",
            "SIDES", "lock_turn_designs", "lock_turn_designs_key", "cached_lock_turn_designs"]

@@ -48,9 +48,10 @@ NO_PROBE = dict(probe=0.0, probe_unit=1, check=0, hand_back=0.0, hand_back_sd=0.
 configured probe's, so that both compile to one signature)."""
 
 NO_ROLLOUT = dict(ro_on=0, ro_steps=1, ro_sub=1, ro_first=np.ones(1, dtype=np.int64),
-                  ro_u=np.zeros((2, 1, 2, 2)), ro_env=np.zeros(5))
-"""The ``LockTurnTable`` fields of no rocking law (``monitor.turn_beyond: hold``;
-the same types as the law's, one signature)."""
+                  ro_u=np.zeros((2, 1, 2, 2)), ro_env=np.zeros(5), gd_on=0, gd_pairs=0,
+                  gd_holds=np.ones(1, dtype=np.int64))
+"""The ``LockTurnTable`` fields of no rocking law and no rollout guard
+(``monitor.turn_beyond: hold``; the same types as the law's, one signature)."""
 
 MEASURED = LONGITUDINAL.outputs + MONITOR_LATERAL
 """The monitor's measured outputs in its order (``CAS`` and ``Va`` both the
@@ -100,12 +101,14 @@ class MonitorSpec:
     state_noise_scale : float
         Multiplies the process noise variance ``q_x`` of the 6-DOF states.
     turn_rollout : dict or None
-        The rocking law (``monitor.turn_beyond: rollout``): ``steps`` (its
-        horizon), ``switches`` (the candidates' switch times) [periods],
-        ``sub`` (RK4 sub-steps per period), ``levels`` (the healthy elevon's
-        positions) and ``env`` (the envelope: airspeed
-        [m/s], angle of attack and bank [deg], :func:`rocking_table`'s
-        order); None: the trim is held (``hold``).
+        The rocking law (``monitor.turn_beyond: rollout`` or ``guarded``):
+        ``steps`` (its horizon), ``switches`` (the candidates' switch times)
+        [periods], ``sub`` (RK4 sub-steps per period), ``levels`` (the healthy
+        elevon's positions), ``env`` (the envelope: airspeed [m/s], angle of
+        attack and bank [deg], :func:`rocking_table`'s order), ``holds`` (the
+        rollout guard's hold times [periods]; empty: no guard, and no wide
+        design box) and ``bank_margin`` (the wide box's room below the largest
+        bank [deg]); None: the trim is held (``hold``).
     """
 
     threshold: float
@@ -181,7 +184,10 @@ def monitor_spec(cfg, fm, det, lock_turn: bool = False) -> MonitorSpec | None:
             sub=int(mc.rollout_substeps), levels=int(mc.rollout_elevon_levels),
             env=(cfg.validity.airspeed_min_mps, cfg.validity.airspeed_max_mps,
                  cfg.validity.alpha_min_deg, cfg.validity.alpha_max_deg,
-                 cfg.validity.bank_max_deg)))
+                 cfg.validity.bank_max_deg),
+            holds=(tuple(cfg.steps(t) for t in mc.rollout_guard_holds_s)
+                   if mc.turn_beyond == "guarded" else ()),
+            bank_margin=float(mc.rollout_guard_bank_margin_deg)))
 
 
 def gust_block(six, spec: MonitorSpec, span: float):
@@ -211,9 +217,9 @@ def gust_block(six, spec: MonitorSpec, span: float):
 
 
 def rocking_table(lo_dev, hi_dev, steps: int, switches, sub: int, env,
-                  levels: int = 3) -> dict:
-    """The ``LockTurnTable`` fields of the rocking law (``ro_*``; module
-    docstring of :mod:`ftc_mc.core.sixdof.lockturn`).
+                  levels: int = 3, holds=()) -> dict:
+    """The ``LockTurnTable`` fields of the rocking law and the rollout guard
+    (``ro_*``, ``gd_*``; module docstring of :mod:`ftc_mc.core.sixdof.lockturn`).
 
     The pairs (throttle, healthy elevon) are the throttle's two limits by
     ``levels`` positions of the healthy elevon evenly spaced from its lower
@@ -236,6 +242,10 @@ def rocking_table(lo_dev, hi_dev, steps: int, switches, sub: int, env,
         Airspeed min, max [m/s], angle of attack min, max [deg], largest bank [deg].
     levels : int
         Positions of the healthy elevon, at least 2 (its two limits).
+    holds : sequence of int
+        The rollout guard's hold times [periods], each at least 1 (its
+        candidates hold one of the ``2 levels`` held pairs, then fly the LQR);
+        empty: no guard.
     """
     from ..design.lock_turn import SIDES, healthy
 
@@ -252,11 +262,14 @@ def rocking_table(lo_dev, hi_dev, steps: int, switches, sub: int, env,
     return dict(ro_on=1, ro_steps=int(steps), ro_sub=int(sub),
                 ro_first=np.array([k for _, _, k in order], dtype=np.int64),
                 ro_u=np.ascontiguousarray(ro_u, dtype=np.float64),
-                ro_env=np.asarray(env, dtype=np.float64))
+                ro_env=np.asarray(env, dtype=np.float64), gd_on=int(bool(len(holds))),
+                gd_pairs=n_p if len(holds) else 0,
+                gd_holds=np.array(list(holds) or [1], dtype=np.int64))
 
 
 def lock_turn_table(six, u0: np.ndarray, offsets=(), airframe=None,
-                    measured: bool = True, probe=None, rollout=None) -> LockTurnTable:
+                    measured: bool = True, probe=None, rollout=None,
+                    wide=None) -> LockTurnTable:
     """The kernels' :class:`LockTurnTable` (empty, ``x`` of shape ``(2, 0, 10)``,
     when ``offsets`` is).
 
@@ -282,8 +295,11 @@ def lock_turn_table(six, u0: np.ndarray, offsets=(), airframe=None,
         The table's probe fields (:attr:`MonitorSpec.turn_probe`); default
         :data:`NO_PROBE`.
     rollout : dict, optional
-        The table's rocking-law fields (:func:`rocking_table`); default
-        :data:`NO_ROLLOUT`.
+        The table's rocking-law and guard fields (:func:`rocking_table`);
+        default :data:`NO_ROLLOUT`.
+    wide : DesignBox, optional
+        The designs' wide box (:func:`ftc_mc.design.lock_turn.envelope_box`;
+        the rollout guard's), or None.
 
     Designs the cache does not hold are computed with a notice on stderr and
     their duration.
@@ -310,7 +326,7 @@ def lock_turn_table(six, u0: np.ndarray, offsets=(), airframe=None,
                              **pr)
     d = cached_lock_turn_designs(airframe, off, float(six.trim.V0),
                                  float(np.degrees(six.trim.gamma0)), six.dt,
-                                 stream=sys.stderr)
+                                 stream=sys.stderr, wide=wide)
     idx = np.array([[STATE[n] for n in turn_states(side)] for side in SIDES])
     x = np.stack([d.x[s][:, idx[s]] - six.trim.x0[idx[s]] for s in range(2)])
     c = np.ascontiguousarray
@@ -385,7 +401,13 @@ def side_monitor(six, u_ff: np.ndarray, u_lower, u_upper, lon_out: np.ndarray,
     ro = spec.turn_rollout
     rollout = None if ro is None else rocking_table(
         u_lower - u0, u_upper - u0, ro["steps"], ro["switches"], ro["sub"], ro["env"],
-        ro["levels"])
+        ro["levels"], ro.get("holds", ()))
+    wide = None
+    if ro is not None and ro.get("holds"):
+        from ..design.lock_turn import envelope_box
+
+        env = ro["env"]
+        wide = envelope_box(env[0:2], env[2:4], env[4], bank_margin=ro["bank_margin"])
     return SideMonitor(
         on=1, A=c(A), B=c(B), C=c(C), u0=c(u0, dtype=np.float64),
         u_ff=c(u_ff, dtype=np.float64), lo=c(u_lower), hi=c(u_upper), P0=c(P0), Q=c(Q),
@@ -393,6 +415,6 @@ def side_monitor(six, u_ff: np.ndarray, u_lower, u_upper, lon_out: np.ndarray,
         threshold=float(spec.threshold), window=int(spec.window),
         min_window=int(spec.min_window), startup=int(spec.startup), snap=int(spec.snap),
         turn=lock_turn_table(six, u0, spec.turn_offsets, airframe, spec.turn_measured,
-                             spec.turn_probe, rollout),
+                             spec.turn_probe, rollout, wide),
         nonlinear=EXTENDED if spec.extended else int(spec.nonlinear),
         states=c(states, dtype=np.int64), outs=outs, n_sub=int(spec.substeps), wind=c(W))

@@ -53,6 +53,26 @@ histories that last swing it: roll with the lock while pitching up, then
 mirror the lock with the healthy elevon and dive back to wings level, trading
 height for time (``docs/airframes.md``).
 
+**Rollout guard** (``turn_beyond: guarded``, :func:`guarded_law`).  The
+table is then designed with a wide box as well
+(:func:`ftc_mc.design.lock_turn.envelope_box`: the validity envelope less
+0.5 of each bound, and ``monitor.rollout_guard_bank_margin_deg`` below the
+bank bound), so that a lock whose steady flights all lie outside the design
+box (on ``x8-pyfly``, with the default 10 deg: locks from -15 to -11 deg of
+trim, turns at 50 deg of bank and 12.5-14.7 m/s) has a design about its
+own.  Flown directly from the nominal glide, such a design overshoots the
+bank bound (oracle, designs at 59.5 deg: within 1.1-2.4 s; true lock and
+state from 0.1 s after the lock).  So every step, before the LQR's command
+is sent, the airframe's equations fly the LQR ``ro_steps`` periods from the
+lane's state (as the rocking law does, the LQR applied to the flown state);
+if it leaves, candidates that first hold a pair (throttle, healthy elevon)
+for ``gd_holds`` periods and then hand over to the LQR are flown too, and
+the first pair of the one that stays inside longest (then with the widest
+margin) is sent.  On the oracle's flights (designs at 59.5 deg) this kept
+left and right locks from -14.5 to -10 deg in for 60 s, where the LQR alone
+left.  Where no steady flight exists even in the wide box, the rocking law
+flies.
+
 **Law** (:func:`lock_turn_law`), on ``x_hat``: the ten fed-back states (bank,
 pitch, body velocities and rates, the throttle and the healthy elevon), each
 read from its sensor where one measures it and ``monitor.turn_feedback`` is
@@ -106,7 +126,7 @@ reads the turn as a thrust change; the monitor reads roll and pitch together
 (issue 26, item 2: the side decided by the direction's GLR).
 
 Plain-NumPy twins: ``tests/naive_sixdof.py::lock_turn_law_ref``,
-``rocking_law_ref``, ``turn_probe_ref``, ``side_blocks_ref``.
+``rocking_law_ref``, ``guarded_law_ref``, ``turn_probe_ref``, ``side_blocks_ref``.
 """
 
 from __future__ import annotations
@@ -159,6 +179,9 @@ LockTurnTable = namedtuple("LockTurnTable", [
     "ro_u",    # (2, n_c, 2, 2) per side and candidate, the first and the second pair
                # (throttle, healthy elevon) less the longitudinal trim u0
     "ro_env",  # (5,) envelope: Va min, max [m/s], alpha min, max [deg], |bank| max [deg]
+    "gd_on",   # 1: the LQR flies under the rollout guard (turn_beyond: guarded); 0: not
+    "gd_pairs",  # the guard's pairs: the first gd_pairs candidates of ro_u (the held ones)
+    "gd_holds",  # (n_h,) int64: periods each of the guard's candidates holds its pair
 ])
 """The lock-turn designs of both sides over a grid of lock positions (module
 docstring); ``x`` of shape ``(2, 0, n_f)`` when no design flies it.  Built by
@@ -204,7 +227,8 @@ def lock_turn_law(tab, pl, s, p, mx, z, lat, l, lo_dev, hi_dev, u):
             for c in range(2):  # hold the trim commands
                 a = tab.cmd[s, c]
                 u[a, l] = min(hi_dev[a], max(lo_dev[a], tab.hold[a]))
-    else:
+    elif tab.gd_on == 0 or not guarded_law(tab, pl, s, i, j1, w, p, mx, z, lat, l, lo_dev,
+                                           hi_dev, u):
         turn_law(tab, s, i, j1, w, mx, z, lat, l, lo_dev, hi_dev, u)
     a = tab.locked[s]
     u[a, l] = min(hi_dev[a], max(lo_dev[a], tab.hold[a]))
@@ -219,13 +243,7 @@ def rocking_law(tab, pl, s, p, mx, z, lat, l, lo_dev, hi_dev, u):
     candidate leaves within the first period (or the state is not finite)."""
     mon = pl.monitor
     x6 = np.empty(N_STATE)
-    on_trim(mon, pl, mx[:, l], x6)
-    nz = z.shape[0]
-    for r in range(tab.meas.shape[1]):
-        o = tab.meas[s, r]
-        if o >= 0:
-            j = mon.states[tab.rows[s, r]]
-            x6[j] = pl.x0[j] + (z[o, l] if o < nz else lat[o - nz, l])
+    lane_state(tab, pl, s, mx, z, lat, l, x6)
     xs = np.empty(N_STATE)
     cmd = np.empty(N_COMMAND)
     wd = np.zeros(N_WIND)
@@ -260,6 +278,104 @@ def rocking_law(tab, pl, s, p, mx, z, lat, l, lo_dev, hi_dev, u):
     u[a_thr, l] = min(hi_dev[a_thr], max(lo_dev[a_thr], tab.ro_u[s, best, 0, 0]))
     u[a_free, l] = min(hi_dev[a_free], max(lo_dev[a_free], tab.ro_u[s, best, 0, 1]))
     return True
+
+
+@kernel(inline="always")
+def lane_state(tab, pl, s, mx, z, lat, l, x6):
+    """Lane ``l``'s 6-DOF state (absolute) over ``x6`` (15,): the monitor's
+    estimate on its rows (:func:`~ftc_mc.core.sixdof.monitor.on_trim`), the
+    fed-back states of side ``s`` from their sensors where ``tab.meas`` says
+    so, the rest of the 6-DOF trim."""
+    mon = pl.monitor
+    on_trim(mon, pl, mx[:, l], x6)
+    nz = z.shape[0]
+    for r in range(tab.meas.shape[1]):
+        o = tab.meas[s, r]
+        if o >= 0:
+            j = mon.states[tab.rows[s, r]]
+            x6[j] = pl.x0[j] + (z[o, l] if o < nz else lat[o - nz, l])
+
+
+@kernel(internal=True)
+def guarded_law(tab, pl, s, i, j1, w, p, mx, z, lat, l, lo_dev, hi_dev, u):
+    """The rollout guard on the lock-turn LQR (``monitor.turn_beyond:
+    guarded``; module docstring).  From the lane's state (:func:`lane_state`),
+    the airframe's equations fly ``tab.ro_steps`` periods under the LQR of the
+    designs ``i`` and ``j1`` (weight ``w`` on ``j1``; :func:`turn_command`).
+    If that flight stays inside the envelope, returns False and writes
+    nothing: :func:`turn_law` flies.  Else each of the guard's candidates
+    holds one of the first ``tab.gd_pairs`` pairs of ``tab.ro_u`` (the held
+    ones: the throttle's limits by the healthy elevon's positions) for
+    ``tab.gd_holds`` periods, then flies the LQR for the rest of the horizon;
+    the candidate that stays inside longest, then with the widest margin,
+    wins (the LQR's own flight first, then the candidates pair-major, on a
+    tie).  When the LQR's own flight wins, returns False; else writes the
+    winning pair and returns True.  Arguments as :func:`lock_turn_law`'s and
+    :func:`turn_law`'s."""
+    x6 = np.empty(N_STATE)
+    lane_state(tab, pl, s, mx, z, lat, l, x6)
+    xs = np.empty(N_STATE)
+    cmd = np.empty(N_COMMAND)
+    wd = np.zeros(N_WIND)
+    rk = np.empty((N_WORK, N_STATE))
+    a_thr = tab.cmd[s, 0]
+    a_free = tab.cmd[s, 1]
+    best = -1
+    best_h = 0
+    best_k = -1
+    best_e = np.inf
+    nh = tab.gd_holds.shape[0]
+    for c in range(-1, tab.gd_pairs):
+        for hh in range(nh if c >= 0 else 1):
+            h = tab.gd_holds[hh] if c >= 0 else 0
+            for q in range(N_STATE):
+                xs[q] = x6[q]
+            cmd[tab.locked[s]] = p
+            k_out = tab.ro_steps
+            worst = -np.inf
+            for k in range(tab.ro_steps):
+                if k < h:
+                    cmd[a_thr] = pl.monitor.u0[a_thr] + tab.ro_u[s, c, 0, 0]
+                    cmd[a_free] = pl.monitor.u0[a_free] + tab.ro_u[s, c, 0, 1]
+                else:
+                    turn_command(tab, pl, s, i, j1, w, xs, lo_dev, hi_dev, cmd)
+                propagate(xs, cmd, pl.p, wd, pl.dt, tab.ro_sub, rk)
+                e = envelope_excess(tab.ro_env, xs)
+                if e > 0.0:
+                    k_out = k
+                    break
+                worst = max(worst, e)
+            if k_out > best_k or (k_out == best_k and worst < best_e):
+                best = c
+                best_h = h
+                best_k = k_out
+                best_e = worst
+            if c < 0 and k_out == tab.ro_steps:  # the LQR stays in: no guard needed
+                return False
+    if best < 0 or best_h == 0:
+        return False
+    u[a_thr, l] = min(hi_dev[a_thr], max(lo_dev[a_thr], tab.ro_u[s, best, 0, 0]))
+    u[a_free, l] = min(hi_dev[a_free], max(lo_dev[a_free], tab.ro_u[s, best, 0, 1]))
+    return True
+
+
+@kernel(inline="always")
+def turn_command(tab, pl, s, i, j1, w, xs, lo_dev, hi_dev, cmd):
+    """The throttle and healthy elevon commands (absolute) of the lock-turn LQR
+    of designs ``i`` and ``j1`` of side ``s`` (weight ``w`` on ``j1``) at the
+    6-DOF state ``xs`` (absolute), each fed-back state read from ``xs``;
+    written into ``cmd`` (:func:`turn_law`'s law on a flown state)."""
+    mon = pl.monitor
+    nf = tab.x.shape[2]
+    for c in range(2):
+        a = tab.cmd[s, c]
+        v = (1.0 - w) * (tab.u[s, i, a] - tab.k[s, i, c]) + w * (tab.u[s, j1, a]
+                                                                  - tab.k[s, j1, c])
+        for r in range(nf):
+            q = mon.states[tab.rows[s, r]]
+            dev = xs[q] - pl.x0[q] - ((1.0 - w) * tab.x[s, i, r] + w * tab.x[s, j1, r])
+            v -= ((1.0 - w) * tab.K[s, i, c, r] + w * tab.K[s, j1, c, r]) * dev
+        cmd[a] = mon.u0[a] + min(hi_dev[a], max(lo_dev[a], v))
 
 
 @kernel(inline="always")
