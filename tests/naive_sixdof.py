@@ -514,6 +514,41 @@ def lock_turn_law_ref(tab, s, p, xhat, lo_dev, hi_dev):
     return np.clip(out, lo_dev, hi_dev)
 
 
+def envelope_excess_ref(env, xs):
+    """The envelope's excess at the absolute 6-DOF state ``xs``, in m/s and
+    degrees, from ``u, v, w`` and ``phi`` (``core/sixdof/lockturn.py``'s
+    module docstring): the largest of ``env[0] - Va``, ``Va - env[1]``,
+    ``env[2] - alpha``, ``alpha - env[3]``, ``|phi| - env[4]``; inf where not
+    finite."""
+    u, v, w = (xs[LAYOUT.states.index(n)] for n in ("u", "v", "w"))
+    va = np.sqrt(u * u + v * v + w * w)
+    alpha = np.degrees(np.arctan2(w, u))
+    bank = np.degrees(abs(xs[LAYOUT.states.index("phi")]))
+    e = max(env[0] - va, va - env[1], env[2] - alpha, alpha - env[3], bank - env[4])
+    return e if np.isfinite([va, alpha, bank]).all() else np.inf
+
+
+def rocking_scores_ref(tab, pl, s, p, x):
+    """``(periods inside, -largest excess before leaving)`` of every rocking
+    candidate (its first pair for ``ro_first`` periods, its second after, the
+    named elevon at ``p``) flown ``ro_steps`` periods of :func:`rk4_ref`
+    (``ro_sub`` sub-steps, still air) from the absolute state ``x``."""
+    scores = []
+    for c in range(len(tab.ro_first)):
+        xs = np.array(x, dtype=float)
+        excess = []
+        for k in range(tab.ro_steps):
+            pair = tab.ro_u[s, c, 0 if k < tab.ro_first[c] else 1]
+            cmd = np.zeros(3)
+            cmd[tab.cmd[s]] = pl.monitor.u0[tab.cmd[s]] + pair
+            cmd[tab.locked[s]] = p
+            xs = rk4_ref(xs, cmd, pl.p, np.zeros(6), pl.dt, tab.ro_sub)
+            excess.append(envelope_excess_ref(tab.ro_env, xs))
+        out = next((k for k, e in enumerate(excess) if e > 0), tab.ro_steps)
+        scores.append((out, -max(excess[:out], default=-np.inf)))
+    return scores
+
+
 def rocking_law_ref(tab, pl, s, p, x, lo_dev, hi_dev):
     """The rocking law of one lane (``ftc_mc/core/sixdof/lockturn.py``), written
     from that module's docstring: from the absolute 6-DOF state ``x`` (15,),
@@ -527,25 +562,7 @@ def rocking_law_ref(tab, pl, s, p, x, lo_dev, hi_dev):
     commands of the throttle and the healthy elevon (2,) less the
     longitudinal trim ``pl.monitor.u0``, and the chosen candidate's index
     (-1: the trim held)."""
-    env = tab.ro_env
-    scores = []
-    for c in range(len(tab.ro_first)):
-        xs = np.array(x, dtype=float)
-        excess = []
-        for k in range(tab.ro_steps):
-            pair = tab.ro_u[s, c, 0 if k < tab.ro_first[c] else 1]
-            cmd = np.zeros(3)
-            cmd[tab.cmd[s]] = pl.monitor.u0[tab.cmd[s]] + pair
-            cmd[tab.locked[s]] = p
-            xs = rk4_ref(xs, cmd, pl.p, np.zeros(6), pl.dt, tab.ro_sub)
-            u, v, w = (xs[LAYOUT.states.index(n)] for n in ("u", "v", "w"))
-            va = np.sqrt(u * u + v * v + w * w)
-            alpha = np.degrees(np.arctan2(w, u))
-            bank = np.degrees(abs(xs[LAYOUT.states.index("phi")]))
-            e = max(env[0] - va, va - env[1], env[2] - alpha, alpha - env[3], bank - env[4])
-            excess.append(e if np.isfinite([va, alpha, bank]).all() else np.inf)
-        out = next((k for k, e in enumerate(excess) if e > 0), tab.ro_steps)
-        scores.append((out, -max(excess[:out], default=-np.inf)))
+    scores = rocking_scores_ref(tab, pl, s, p, x)
     best = max(range(len(scores)), key=lambda c: (scores[c], -c))
     if scores[best][0] == 0:
         return np.clip(tab.hold[tab.cmd[s]], lo_dev[tab.cmd[s]], hi_dev[tab.cmd[s]]), -1
@@ -569,7 +586,6 @@ def guarded_law_ref(tab, pl, s, p, x, lo_dev, hi_dev):
     from ftc_mc.design.lock_turn import SIDES, turn_states
 
     idx = [LAYOUT.states.index(n) for n in turn_states(SIDES[s])]
-    env = tab.ro_env
 
     def lqr(xs):
         full = lock_turn_law_ref(tab, s, p, xs[idx] - pl.x0[idx], lo_dev, hi_dev)
@@ -583,12 +599,7 @@ def guarded_law_ref(tab, pl, s, p, x, lo_dev, hi_dev):
             cmd[tab.cmd[s]] = pl.monitor.u0[tab.cmd[s]] + (pair if k < hold else lqr(xs))
             cmd[tab.locked[s]] = p
             xs = rk4_ref(xs, cmd, pl.p, np.zeros(6), pl.dt, tab.ro_sub)
-            u, v, w = (xs[LAYOUT.states.index(n)] for n in ("u", "v", "w"))
-            va = np.sqrt(u * u + v * v + w * w)
-            alpha = np.degrees(np.arctan2(w, u))
-            bank = np.degrees(abs(xs[LAYOUT.states.index("phi")]))
-            e = max(env[0] - va, va - env[1], env[2] - alpha, alpha - env[3], bank - env[4])
-            excess.append(e if np.isfinite([va, alpha, bank]).all() else np.inf)
+            excess.append(envelope_excess_ref(tab.ro_env, xs))
         out = next((k for k, e in enumerate(excess) if e > 0), tab.ro_steps)
         return out, -max(excess[:out], default=-np.inf)
 

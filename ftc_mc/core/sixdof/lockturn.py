@@ -241,43 +241,46 @@ def rocking_law(tab, pl, s, p, mx, z, lat, l, lo_dev, hi_dev, u):
     the airframe's equations keep inside the envelope longest.  Arguments as
     :func:`lock_turn_law`'s.  Returns False, writing nothing, when every
     candidate leaves within the first period (or the state is not finite)."""
-    mon = pl.monitor
     x6 = np.empty(N_STATE)
     lane_state(tab, pl, s, mx, z, lat, l, x6)
     xs = np.empty(N_STATE)
     cmd = np.empty(N_COMMAND)
     wd = np.zeros(N_WIND)
     rk = np.empty((N_WORK, N_STATE))
-    a_thr = tab.cmd[s, 0]
-    a_free = tab.cmd[s, 1]
+    best, best_k, _ = rocking_choice(tab, pl, s, p, x6, lo_dev, hi_dev, xs, cmd, wd, rk)
+    if best_k == 0:  # every history leaves within a period (or the state is not finite)
+        return False
+    send_pair(tab, s, best, l, lo_dev, hi_dev, u)
+    return True
+
+
+@kernel(inline="always")
+def rocking_choice(tab, pl, s, p, x6, lo_dev, hi_dev, xs, cmd, wd, rk):
+    """The rocking law's choice from the absolute 6-DOF state ``x6``
+    (:func:`rocking_law`): ``(candidate, period it leaves in, largest excess
+    before)`` of the candidate that stays in longest, then with the widest
+    margin, the first on a tie (:func:`fly_history`; ``xs`` to ``rk`` work
+    arrays)."""
     best = 0
     best_k = -1
     best_e = np.inf
     for c in range(tab.ro_first.shape[0]):
-        for i in range(N_STATE):
-            xs[i] = x6[i]
-        cmd[tab.locked[s]] = p
-        k_out = tab.ro_steps
-        worst = -np.inf
-        for k in range(tab.ro_steps):
-            ph = 0 if k < tab.ro_first[c] else 1
-            cmd[a_thr] = mon.u0[a_thr] + tab.ro_u[s, c, ph, 0]
-            cmd[a_free] = mon.u0[a_free] + tab.ro_u[s, c, ph, 1]
-            propagate(xs, cmd, pl.p, wd, pl.dt, tab.ro_sub, rk)
-            e = envelope_excess(tab.ro_env, xs)
-            if e > 0.0:
-                k_out = k
-                break
-            worst = max(worst, e)
+        k_out, worst = fly_history(tab, pl, s, p, x6, c, tab.ro_first[c], tab.ro_steps, 0, 0,
+                                   0.0, lo_dev, hi_dev, xs, cmd, wd, rk)
         if k_out > best_k or (k_out == best_k and worst < best_e):
             best = c
             best_k = k_out
             best_e = worst
-    if best_k == 0:  # every history leaves within a period (or the state is not finite)
-        return False
-    u[a_thr, l] = min(hi_dev[a_thr], max(lo_dev[a_thr], tab.ro_u[s, best, 0, 0]))
-    u[a_free, l] = min(hi_dev[a_free], max(lo_dev[a_free], tab.ro_u[s, best, 0, 1]))
-    return True
+    return best, best_k, best_e
+
+
+@kernel(inline="always")
+def send_pair(tab, s, c, l, lo_dev, hi_dev, u):
+    """Write the first pair (throttle, healthy elevon) of candidate ``c`` of
+    side ``s`` (``tab.ro_u``, clipped to the limits) into lane ``l`` of ``u``."""
+    for j in range(2):
+        a = tab.cmd[s, j]
+        u[a, l] = min(hi_dev[a], max(lo_dev[a], tab.ro_u[s, c, 0, j]))
 
 
 @kernel(inline="always")
@@ -318,8 +321,6 @@ def guarded_law(tab, pl, s, i, j1, w, p, mx, z, lat, l, lo_dev, hi_dev, u):
     cmd = np.empty(N_COMMAND)
     wd = np.zeros(N_WIND)
     rk = np.empty((N_WORK, N_STATE))
-    a_thr = tab.cmd[s, 0]
-    a_free = tab.cmd[s, 1]
     best = -1
     best_h = 0
     best_k = -1
@@ -328,23 +329,8 @@ def guarded_law(tab, pl, s, i, j1, w, p, mx, z, lat, l, lo_dev, hi_dev, u):
     for c in range(-1, tab.gd_pairs):
         for hh in range(nh if c >= 0 else 1):
             h = tab.gd_holds[hh] if c >= 0 else 0
-            for q in range(N_STATE):
-                xs[q] = x6[q]
-            cmd[tab.locked[s]] = p
-            k_out = tab.ro_steps
-            worst = -np.inf
-            for k in range(tab.ro_steps):
-                if k < h:
-                    cmd[a_thr] = pl.monitor.u0[a_thr] + tab.ro_u[s, c, 0, 0]
-                    cmd[a_free] = pl.monitor.u0[a_free] + tab.ro_u[s, c, 0, 1]
-                else:
-                    turn_command(tab, pl, s, i, j1, w, xs, lo_dev, hi_dev, cmd)
-                propagate(xs, cmd, pl.p, wd, pl.dt, tab.ro_sub, rk)
-                e = envelope_excess(tab.ro_env, xs)
-                if e > 0.0:
-                    k_out = k
-                    break
-                worst = max(worst, e)
+            k_out, worst = fly_history(tab, pl, s, p, x6, max(c, 0), h, h, i, j1, w, lo_dev,
+                                       hi_dev, xs, cmd, wd, rk)
             if k_out > best_k or (k_out == best_k and worst < best_e):
                 best = c
                 best_h = h
@@ -354,9 +340,42 @@ def guarded_law(tab, pl, s, i, j1, w, p, mx, z, lat, l, lo_dev, hi_dev, u):
                 return False
     if best < 0 or best_h == 0:
         return False
-    u[a_thr, l] = min(hi_dev[a_thr], max(lo_dev[a_thr], tab.ro_u[s, best, 0, 0]))
-    u[a_free, l] = min(hi_dev[a_free], max(lo_dev[a_free], tab.ro_u[s, best, 0, 1]))
+    send_pair(tab, s, best, l, lo_dev, hi_dev, u)
     return True
+
+
+@kernel(inline="always")
+def fly_history(tab, pl, s, p, x6, c, first, lqr_from, i, j1, w, lo_dev, hi_dev, xs, cmd, wd,
+                rk):
+    """Fly one command history ``tab.ro_steps`` periods on the airframe's
+    equations from the absolute 6-DOF state ``x6`` (into ``xs``; still air,
+    ``tab.ro_sub`` RK4 sub-steps, the named elevon of side ``s`` at ``p``):
+    the first pair of candidate ``c`` (``tab.ro_u``) for ``first`` periods,
+    its second after, and from period ``lqr_from`` on the LQR of the designs
+    ``i`` and ``j1`` (weight ``w`` on ``j1``; :func:`turn_command`).  Returns
+    the period in which the flight leaves the envelope (``tab.ro_steps`` if it
+    stays in) and its largest excess before (:func:`envelope_excess`;
+    ``-inf`` if it leaves in the first).  ``cmd``, ``wd``, ``rk``: work
+    arrays."""
+    for q in range(N_STATE):
+        xs[q] = x6[q]
+    cmd[tab.locked[s]] = p
+    a_thr = tab.cmd[s, 0]
+    a_free = tab.cmd[s, 1]
+    worst = -np.inf
+    for k in range(tab.ro_steps):
+        if k >= lqr_from:
+            turn_command(tab, pl, s, i, j1, w, xs, lo_dev, hi_dev, cmd)
+        else:
+            ph = 0 if k < first else 1
+            cmd[a_thr] = pl.monitor.u0[a_thr] + tab.ro_u[s, c, ph, 0]
+            cmd[a_free] = pl.monitor.u0[a_free] + tab.ro_u[s, c, ph, 1]
+        propagate(xs, cmd, pl.p, wd, pl.dt, tab.ro_sub, rk)
+        e = envelope_excess(tab.ro_env, xs)
+        if e > 0.0:
+            return k, worst
+        worst = max(worst, e)
+    return tab.ro_steps, worst
 
 
 @kernel(inline="always")
