@@ -409,26 +409,34 @@ def test_lock_turn_design_flies_on(tmp_path):
     assert wrong["sixdof"] == 0 and wrong["paper"] > 0, wrong
 
 
+def fly_both_ways(tmp_path, offsets_deg, table_deg, beyond, duration_s):
+    """Two trials per elevon row, locked at ``offsets_deg`` (lowest, highest)
+    from trim at 5 s and flown to ``duration_s``, with ``turn_beyond: hold``
+    and with ``beyond`` (the lock-turn table over ``table_deg``): the trials
+    of each, indexed by transition and trial."""
+    trim = float(build_setup(api.campaign_config(
+        {"plant": {"kind": "linear", "dof": 6}})).truth.u0[1])
+    out = []
+    for way in ("hold", beyond):
+        cfg = flies_on_config(trim)
+        cfg["campaign"].update(transitions=["elevon_lock", "right_elevon_lock"], trials=2,
+                               chunk_size=2, signature="none")
+        cfg["draws"] = {"elevon_lock_range_rad": [trim + math.radians(offsets_deg[0]),
+                                                  trim + math.radians(offsets_deg[1])]}
+        cfg["timing"]["duration_s"] = duration_s
+        cfg["monitor"].update(turn_beyond=way, turn_offsets_deg=table_deg)
+        t = api.run_campaign(cfg, jobs=1, progress=False, out=tmp_path / way).trials
+        out.append(t.set_index(["transition", "trial_id"]))
+    return out
+
+
 def test_the_rocking_law_outlasts_the_held_trim(tmp_path):
     """Locks 5-12 deg above trim, beyond the steady band (no steady flight
     exists there with the healthy elevon and the throttle): with the trim
     held (``turn_beyond: hold``) every trial leaves the envelope within 15 s
     of the lock; the rocking law keeps every one of the same trials inside
     for the 30 s flown (docs/airframes.md has the campaign)."""
-    trim = float(build_setup(api.campaign_config(
-        {"plant": {"kind": "linear", "dof": 6}})).truth.u0[1])
-    out = {}
-    for beyond in ("hold", "rollout"):
-        cfg = flies_on_config(trim)
-        cfg["campaign"].update(transitions=["elevon_lock", "right_elevon_lock"], trials=2,
-                               chunk_size=2, signature="none")
-        cfg["draws"] = {"elevon_lock_range_rad": [trim + math.radians(5.0),
-                                                  trim + math.radians(12.0)]}
-        cfg["timing"]["duration_s"] = 30.0
-        cfg["monitor"].update(turn_beyond=beyond, turn_offsets_deg=[-2.0, 6.0])
-        t = api.run_campaign(cfg, jobs=1, progress=False, out=tmp_path / beyond).trials
-        out[beyond] = t.set_index(["transition", "trial_id"])
-    hold, rock = out["hold"], out["rollout"]
+    hold, rock = fly_both_ways(tmp_path, (5.0, 12.0), [-2.0, 6.0], "rollout", 30.0)
     assert (hold["lock_position"] == rock["lock_position"]).all()
     assert (rock["side_correct"] == 1).all()
     assert (hold["status"] != "ok").all(), hold["status"].value_counts()
@@ -443,23 +451,9 @@ def test_the_guard_flies_locks_the_design_box_cannot(tmp_path):
     5 s of the lock; with the guard (``guarded``), which designs about those
     turns and flies the LQR under its rollouts, every one of the same trials
     stays inside for the 30 s flown (docs/airframes.md has the campaign)."""
-    trim = float(build_setup(api.campaign_config(
-        {"plant": {"kind": "linear", "dof": 6}})).truth.u0[1])
-    out = {}
-    for beyond in ("hold", "guarded"):
-        cfg = flies_on_config(trim)
-        cfg["campaign"].update(transitions=["elevon_lock", "right_elevon_lock"], trials=2,
-                               chunk_size=2, signature="none")
-        cfg["draws"] = {"elevon_lock_range_rad": [trim + math.radians(-13.0),
-                                                  trim + math.radians(-11.5)]}
-        cfg["timing"]["duration_s"] = 35.0
-        # the table reaches the trim side too: the monitor's first lock
-        # estimates lie there (with it cut at -4 deg, a right lock at -12.5
-        # deg left after 3.8 s)
-        cfg["monitor"].update(turn_beyond=beyond, turn_offsets_deg=[-14.0, 4.0])
-        t = api.run_campaign(cfg, jobs=1, progress=False, out=tmp_path / beyond).trials
-        out[beyond] = t.set_index(["transition", "trial_id"])
-    hold, guard = out["hold"], out["guarded"]
+    # the table reaches the trim side too: the monitor's first lock estimates
+    # lie there (with it cut at -4 deg, a right lock at -12.5 deg left after 3.8 s)
+    hold, guard = fly_both_ways(tmp_path, (-13.0, -11.5), [-14.0, 4.0], "guarded", 35.0)
     assert (hold["lock_position"] == guard["lock_position"]).all()
     assert (guard["side_correct"] == 1).all()
     assert (hold["status"] != "ok").all(), hold["status"].value_counts()
