@@ -89,7 +89,7 @@ from scipy.optimize import minimize
 
 from ftc_mc.core.sixdof import plant as kernels
 from ftc_mc.core.sixdof.layout import COMMAND, N_STATE, N_WIND, STATE
-from ftc_mc.design.lock_turn import DesignBox, design_point, healthy, lock_turn_lqr
+from ftc_mc.design.lock_turn import design_point, envelope_box, healthy, lock_turn_lqr
 from ftc_mc.io.atomic import write_text
 from ftc_mc.model.presets import PRESETS
 from ftc_mc.model.sixdof import build_sixdof_plant
@@ -101,8 +101,7 @@ DT, N_SUB, NODE = 0.1, 10, 0.2
 T_END = 60.0
 ENVELOPE = dict(va=(12.0, 30.0), alpha=(-8.0, 12.0), bank=60.0)
 """The trials' validity envelope (``validity`` defaults) [m/s, deg, deg]."""
-WIDE = DesignBox(airspeed=(12.5, 29.5), alpha=(math.radians(-7.5), math.radians(11.5)),
-                 bank=math.radians(59.5), gamma=(math.radians(-45.0), math.radians(30.0)))
+WIDE = envelope_box(ENVELOPE["va"], ENVELOPE["alpha"], ENVELOPE["bank"])
 """Where the oracle's design point may lie: the envelope less 0.5 of each bound."""
 LONG_NODE = 1.0
 """Command node spacing of the long horizons after their first :data:`FINE_S` [s]."""
