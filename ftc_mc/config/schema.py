@@ -451,7 +451,7 @@ class MonitorConfig(_Strict):
     rollout_guard_holds_s: tuple[Pos, ...] = (0.2, 0.5, 1.0)
     """guarded: how long each of the guard's candidates holds its (throttle, healthy elevon) pair before the LQR takes over [s] (distinct multiples of model.dt_s, below rollout_horizon_s; at least one); with 5 elevon levels, 10 pairs each."""
     rollout_guard_bank_margin_deg: Annotated[float, NoBool, Field(ge=0.5, le=30, allow_inf_nan=False)] = 10.0
-    """guarded: room the designs about steady flights outside the design box leave below validity.bank_max_deg [deg] (the other bounds keep 0.5 m/s or deg). On x8-pyfly, locks from -15 to -10 deg, 150 per side: 0.5 keeps 214 of 300 in for 60 s (designs at 59.5 deg of bank, which the noise tips over 60), 2 to 8 keep 244-255, 10 keeps 258 (245 on another seed, against 195 with 0.5), 12 keeps 241, 15 (the design box's 45 deg) 172 (docs/airframes.md)."""
+    """guarded: room the designs about steady flights outside the design box leave below validity.bank_max_deg [deg] (the other bounds keep 0.5 m/s or deg). On x8-pyfly, locks from -15 to -10 deg, 150 per side: 0.5 keeps 214 of 300 in for 60 s (designs at 59.5 deg of bank, which the noise tips over 60), 2 to 8 keep 244-255, 10 keeps 258 (245 on another seed, against 195 with 0.5), 12 keeps 241, 15 (the design box's 45 deg) 172. x8-gryte2018 needs 15: inside its trimmable set 62.7 / 63.1 % stay in, against 58.2 / 57.7 % with 10 (docs/airframes.md)."""
     rollout_substeps: Annotated[int, NoBool, Field(ge=1, le=100)] = 2
     """rollout: RK4 sub-steps per control period of those flights (the trials' truth uses 10); a sub-step (model.dt_s / rollout_substeps) must be at most 0.05 s: x8-pyfly's roll mode, -38.5 1/s, then gives h lambda = 1.9, inside RK4's 2.8."""
 
