@@ -241,26 +241,7 @@ def rocking_law(tab, pl, s, p, mx, z, lat, l, lo_dev, hi_dev, u):
     the airframe's equations keep inside the envelope longest.  Arguments as
     :func:`lock_turn_law`'s.  Returns False, writing nothing, when every
     candidate leaves within the first period (or the state is not finite)."""
-    x6 = np.empty(N_STATE)
-    lane_state(tab, pl, s, mx, z, lat, l, x6)
-    xs = np.empty(N_STATE)
-    cmd = np.empty(N_COMMAND)
-    wd = np.zeros(N_WIND)
-    rk = np.empty((N_WORK, N_STATE))
-    best, best_k, _ = rocking_choice(tab, pl, s, p, x6, lo_dev, hi_dev, xs, cmd, wd, rk)
-    if best_k == 0:  # every history leaves within a period (or the state is not finite)
-        return False
-    send_pair(tab, s, best, l, lo_dev, hi_dev, u)
-    return True
-
-
-@kernel(inline="always")
-def rocking_choice(tab, pl, s, p, x6, lo_dev, hi_dev, xs, cmd, wd, rk):
-    """The rocking law's choice from the absolute 6-DOF state ``x6``
-    (:func:`rocking_law`): ``(candidate, period it leaves in, largest excess
-    before)`` of the candidate that stays in longest, then with the widest
-    margin, the first on a tie (:func:`fly_history`; ``xs`` to ``rk`` work
-    arrays)."""
+    x6, xs, cmd, wd, rk = rollout_start(tab, pl, s, mx, z, lat, l)
     best = 0
     best_k = -1
     best_e = np.inf
@@ -271,7 +252,10 @@ def rocking_choice(tab, pl, s, p, x6, lo_dev, hi_dev, xs, cmd, wd, rk):
             best = c
             best_k = k_out
             best_e = worst
-    return best, best_k, best_e
+    if best_k == 0:  # every history leaves within a period (or the state is not finite)
+        return False
+    send_pair(tab, s, best, l, lo_dev, hi_dev, u)
+    return True
 
 
 @kernel(inline="always")
@@ -284,12 +268,15 @@ def send_pair(tab, s, c, l, lo_dev, hi_dev, u):
 
 
 @kernel(inline="always")
-def lane_state(tab, pl, s, mx, z, lat, l, x6):
-    """Lane ``l``'s 6-DOF state (absolute) over ``x6`` (15,): the monitor's
-    estimate on its rows (:func:`~ftc_mc.core.sixdof.monitor.on_trim`), the
-    fed-back states of side ``s`` from their sensors where ``tab.meas`` says
-    so, the rest of the 6-DOF trim."""
+def rollout_start(tab, pl, s, mx, z, lat, l):
+    """What the rocking law and the guard fly from: ``(x6, xs, cmd, wd, rk)``,
+    lane ``l``'s 6-DOF state (absolute, 15): the monitor's estimate on its
+    rows (:func:`~ftc_mc.core.sixdof.monitor.on_trim`), the fed-back states
+    of side ``s`` from their sensors where ``tab.meas`` says so, the rest of
+    the 6-DOF trim; then :func:`fly_history`'s work arrays (the flown state,
+    the commands, still air, the RK4 stages)."""
     mon = pl.monitor
+    x6 = np.empty(N_STATE)
     on_trim(mon, pl, mx[:, l], x6)
     nz = z.shape[0]
     for r in range(tab.meas.shape[1]):
@@ -297,12 +284,14 @@ def lane_state(tab, pl, s, mx, z, lat, l, x6):
         if o >= 0:
             j = mon.states[tab.rows[s, r]]
             x6[j] = pl.x0[j] + (z[o, l] if o < nz else lat[o - nz, l])
+    return (x6, np.empty(N_STATE), np.empty(N_COMMAND), np.zeros(N_WIND),
+            np.empty((N_WORK, N_STATE)))
 
 
 @kernel(internal=True)
 def guarded_law(tab, pl, s, i, j1, w, p, mx, z, lat, l, lo_dev, hi_dev, u):
     """The rollout guard on the lock-turn LQR (``monitor.turn_beyond:
-    guarded``; module docstring).  From the lane's state (:func:`lane_state`),
+    guarded``; module docstring).  From the lane's state (:func:`rollout_start`),
     the airframe's equations fly ``tab.ro_steps`` periods under the LQR of the
     designs ``i`` and ``j1`` (weight ``w`` on ``j1``; :func:`turn_command`).
     If that flight stays inside the envelope, returns False and writes
@@ -315,12 +304,7 @@ def guarded_law(tab, pl, s, i, j1, w, p, mx, z, lat, l, lo_dev, hi_dev, u):
     tie).  When the LQR's own flight wins, returns False; else writes the
     winning pair and returns True.  Arguments as :func:`lock_turn_law`'s and
     :func:`turn_law`'s."""
-    x6 = np.empty(N_STATE)
-    lane_state(tab, pl, s, mx, z, lat, l, x6)
-    xs = np.empty(N_STATE)
-    cmd = np.empty(N_COMMAND)
-    wd = np.zeros(N_WIND)
-    rk = np.empty((N_WORK, N_STATE))
+    x6, xs, cmd, wd, rk = rollout_start(tab, pl, s, mx, z, lat, l)
     best = -1
     best_h = 0
     best_k = -1
