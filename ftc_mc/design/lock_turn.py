@@ -338,7 +338,8 @@ def _polish(p, side, lock, w):
 
 def design_point(airframe: Airframe, side: str, lock: float, box: DesignBox = DesignBox(),
                  weights: DesignWeights = DesignWeights(), V0: float = 20.0,
-                 gamma0_deg: float = -3.0, extra_starts=()) -> DesignPoint:
+                 gamma0_deg: float = -3.0, extra_starts=(),
+                 nearest: bool = True) -> DesignPoint | None:
     """The design point of the lock-turn controller (module docstring, steps 1-2).
 
     Parameters
@@ -359,16 +360,21 @@ def design_point(airframe: Airframe, side: str, lock: float, box: DesignBox = De
         Nominal air-path angle [deg].
     extra_starts : sequence of array_like
         More starting points (:data:`~ftc_mc.model.trimmable.UNKNOWNS`).
+    nearest : bool
+        Where the lock has no steady flight in the box, design about the
+        nearest lock that has one (a bisection towards the trim position);
+        False: return None instead.
 
     Returns
     -------
-    DesignPoint
+    DesignPoint or None
+        None only with ``nearest=False``.
 
     Raises
     ------
     ValueError
         When not even the trim position of the locked elevon has a steady
-        flight in the box.
+        flight in the box (``nearest`` only).
     """
     other = healthy(side)
     tr = trim6(airframe, V0, gamma0_deg)
@@ -385,6 +391,8 @@ def design_point(airframe: Airframe, side: str, lock: float, box: DesignBox = De
 
     best = attempt(lock, [np.asarray(s, dtype=float) for s in extra_starts])
     design_lock = float(lock)
+    if best is None and not nearest:
+        return None
     if best is None:
         inside = attempt(trim_pos)
         if inside is None:
@@ -622,12 +630,14 @@ def _designs(airframe, offsets, V0, gamma0_deg, dt, wide=None) -> LockTurnDesign
     for s, side in enumerate(SIDES):
         for i, off in enumerate(offsets):
             lock[s, i] = trim_cmd[COMMAND[side]] + off
-            d = lock_turn_lqr(airframe, side, float(lock[s, i]), dt, V0=V0,
+            point = None  # the design box's, with its nearest steady lock if need be
+            if wide is not None:  # the lock's own steady flight in either box first
+                for box in (DesignBox(), wide):
+                    if point is None:
+                        point = design_point(airframe, side, float(lock[s, i]), box=box,
+                                             V0=V0, gamma0_deg=gamma0_deg, nearest=False)
+            d = lock_turn_lqr(airframe, side, float(lock[s, i]), dt, point=point, V0=V0,
                               gamma0_deg=gamma0_deg)
-            if wide is not None and not d.point.steady:
-                dw = lock_turn_lqr(airframe, side, float(lock[s, i]), dt, V0=V0,
-                                   gamma0_deg=gamma0_deg, box=wide)
-                d = dw if dw.point.steady else d
             x[s, i], cmd[s, i] = d.point.x, d.point.cmd
             K[s, i], k[s, i] = d.K, d.k
             steady[s, i] = d.point.lock == d.point.design_lock
