@@ -203,6 +203,16 @@ def campaign_configs() -> dict:
              "the lock-turn controller once the side monitor names the elevon), on the "
              "same trials; --dof 3 --design paper --design paper_nominal for the "
              "longitudinal plant", omit=six)
+    linear = cfg.model_copy(update={
+        "plant": cfg.plant.model_copy(update={"kind": "linear"}),
+        "monitor": cfg.monitor.model_copy(update={"turn_offsets_deg": (-8.0, 8.0)})})
+    files["sixdof_survival_linear.yaml"] = render_yaml(
+        linear, "ftc-mc run configs/sixdof_survival_linear.yaml -- configs/sixdof_survival"
+                ".yaml's trials on the 6-DOF linear plant (issue 26's setting): sixdof's "
+                "lock-turn table is designed on the linear model the plant flies "
+                "(monitor.turn_model: auto), whose steady flights span -4.75 to +5.5 deg "
+                "of trim (left elevon) and -5.25 to +5.5 deg (right) on x8-pyfly, so the "
+                "table spans -8 to +8 deg", omit=six)
     cfg = cfg.model_copy(update={"monitor": cfg.monitor.model_copy(
         update={"turn_beyond": "rollout"})})
     files["sixdof_rocking.yaml"] = render_yaml(

@@ -102,3 +102,53 @@ def test_a_lock_with_no_steady_flight_designs_about_the_nearest_one():
     assert pt.x[STATE["left"]] == pt.design_lock
     # the command holds the true lock on the dead elevon
     assert d.command(pt.x)[COMMAND["left"]] == pt.lock
+
+
+# --- designs on the 6-DOF linear model (monitor.turn_model: linear) ---
+
+@pytest.fixture(scope="module")
+def linear_plant():
+    from ftc_mc.model.sixdof import build_sixdof_plant
+
+    return build_sixdof_plant(AF)
+
+
+def test_on_the_linear_model_the_gain_is_its_own_lqr(linear_plant):
+    """A design on the linear model flies its discrete matrices' rows and
+    columns of the fed-back states, with python-control's discounted LQR on
+    them (as the paper's controllers are designed on eq. 1's model); a steady
+    lock has no constant term, and the law holds the design point."""
+    control = pytest.importorskip("control")
+    pl = linear_plant
+    d = lock_turn_lqr(AF, "right", lock_at("right", 3.0), plant=pl)
+    assert d.point.steady
+    idx, inputs = d.idx, list(d.inputs)
+    np.testing.assert_array_equal(d.A, pl.A[np.ix_(idx, idx)])
+    np.testing.assert_array_equal(d.B, pl.B[np.ix_(idx, inputs)])
+    sa = math.sqrt(d.alpha)
+    K, _, _ = control.dlqr(sa * d.A, sa * d.B, d.Q, d.R)
+    np.testing.assert_allclose(d.K, K, rtol=1e-7, atol=1e-9)
+    assert not d.F.any() and not d.k.any()
+    assert np.max(np.abs(d.closed_loop)) < 0.99
+    np.testing.assert_allclose(d.command(d.point.x), d.point.cmd, rtol=0, atol=1e-15)
+    # one step of the linear plant from the design point leaves it there
+    dx, du = d.point.x - pl.trim.x0, d.point.cmd - pl.u0
+    step = pl.A @ dx + pl.B @ du - dx
+    assert np.abs(step[idx]).max() < 1e-12
+
+
+def test_on_the_linear_model_a_far_lock_designs_about_its_nearest(linear_plant):
+    """-6 deg has no steady flight of the linear model in the design box (its
+    steady flights end near -3.5 deg on the left, docs/airframes.md): the
+    design is about the nearest lock that has one, and the held offset
+    enters as the plant's own constant input, its actuator's column and its
+    command's."""
+    pl = linear_plant
+    d = lock_turn_lqr(AF, "left", lock_at("left", -6.0), plant=pl)
+    pt = d.point
+    assert not pt.steady and -4.0 < pt.design_offset_deg < -3.0
+    locked = STATE["left"]
+    F = (pl.A[d.idx, locked] + pl.B[d.idx, COMMAND["left"]]) * (pt.lock - pt.design_lock)
+    np.testing.assert_array_equal(d.F, F)
+    assert np.abs(d.k).max() > 0
+    assert d.command(pt.x)[COMMAND["left"]] == pt.lock

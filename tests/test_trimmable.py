@@ -10,7 +10,7 @@ import math
 import numpy as np
 import pytest
 
-from ftc_mc.core.sixdof.layout import STATE
+from ftc_mc.core.sixdof.layout import OUTPUT, STATE
 from ftc_mc.model.presets import PRESETS
 from ftc_mc.model.sixdof import derivatives, pack_parameters, trim6
 from ftc_mc.model.trimmable import _state, steady_flight, trimmable_set
@@ -48,3 +48,76 @@ def test_at_20_mps_and_minus_3_deg_as_the_held_out_analysis(offset_deg, steady):
     if steady:
         assert abs(f.values["airspeed"] - 20.0) < 1e-12
         assert abs(f.values["gamma"] - math.radians(-3.0)) < 1e-8
+
+
+# --- the 6-DOF linear model's steady flights (the linear plant's own) ---
+
+PLANT = None
+
+
+def linear_plant():
+    global PLANT
+    if PLANT is None:
+        from ftc_mc.model.sixdof import build_sixdof_plant
+
+        PLANT = build_sixdof_plant(AF)
+    return PLANT
+
+
+def test_a_linear_steady_flight_is_an_equilibrium_of_the_continuous_model():
+    """The lock-turn design point on the linear model with the left elevon
+    4 deg above trim (:func:`ftc_mc.design.lock_turn.design_point`), put back
+    into the linear model before its zero-order hold (``Ac``, ``Bc``, which
+    :func:`linear_steady` does not read): the rigid-body states and the
+    actuators do not move, the dead elevon sits at its lock, and it turns,
+    banked, inside the design box."""
+    from ftc_mc.core.sixdof.layout import COMMAND
+    from ftc_mc.design.lock_turn import DesignBox, design_point
+
+    pl = linear_plant()
+    lock = pl.u0[COMMAND["left"]] + math.radians(4.0)
+    pt = design_point(AF, "left", lock, plant=pl)
+    assert pt.steady
+    dx, du = pt.x - pl.trim.x0, pt.cmd - pl.u0
+    assert pt.cmd[COMMAND["left"]] == lock
+    rows = [STATE[n] for n in ("phi", "theta", "u", "v", "w", "p", "q", "r",
+                               "throttle", "left", "right")]
+    assert np.abs((pl.Ac @ dx + pl.Bc @ du)[rows]).max() < 1e-9
+    box, v = DesignBox(), pt.values
+    assert math.radians(20.0) < abs(v["phi"]) <= box.bank + 1e-9
+    assert box.airspeed[0] - 1e-9 <= v["airspeed"] <= box.airspeed[1] + 1e-9
+    assert abs(v["turn_rate"]) > 0.01
+    assert abs(v["airspeed"] - (pl.trim.y0[OUTPUT["Va"]] + pl.C[OUTPUT["Va"]] @ dx)) < 1e-12
+
+
+@pytest.mark.parametrize("offset_deg", [-6.0, -3.0, 0.0, 4.0, 7.0, -8.0])
+def test_the_linear_trimmable_set_agrees_with_a_search_of_its_plane(offset_deg):
+    """:func:`linear_steady_flight` (a linear programme) against a plain
+    search: the steady flights form a plane, on which airspeed and bank are
+    coordinates; solving the steady conditions for each point of a grid of
+    them (12-30 m/s by 0.05, +-60 deg by 0.25) finds one inside the envelope
+    and the limits exactly where the programme does.  The linear model is
+    narrower than the airframe's equations, which have steady turns from -29
+    to +2.25 deg (docs/airframes.md): at -6 and -8 deg neither finds one."""
+    from ftc_mc.core.sixdof.layout import COMMAND
+    from ftc_mc.model.trimmable import linear_quantities, linear_steady, linear_steady_flight
+
+    pl = linear_plant()
+    lock = pl.u0[COMMAND["left"]] + math.radians(offset_deg)
+    s = linear_steady(pl, "left", lock)
+    q = linear_quantities(pl, s)
+    square = np.vstack([s.M, q["Va"][1], q["phi"][1]])
+    va, bank = np.meshgrid(np.arange(12.0, 30.0 + 1e-9, 0.05),
+                           np.radians(np.arange(-60.0, 60.0 + 1e-9, 0.25)))
+    rhs = np.vstack([np.repeat(-s.c[:, None], va.size, axis=1),
+                     va.ravel() - q["Va"][0], bank.ravel() - q["phi"][0]])
+    z = np.linalg.solve(square, rhs)
+    v = {n: q[n][0] + q[n][1] @ z for n in q}
+    lo_t, hi_t = AF.throttle_limits
+    lo_e, hi_e = AF.elevon_limits
+    ok = ((np.radians(-8.0) <= v["alpha"]) & (v["alpha"] <= np.radians(12.0))
+          & (np.abs(v["beta"]) <= 0.5) & (np.abs(v["theta"]) <= 1.2) & (np.abs(v["r"]) <= 2.0)
+          & (lo_t <= v["throttle"]) & (v["throttle"] <= hi_t)
+          & (lo_e <= v["free_elevon"]) & (v["free_elevon"] <= hi_e))
+    assert linear_steady_flight(pl, "left", lock) == bool(ok.any())
+    assert bool(ok.any()) == (offset_deg in (-3.0, 0.0, 4.0))

@@ -79,8 +79,9 @@ from threadpoolctl import threadpool_limits
 from ..core.sixdof.layout import COMMAND, OUTPUT, STATE
 from ..model.airframe import Airframe
 from ..model.linear import jacobian, zoh
-from ..model.sixdof import derivatives, outputs, trim6
-from ..model.trimmable import UNKNOWNS, _state, steady_flight
+from ..model.sixdof import build_sixdof_plant, derivatives, outputs, trim6
+from ..model.trimmable import (UNKNOWNS, _state, linear_closest, linear_quantities,
+                               linear_steady, steady_flight)
 from .cache import default_cache_dir, write_atomic
 from .theorem41 import ALPHA, biased_discounted_lqr
 
@@ -336,10 +337,49 @@ def _polish(p, side, lock, w):
     return ww, float(np.max(np.abs(sol.fun)))
 
 
+def _closest_linear(plant, side, lock, box, weights):
+    """:func:`_closest` on the 6-DOF linear model ``plant``: ``(J, (s, z))`` or
+    ``None`` (:func:`~ftc_mc.model.trimmable.linear_closest` in the box, the
+    cost of the module docstring about the plant's trim)."""
+    lo, hi = box.bounds()
+    bounds = {"Va": box.airspeed, "alpha": box.alpha, "beta": (lo[2], hi[2]),
+              "phi": (lo[3], hi[3]), "theta": (lo[4], hi[4]), "r": (lo[5], hi[5]),
+              "throttle": box.throttle, "free_elevon": (lo[7], hi[7]), "gamma": box.gamma}
+    tr = plant.trim
+    cost = {"Va": (tr.V0, weights.airspeed), "gamma": (tr.gamma0, weights.gamma),
+            "phi": (0.0, weights.bank)}
+    s = linear_steady(plant, side, lock)
+    z = linear_closest(plant, s, bounds, cost)
+    if z is None:
+        return None
+    q = linear_quantities(plant, s)
+    return (float(sum(((q[n][0] + q[n][1] @ z - t) / sc) ** 2 for n, (t, sc) in cost.items())),
+            (s, z))
+
+
+def _linear_point(plant, found):
+    """State, commands (absolute), :data:`UNKNOWNS` with ``gamma``, and the
+    steady residual of a steady flight of the linear model
+    (:func:`_closest_linear`'s ``(s, z)``); its turn rate is the heading's
+    rate of change [rad/s]."""
+    s, z = found
+    tr = plant.trim
+    dx, du = s.x + s.X @ z, s.u + s.U @ z
+    q = linear_quantities(plant, s)
+    values = {"airspeed": "Va", "alpha": "alpha", "beta": "beta", "phi": "phi",
+              "theta": "theta", "throttle": "throttle", "free_elevon": "free_elevon",
+              "gamma": "gamma"}
+    values = {k: float(q[n][0] + q[n][1] @ z) for k, n in values.items()}
+    psi = STATE["psi"]
+    values["turn_rate"] = float((plant.A[psi] @ dx + plant.B[psi] @ du - dx[psi]) / plant.dt)
+    residual = float(np.max(np.abs(s.M @ z + s.c)))
+    return tr.x0 + dx, tr.u0 + du, values, residual
+
+
 def design_point(airframe: Airframe, side: str, lock: float, box: DesignBox = DesignBox(),
                  weights: DesignWeights = DesignWeights(), V0: float = 20.0,
                  gamma0_deg: float = -3.0, extra_starts=(),
-                 nearest: bool = True) -> DesignPoint | None:
+                 nearest: bool = True, plant=None) -> DesignPoint | None:
     """The design point of the lock-turn controller (module docstring, steps 1-2).
 
     Parameters
@@ -364,6 +404,11 @@ def design_point(airframe: Airframe, side: str, lock: float, box: DesignBox = De
         Where the lock has no steady flight in the box, design about the
         nearest lock that has one (a bisection towards the trim position);
         False: return None instead.
+    plant : SixDofPlant, optional
+        Find the steady flight of this 6-DOF linear model
+        (:class:`~ftc_mc.model.trimmable.LinearSteady`: the linear plant's own,
+        ``monitor.turn_model: linear``) instead of the airframe's equations';
+        its trim must be the one of ``V0`` and ``gamma0_deg``.
 
     Returns
     -------
@@ -385,6 +430,8 @@ def design_point(airframe: Airframe, side: str, lock: float, box: DesignBox = De
                         tr.u0[COMMAND["throttle"]], tr.u0[COMMAND[other]]])
 
     def attempt(pos, more=()):
+        if plant is not None:
+            return _closest_linear(plant, side, pos, box, weights)
         f = steady_flight(airframe, side, pos, starts=4)
         starts = [np.array([f.values[k] for k in UNKNOWNS]), nominal, *more]
         return _closest(p, side, pos, box, weights, tr.V0, gamma0, starts)
@@ -407,10 +454,13 @@ def design_point(airframe: Airframe, side: str, lock: float, box: DesignBox = De
             else:
                 a, inside = mid, found
         design_lock, best = a, inside
-    w, residual = _polish(p, side, design_lock, best[1])
-    x, cmd = _state(w, side, design_lock)
-    values = dict(zip(UNKNOWNS, (float(v) for v in w)))
-    values["gamma"] = float(outputs(x, p)[OUTPUT["gamma"]])
+    if plant is not None:
+        x, cmd, values, residual = _linear_point(plant, best[1])
+    else:
+        w, residual = _polish(p, side, design_lock, best[1])
+        x, cmd = _state(w, side, design_lock)
+        values = dict(zip(UNKNOWNS, (float(v) for v in w)))
+        values["gamma"] = float(outputs(x, p)[OUTPUT["gamma"]])
     return DesignPoint(side=side, lock=float(lock), design_lock=design_lock,
                        offset_deg=math.degrees(lock - trim_pos),
                        design_offset_deg=math.degrees(design_lock - trim_pos),
@@ -430,10 +480,12 @@ class LockTurnDesign:
         Their indices in the 15-state layout.
     inputs : tuple of int
         Command indices of the throttle and the healthy elevon.
-    Ac, Bc : ndarray, shapes (10, 10), (10, 2)
-        Continuous Jacobians at the design point [1/s].
+    Ac, Bc : ndarray, shapes (10, 10), (10, 2), or None
+        Continuous Jacobians at the design point [1/s] (of a linear model:
+        its own, None when it has none).
     A, B : ndarray
-        Their zero-order hold at ``dt``.
+        Their zero-order hold at ``dt`` (of a linear model: its discrete
+        matrices' rows and columns).
     F : ndarray, shape (10,)
         Constant input per step from ``lock - design_lock`` (zero when steady).
     K : ndarray, shape (2, 10)
@@ -488,7 +540,8 @@ class LockTurnDesign:
 
 def lock_turn_lqr(airframe: Airframe, side: str, lock: float, dt: float = 0.1,
                   weights: TurnWeights = TurnWeights(), alpha: float = ALPHA,
-                  point: DesignPoint | None = None, **point_kw) -> LockTurnDesign:
+                  point: DesignPoint | None = None, plant=None,
+                  **point_kw) -> LockTurnDesign:
     """Design the lock-turn controller of one side and lock (module docstring).
 
     Parameters
@@ -507,6 +560,11 @@ def lock_turn_lqr(airframe: Airframe, side: str, lock: float, dt: float = 0.1,
         Discount in (0, 1] (the paper's 0.999).
     point : DesignPoint, optional
         A design point already found for this side and lock.
+    plant : SixDofPlant, optional
+        Design on this 6-DOF linear model (``monitor.turn_model: linear``):
+        its design point (:func:`design_point`'s ``plant``), and its own
+        discrete matrices in place of the airframe's equations' Jacobians at
+        the point; ``dt`` must be its period.
     **point_kw
         Passed to :func:`design_point`.
 
@@ -515,21 +573,32 @@ def lock_turn_lqr(airframe: Airframe, side: str, lock: float, dt: float = 0.1,
     LockTurnDesign
     """
     if point is None:
-        point = design_point(airframe, side, lock, **point_kw)
-    p = trim6(airframe).params
+        point = design_point(airframe, side, lock, plant=plant, **point_kw)
     names = turn_states(side)
     idx = np.array([STATE[n] for n in names])
     inputs = (COMMAND["throttle"], COMMAND[healthy(side)])
     locked = STATE[side]
-    x0, u0 = point.x, point.cmd
-    Jx = jacobian(lambda x: derivatives(x, u0, p), x0)
-    Ju = jacobian(lambda u: derivatives(x0, u, p), u0)
-    Ac = Jx[np.ix_(idx, idx)]
-    Bc = Ju[np.ix_(idx, list(inputs))]
-    # the locked elevon's offset from the design lock as a third (held) input
-    Ad, Bd = zoh(Ac, np.column_stack((Bc, Jx[idx, locked])), dt)
-    A, B = np.array(Ad), np.array(Bd[:, :2])
-    F = Bd[:, 2] * (point.lock - point.design_lock)
+    if plant is not None:
+        if not math.isclose(plant.dt, dt):
+            raise ValueError(f"the linear model's period is {plant.dt} s, not dt = {dt} s")
+        Ac = None if plant.Ac is None else plant.Ac[np.ix_(idx, idx)]
+        Bc = None if plant.Bc is None else plant.Bc[np.ix_(idx, list(inputs))]
+        A = plant.A[np.ix_(idx, idx)]
+        B = plant.B[np.ix_(idx, list(inputs))]
+        # the held lock offset: its actuator state and its command
+        F = (plant.A[idx, locked] + plant.B[idx, COMMAND[side]]) * (point.lock
+                                                                    - point.design_lock)
+    else:
+        p = trim6(airframe).params
+        x0, u0 = point.x, point.cmd
+        Jx = jacobian(lambda x: derivatives(x, u0, p), x0)
+        Ju = jacobian(lambda u: derivatives(x0, u, p), u0)
+        Ac = Jx[np.ix_(idx, idx)]
+        Bc = Ju[np.ix_(idx, list(inputs))]
+        # the locked elevon's offset from the design lock as a third (held) input
+        Ad, Bd = zoh(Ac, np.column_stack((Bc, Jx[idx, locked])), dt)
+        A, B = np.array(Ad), np.array(Bd[:, :2])
+        F = Bd[:, 2] * (point.lock - point.design_lock)
     Q, R = weights.matrices(side)
     sol = biased_discounted_lqr(A, B, F, Q, R, alpha)
     return LockTurnDesign(point=point, states=names, idx=idx, inputs=inputs, Ac=Ac, Bc=Bc,
@@ -582,7 +651,7 @@ SIDES = ("left", "right")
 
 def lock_turn_designs(airframe: Airframe, offsets, V0: float = 20.0,
                       gamma0_deg: float = -3.0, dt: float = 0.1,
-                      wide: DesignBox | None = None) -> LockTurnDesigns:
+                      wide: DesignBox | None = None, linear: bool = False) -> LockTurnDesigns:
     """:func:`lock_turn_lqr` of both sides at each lock offset from trim.
 
     Parameters
@@ -600,6 +669,11 @@ def lock_turn_designs(airframe: Airframe, offsets, V0: float = 20.0,
         about its own steady flight in this box if it has one
         (:func:`envelope_box`; ``monitor.turn_beyond: guarded``); else, and
         without it, about the nearest lock that has one in the design box.
+    linear : bool
+        Design on the 6-DOF linear model at the trim of ``V0``, ``gamma0_deg``
+        and ``dt`` (:func:`~ftc_mc.model.sixdof.build_sixdof_plant`: the linear
+        plant's own; ``monitor.turn_model: linear``) instead of the airframe's
+        equations.
 
     Returns
     -------
@@ -614,12 +688,13 @@ def lock_turn_designs(airframe: Airframe, offsets, V0: float = 20.0,
     """
     offsets = np.asarray(offsets, dtype=float)
     with threadpool_limits(limits=1, user_api="blas"):
-        return _designs(airframe, offsets, V0, gamma0_deg, dt, wide)
+        return _designs(airframe, offsets, V0, gamma0_deg, dt, wide, linear)
 
 
-def _designs(airframe, offsets, V0, gamma0_deg, dt, wide=None) -> LockTurnDesigns:
+def _designs(airframe, offsets, V0, gamma0_deg, dt, wide=None, linear=False) -> LockTurnDesigns:
     """:func:`lock_turn_designs` on the threads in force."""
     n = offsets.size
+    plant = build_sixdof_plant(airframe, V0, gamma0_deg, dt) if linear else None
     trim_cmd = trim6(airframe, V0, gamma0_deg).u0
     lock = np.empty((2, n))
     x = np.empty((2, n, len(STATE)))
@@ -635,9 +710,10 @@ def _designs(airframe, offsets, V0, gamma0_deg, dt, wide=None) -> LockTurnDesign
                 for box in (DesignBox(), wide):
                     if point is None:
                         point = design_point(airframe, side, float(lock[s, i]), box=box,
-                                             V0=V0, gamma0_deg=gamma0_deg, nearest=False)
+                                             V0=V0, gamma0_deg=gamma0_deg, nearest=False,
+                                             plant=plant)
             d = lock_turn_lqr(airframe, side, float(lock[s, i]), dt, point=point, V0=V0,
-                              gamma0_deg=gamma0_deg)
+                              gamma0_deg=gamma0_deg, plant=plant)
             x[s, i], cmd[s, i] = d.point.x, d.point.cmd
             K[s, i], k[s, i] = d.K, d.k
             steady[s, i] = d.point.lock == d.point.design_lock
@@ -646,10 +722,12 @@ def _designs(airframe, offsets, V0, gamma0_deg, dt, wide=None) -> LockTurnDesign
 
 
 def lock_turn_designs_key(airframe: Airframe, offsets, V0: float, gamma0_deg: float,
-                          dt: float, wide: DesignBox | None = None) -> str:
+                          dt: float, wide: DesignBox | None = None,
+                          linear: bool = False) -> str:
     """SHA-256 cache key of every input of :func:`lock_turn_designs`: the packed
     6-DOF parameters and command limits of the airframe, the grid, the glide,
-    the period, the default design box and weights, the wide box if any,
+    the period, the default design box and weights, the wide box if any, the
+    linear model if designed on it,
     :data:`LOCK_TURN_TABLE_VERSION` and the OpenBLAS kernels in force
     (``ftc_mc/blas.py``)."""
     h = hashlib.sha256()
@@ -658,6 +736,8 @@ def lock_turn_designs_key(airframe: Airframe, offsets, V0: float, gamma0_deg: fl
     h.update(repr((DesignBox(), DesignWeights(), TurnWeights(), ALPHA, LOCK_TOLERANCE)).encode())
     if wide is not None:
         h.update(f"wide:{wide!r}".encode())
+    if linear:
+        h.update(b"model:linear")
     for a in (trim6(airframe, V0, gamma0_deg).params, airframe.command_lower,
               airframe.command_upper, offsets, [V0, gamma0_deg, dt]):
         b = np.ascontiguousarray(a, dtype=np.float64)
@@ -669,14 +749,15 @@ def lock_turn_designs_key(airframe: Airframe, offsets, V0: float, gamma0_deg: fl
 def cached_lock_turn_designs(airframe: Airframe, offsets, V0: float = 20.0,
                              gamma0_deg: float = -3.0, dt: float = 0.1,
                              cache_dir=None, stream=None,
-                             wide: DesignBox | None = None) -> LockTurnDesigns:
+                             wide: DesignBox | None = None,
+                             linear: bool = False) -> LockTurnDesigns:
     """:func:`lock_turn_designs`, cached on disk as ``.npz``
     (``<cache_dir>/lock_turn/<sha256>.npz``, key :func:`lock_turn_designs_key`,
     written atomically; an unreadable or mismatching file is recomputed).
 
     Parameters
     ----------
-    airframe, offsets, V0, gamma0_deg, dt, wide
+    airframe, offsets, V0, gamma0_deg, dt, wide, linear
         As :func:`lock_turn_designs`.
     cache_dir : str or Path, optional
         Cache root; default :func:`ftc_mc.design.cache.default_cache_dir`.
@@ -689,7 +770,7 @@ def cached_lock_turn_designs(airframe: Airframe, offsets, V0: float = 20.0,
     LockTurnDesigns
     """
     offsets = np.asarray(offsets, dtype=float)
-    key = lock_turn_designs_key(airframe, offsets, V0, gamma0_deg, dt, wide)
+    key = lock_turn_designs_key(airframe, offsets, V0, gamma0_deg, dt, wide, linear)
     folder = Path(cache_dir) if cache_dir is not None else default_cache_dir()
     path = folder / "lock_turn" / f"{key}.npz"
     fields = [f.name for f in dataclasses.fields(LockTurnDesigns)]
@@ -704,7 +785,7 @@ def cached_lock_turn_designs(airframe: Airframe, offsets, V0: float = 20.0,
         print(f"ftc-mc: designing the lock-turn controllers ({offsets.size} lock positions "
               "per elevon; cached afterwards)", file=stream, flush=True)
     t0 = time.perf_counter()
-    d = lock_turn_designs(airframe, offsets, V0, gamma0_deg, dt, wide)
+    d = lock_turn_designs(airframe, offsets, V0, gamma0_deg, dt, wide, linear)
     if stream is not None:
         print(f"ftc-mc: lock-turn controllers designed in {time.perf_counter() - t0:.1f} s",
               file=stream, flush=True)

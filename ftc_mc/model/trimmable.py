@@ -179,3 +179,156 @@ def trimmable_set(airframe: Airframe, side: str, offsets_deg, **kw) -> list:
     tr = trim6(airframe)
     return [steady_flight(airframe, side, tr.u0[COMMAND[side]] + math.radians(o), **kw)
             for o in offsets_deg]
+
+
+LINEAR_FREE = ("phi", "theta", "u", "v", "w", "p", "q", "r")
+"""The rigid-body states of a steady flight of the 6-DOF linear model (its
+unknowns, with the throttle and the healthy elevon)."""
+
+
+@dataclasses.dataclass(frozen=True)
+class LinearSteady:
+    """The steady flights of the 6-DOF linear model with one elevon locked.
+
+    The linear plant (``plant.kind: linear``) flies ``x+ = A x + B u`` in
+    deviations from its trim, and has no steady turn in the sense of the
+    authors' equations: its pitch rate, for one, stays ``q`` where a banked
+    turn has ``Omega sin(phi) cos(theta)``.  A flight of it is steady when the
+    rigid-body states of :data:`LINEAR_FREE` repeat, ``x = A x + B u`` on their
+    rows, with each actuator at its command.  With ``z`` their deviations
+    and the throttle's and healthy elevon's command deviations (10), the
+    state deviation is ``x + X z`` and the command deviation ``u + U z``
+    (positions and heading zero, the locked elevon at its lock), and the
+    flight is steady when ``M z + c = 0`` (8 conditions): a plane of
+    steady flights per lock.
+
+    Attributes
+    ----------
+    side : str
+        The locked elevon.
+    lock : float
+        Its absolute position [rad].
+    x, X : ndarray, shapes (15,), (15, 10)
+    u, U : ndarray, shapes (3,), (3, 10)
+    M, c : ndarray, shapes (8, 10), (8,)
+    """
+
+    side: str
+    lock: float
+    x: np.ndarray
+    X: np.ndarray
+    u: np.ndarray
+    U: np.ndarray
+    M: np.ndarray
+    c: np.ndarray
+
+
+def linear_steady(plant, side: str, lock: float) -> LinearSteady:
+    """:class:`LinearSteady` of ``plant`` (a
+    :class:`~ftc_mc.model.sixdof.SixDofPlant`) with the ``side`` elevon locked
+    at ``lock`` [rad, absolute]."""
+    other = "right" if side == "left" else "left"
+    free = [STATE[n] for n in LINEAR_FREE]
+    inputs = [COMMAND["throttle"], COMMAND[other]]
+    n = len(free) + len(inputs)
+    X = np.zeros((N_STATE, n))
+    U = np.zeros((N_COMMAND, n))
+    X[free, np.arange(len(free))] = 1.0
+    U[inputs, len(free) + np.arange(len(inputs))] = 1.0
+    u = np.zeros(N_COMMAND)
+    u[COMMAND[side]] = lock - plant.u0[COMMAND[side]]
+    x = np.zeros(N_STATE)
+    for name in LAYOUT.actuators:  # each actuator at its command
+        x[STATE[name]] = u[COMMAND[name]]
+        X[STATE[name]] = U[COMMAND[name]]
+    A, B = np.asarray(plant.A), np.asarray(plant.B)
+    G = A[free] - np.eye(N_STATE)[free]
+    return LinearSteady(side=side, lock=float(lock), x=x, X=X, u=u, U=U,
+                        M=G @ X + B[free] @ U, c=G @ x + B[free] @ u)
+
+
+def linear_quantities(plant, s: LinearSteady) -> dict:
+    """The quantities a box bounds, each affine in ``z``: name -> ``(a, b)``
+    with the absolute value ``a + b @ z``: ``Va`` [m/s], ``alpha``, ``beta``,
+    ``gamma``, ``phi``, ``theta`` [rad], ``r`` [rad/s] (the linear plant's
+    outputs and states) and the ``throttle`` [-] and ``free_elevon`` [rad]
+    commands."""
+    tr = plant.trim
+    C = np.asarray(plant.C)
+    y0 = tr.y0
+    out = {n: (y0[OUTPUT[n]] + C[OUTPUT[n]] @ s.x, C[OUTPUT[n]] @ s.X)
+           for n in ("Va", "alpha", "beta", "gamma")}
+    for n in ("phi", "theta", "r"):
+        out[n] = (tr.x0[STATE[n]] + s.x[STATE[n]], s.X[STATE[n]])
+    other = "right" if s.side == "left" else "left"
+    for n, k in (("throttle", COMMAND["throttle"]), ("free_elevon", COMMAND[other])):
+        out[n] = (plant.u0[k] + s.u[k], s.U[k])
+    return out
+
+
+def linear_closest(plant, s: LinearSteady, bounds: dict, cost=None):
+    """A steady flight of ``s`` inside ``bounds``, or None.
+
+    Parameters
+    ----------
+    plant : SixDofPlant
+    s : LinearSteady
+    bounds : dict
+        Name of :func:`linear_quantities` -> ``(lo, hi)`` (absolute; either
+        may be None).
+    cost : dict, optional
+        Name -> ``(target, scale)``: the flight minimising the sum of
+        ``((value - target) / scale)^2`` (SLSQP; the problem is convex);
+        default: any flight inside (``scipy.optimize.linprog``).
+
+    Returns
+    -------
+    ndarray, shape (10,), or None
+        ``z`` (:class:`LinearSteady`).
+    """
+    q = linear_quantities(plant, s)
+    rows, rhs = [], []
+    for name, (lo, hi) in bounds.items():
+        a, b = q[name]
+        if lo is not None:
+            rows.append(-b)
+            rhs.append(a - lo)
+        if hi is not None:
+            rows.append(b)
+            rhs.append(hi - a)
+    G, h = np.array(rows), np.array(rhs)
+    if cost is None:
+        sol = scipy.optimize.linprog(np.zeros(s.M.shape[1]), A_ub=G, b_ub=h, A_eq=s.M,
+                                     b_eq=-s.c, bounds=(None, None), method="highs")
+        return sol.x if sol.status == 0 else None
+    terms = [(q[n][0] - t, q[n][1], sc) for n, (t, sc) in cost.items()]
+
+    def f(z):
+        return sum(((a + b @ z) / sc) ** 2 for a, b, sc in terms)
+
+    def grad(z):
+        return sum(2.0 * (a + b @ z) / sc ** 2 * b for a, b, sc in terms)
+
+    sol = scipy.optimize.minimize(
+        f, np.zeros(s.M.shape[1]), jac=grad, method="SLSQP",
+        constraints=[{"type": "eq", "fun": lambda z: s.M @ z + s.c, "jac": lambda z: s.M},
+                     {"type": "ineq", "fun": lambda z: h - G @ z, "jac": lambda z: -G}],
+        options={"maxiter": 500, "ftol": 1e-14})
+    z = sol.x
+    if np.max(np.abs(s.M @ z + s.c)) > RESIDUAL_TOL or np.min(h - G @ z) < -1e-9:
+        return None
+    return z
+
+
+def linear_steady_flight(plant, side: str, lock: float,
+                         envelope: Envelope = Envelope()) -> bool:
+    """Whether the 6-DOF linear model has a steady flight (:class:`LinearSteady`)
+    with the ``side`` elevon locked at ``lock`` [rad] inside ``envelope``, with
+    the throttle and the healthy elevon within the airframe's limits and the
+    sideslip, pitch and yaw rate within :func:`steady_flight`'s bounds."""
+    af = plant.airframe
+    bounds = {"Va": envelope.airspeed, "alpha": envelope.alpha,
+              "phi": (-envelope.bank, envelope.bank), "beta": (-0.5, 0.5),
+              "theta": (-1.2, 1.2), "r": (-2.0, 2.0), "throttle": af.throttle_limits,
+              "free_elevon": af.elevon_limits}
+    return linear_closest(plant, linear_steady(plant, side, lock), bounds) is not None

@@ -86,6 +86,9 @@ class MonitorSpec:
         flies it.
     turn_measured : bool
         The lock-turn law feeds back the measured states (else the estimate).
+    turn_linear : bool
+        The lock-turn table is designed on the 6-DOF linear model
+        (``monitor.turn_model``, resolved against the truth plant's kind).
     turn_probe : dict
         The lock-turn law's probe and hand-back, by their ``LockTurnTable``
         fields: ``probe`` [rad] (0: off), ``probe_unit`` and ``check`` [steps],
@@ -106,9 +109,14 @@ class MonitorSpec:
         [periods], ``sub`` (RK4 sub-steps per period), ``levels`` (the healthy
         elevon's positions), ``env`` (the envelope: airspeed [m/s], angle of
         attack and bank [deg], :func:`rocking_table`'s order), ``holds`` (the
-        rollout guard's hold times [periods]; empty: no guard, and no wide
-        design box) and ``bank_margin`` (the wide box's room below the largest
-        bank [deg]); None: the trim is held (``hold``).
+        rollout guard's hold times [periods]; empty: no guard); None: the trim
+        is held (``hold``).
+    turn_wide : tuple or None
+        The lock-turn table's wide design box
+        (:func:`ftc_mc.design.lock_turn.envelope_box`): the envelope's
+        airspeed [m/s], angle-of-attack [deg] bounds and largest bank [deg],
+        and the box's room below that bank [deg]; set for the rollout guard
+        (``guarded``) and for a table on the linear model; None: no wide box.
     """
 
     threshold: float
@@ -125,12 +133,14 @@ class MonitorSpec:
     altitude_m: float = 100.0
     turn_offsets: tuple = ()
     turn_measured: bool = True
+    turn_linear: bool = False
     turn_probe: dict = field(default_factory=lambda: dict(NO_PROBE))
     nonlinear: bool = False
     substeps: int = 5
     extended: bool = False
     state_noise_scale: float = 1.0
     turn_rollout: dict | None = None
+    turn_wide: tuple | None = None
 
 
 def monitor_spec(cfg, fm, det, lock_turn: bool = False) -> MonitorSpec | None:
@@ -158,6 +168,9 @@ def monitor_spec(cfg, fm, det, lock_turn: bool = False) -> MonitorSpec | None:
     b1 = {"throttle": rv["b1_thrust"], "left": rv["b1_left"], "right": rv["b1_right"]}
     reset = np.array([b0[a] for a in MONITOR_DIRECTIONS] + [b1[a] for a in MONITOR_DIRECTIONS])
     r_lon = np.asarray(fm.r_diag, dtype=float).copy()
+    env = (cfg.validity.airspeed_min_mps, cfg.validity.airspeed_max_mps,
+           cfg.validity.alpha_min_deg, cfg.validity.alpha_max_deg, cfg.validity.bank_max_deg)
+    linear = mc.turn_model == "linear" or (mc.turn_model == "auto" and cfg.plant.kind == "linear")
     return MonitorSpec(
         threshold=float(mc.threshold), window=cfg.steps(mc.window_s),
         min_window=cfg.steps(mc.min_window_s), startup=cfg.steps(mc.startup_s),
@@ -167,6 +180,7 @@ def monitor_spec(cfg, fm, det, lock_turn: bool = False) -> MonitorSpec | None:
         design_turbulence=mc.design_turbulence, altitude_m=float(cfg.plant.altitude_m),
         turn_offsets=tuple(np.radians(mc.turn_offsets())) if lock_turn else (),
         turn_measured=mc.turn_feedback == "measured",
+        turn_linear=linear,
         turn_probe=dict(probe=float(mc.turn_probe_rad),
                         probe_unit=cfg.steps(mc.turn_probe_unit_s),
                         check=cfg.steps(mc.hand_back_after_s),
@@ -182,12 +196,11 @@ def monitor_spec(cfg, fm, det, lock_turn: bool = False) -> MonitorSpec | None:
             steps=cfg.steps(mc.rollout_horizon_s),
             switches=tuple(cfg.steps(t) for t in mc.rollout_switch_s),
             sub=int(mc.rollout_substeps), levels=int(mc.rollout_elevon_levels),
-            env=(cfg.validity.airspeed_min_mps, cfg.validity.airspeed_max_mps,
-                 cfg.validity.alpha_min_deg, cfg.validity.alpha_max_deg,
-                 cfg.validity.bank_max_deg),
+            env=env,
             holds=(tuple(cfg.steps(t) for t in mc.rollout_guard_holds_s)
-                   if mc.turn_beyond == "guarded" else ()),
-            bank_margin=float(mc.rollout_guard_bank_margin_deg)))
+                   if mc.turn_beyond == "guarded" else ())),
+        turn_wide=((*env, float(mc.rollout_guard_bank_margin_deg))
+                   if mc.turn_beyond == "guarded" or linear else None))
 
 
 def gust_block(six, spec: MonitorSpec, span: float):
@@ -269,7 +282,7 @@ def rocking_table(lo_dev, hi_dev, steps: int, switches, sub: int, env,
 
 def lock_turn_table(six, u0: np.ndarray, offsets=(), airframe=None,
                     measured: bool = True, probe=None, rollout=None,
-                    wide=None) -> LockTurnTable:
+                    wide=None, linear: bool = False) -> LockTurnTable:
     """The kernels' :class:`LockTurnTable` (empty, ``x`` of shape ``(2, 0, 10)``,
     when ``offsets`` is).
 
@@ -300,6 +313,8 @@ def lock_turn_table(six, u0: np.ndarray, offsets=(), airframe=None,
     wide : DesignBox, optional
         The designs' wide box (:func:`ftc_mc.design.lock_turn.envelope_box`;
         the rollout guard's), or None.
+    linear : bool
+        Design on the 6-DOF linear model (``monitor.turn_model: linear``).
 
     Designs the cache does not hold are computed with a notice on stderr and
     their duration.
@@ -326,7 +341,7 @@ def lock_turn_table(six, u0: np.ndarray, offsets=(), airframe=None,
                              **pr)
     d = cached_lock_turn_designs(airframe, off, float(six.trim.V0),
                                  float(np.degrees(six.trim.gamma0)), six.dt,
-                                 stream=sys.stderr, wide=wide)
+                                 stream=sys.stderr, wide=wide, linear=linear)
     idx = np.array([[STATE[n] for n in turn_states(side)] for side in SIDES])
     x = np.stack([d.x[s][:, idx[s]] - six.trim.x0[idx[s]] for s in range(2)])
     c = np.ascontiguousarray
@@ -403,11 +418,11 @@ def side_monitor(six, u_ff: np.ndarray, u_lower, u_upper, lon_out: np.ndarray,
         u_lower - u0, u_upper - u0, ro["steps"], ro["switches"], ro["sub"], ro["env"],
         ro["levels"], ro.get("holds", ()))
     wide = None
-    if ro is not None and ro.get("holds"):
+    if spec.turn_wide is not None:
         from ..design.lock_turn import envelope_box
 
-        env = ro["env"]
-        wide = envelope_box(env[0:2], env[2:4], env[4], bank_margin=ro["bank_margin"])
+        w = spec.turn_wide
+        wide = envelope_box(w[0:2], w[2:4], w[4], bank_margin=w[5])
     return SideMonitor(
         on=1, A=c(A), B=c(B), C=c(C), u0=c(u0, dtype=np.float64),
         u_ff=c(u_ff, dtype=np.float64), lo=c(u_lower), hi=c(u_upper), P0=c(P0), Q=c(Q),
@@ -415,6 +430,6 @@ def side_monitor(six, u_ff: np.ndarray, u_lower, u_upper, lon_out: np.ndarray,
         threshold=float(spec.threshold), window=int(spec.window),
         min_window=int(spec.min_window), startup=int(spec.startup), snap=int(spec.snap),
         turn=lock_turn_table(six, u0, spec.turn_offsets, airframe, spec.turn_measured,
-                             spec.turn_probe, rollout, wide),
+                             spec.turn_probe, rollout, wide, spec.turn_linear),
         nonlinear=EXTENDED if spec.extended else int(spec.nonlinear),
         states=c(states, dtype=np.int64), outs=outs, n_sub=int(spec.substeps), wind=c(W))
