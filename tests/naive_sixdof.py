@@ -528,11 +528,33 @@ def envelope_excess_ref(env, xs):
     return e if np.isfinite([va, alpha, bank]).all() else np.inf
 
 
+def rollout_step_ref(tab, pl, xs, cmd):
+    """One period of a rollout from the absolute 6-DOF state ``xs`` under the
+    absolute commands ``cmd``, still air, and the envelope's excess after it
+    (``core/sixdof/lockturn.py``'s module docstring): on the linear plant
+    (``pl.kind``) its model ``x+ = A x + B u`` in deviations from the trim
+    ``x0``, ``u0``, the airspeed and angle of attack from its output map
+    ``y0 + C dx``; else :func:`rk4_ref` (``ro_sub`` sub-steps) and
+    :func:`envelope_excess_ref`.  Returns ``(state, excess)``."""
+    from ftc_mc.core.sixdof.layout import OUTPUT, SIXDOF_LINEAR
+
+    if pl.kind != SIXDOF_LINEAR:
+        xs = rk4_ref(xs, cmd, pl.p, np.zeros(6), pl.dt, tab.ro_sub)
+        return xs, envelope_excess_ref(tab.ro_env, xs)
+    xs = pl.x0 + pl.A @ (xs - pl.x0) + pl.B @ (cmd - pl.u0)
+    y = pl.y0 + pl.C @ (xs - pl.x0)
+    va, alpha = y[OUTPUT["Va"]], np.degrees(y[OUTPUT["alpha"]])
+    bank = np.degrees(abs(xs[LAYOUT.states.index("phi")]))
+    env = tab.ro_env
+    e = max(env[0] - va, va - env[1], env[2] - alpha, alpha - env[3], bank - env[4])
+    return xs, (e if np.isfinite([va, alpha, bank]).all() else np.inf)
+
+
 def rocking_scores_ref(tab, pl, s, p, x):
     """``(periods inside, -largest excess before leaving)`` of every rocking
     candidate (its first pair for ``ro_first`` periods, its second after, the
-    named elevon at ``p``) flown ``ro_steps`` periods of :func:`rk4_ref`
-    (``ro_sub`` sub-steps, still air) from the absolute state ``x``."""
+    named elevon at ``p``) flown ``ro_steps`` periods of
+    :func:`rollout_step_ref` (still air) from the absolute state ``x``."""
     scores = []
     for c in range(len(tab.ro_first)):
         xs = np.array(x, dtype=float)
@@ -542,8 +564,8 @@ def rocking_scores_ref(tab, pl, s, p, x):
             cmd = np.zeros(3)
             cmd[tab.cmd[s]] = pl.monitor.u0[tab.cmd[s]] + pair
             cmd[tab.locked[s]] = p
-            xs = rk4_ref(xs, cmd, pl.p, np.zeros(6), pl.dt, tab.ro_sub)
-            excess.append(envelope_excess_ref(tab.ro_env, xs))
+            xs, e = rollout_step_ref(tab, pl, xs, cmd)
+            excess.append(e)
         out = next((k for k, e in enumerate(excess) if e > 0), tab.ro_steps)
         scores.append((out, -max(excess[:out], default=-np.inf)))
     return scores
@@ -554,8 +576,8 @@ def rocking_law_ref(tab, pl, s, p, x, lo_dev, hi_dev):
     from that module's docstring: from the absolute 6-DOF state ``x`` (15,),
     every candidate history (its first pair for ``ro_first`` periods, its
     second after, the named elevon at ``p``) flies ``ro_steps`` periods of
-    :func:`rk4_ref` (``ro_sub`` sub-steps, still air); the envelope's excess
-    after each period, in m/s and degrees, from ``u, v, w`` and ``phi``; the
+    :func:`rollout_step_ref` (still air), with the envelope's excess after
+    each, in m/s and degrees; the
     candidate that stays in longest, then the one with the least largest
     excess before it leaves, the first on a tie; the trim commands ``hold``
     when every candidate leaves within the first period.  Returns the
@@ -576,7 +598,7 @@ def guarded_law_ref(tab, pl, s, p, x, lo_dev, hi_dev):
     docstring: the LQR of :func:`lock_turn_law_ref` (at ``p``), its fed-back
     states read from the flown absolute state by name (:func:`turn_states`
     less the 6-DOF trim ``pl.x0``), flies ``ro_steps`` periods of
-    :func:`rk4_ref` from ``x`` (15,), the named elevon at ``p``; if that stays
+    :func:`rollout_step_ref` from ``x`` (15,), the named elevon at ``p``; if that stays
     in the envelope the LQR flies.  Else each candidate (one of the first
     ``gd_pairs`` held pairs of ``ro_u`` for ``gd_holds`` periods, then the
     LQR) flies too; the longest stay, then the least largest excess, wins,
@@ -598,8 +620,8 @@ def guarded_law_ref(tab, pl, s, p, x, lo_dev, hi_dev):
             cmd = np.zeros(3)
             cmd[tab.cmd[s]] = pl.monitor.u0[tab.cmd[s]] + (pair if k < hold else lqr(xs))
             cmd[tab.locked[s]] = p
-            xs = rk4_ref(xs, cmd, pl.p, np.zeros(6), pl.dt, tab.ro_sub)
-            excess.append(envelope_excess_ref(tab.ro_env, xs))
+            xs, e = rollout_step_ref(tab, pl, xs, cmd)
+            excess.append(e)
         out = next((k for k, e in enumerate(excess) if e > 0), tab.ro_steps)
         return out, -max(excess[:out], default=-np.inf)
 

@@ -127,14 +127,16 @@ def test_side_blocks_match_their_twin():
             ] == [RESET_THRUST, RESET_ELEVONS, RESET_ELEVONS]
 
 
-def rocking_setup(measured):
+def rocking_setup(measured, kind="nonlinear"):
     """A table with the rocking law's candidates (0.6 s horizon, switches at 0.1
     and 0.3 s, 2 RK4 sub-steps, the trials' envelope) on the default 6-DOF
-    model, and the truth plant fields it reads (``p``, ``x0``, ``dt``,
-    ``monitor.states``, ``monitor.u0``)."""
+    model, and the truth plant fields it reads (``kind``, the equations' ``p``
+    and ``dt``, the linear model's ``A``, ``B``, ``C``, ``y0``, ``u0``, the
+    trim ``x0``, ``monitor.states``, ``monitor.u0``) of a ``kind`` plant."""
     from collections import namedtuple
 
-    from ftc_mc.core.sixdof.layout import MONITOR_STATES, STATE
+    from ftc_mc.core.sixdof.layout import (MONITOR_STATES, SIXDOF_LINEAR, SIXDOF_NONLINEAR,
+                                           STATE)
     from ftc_mc.model.sixdof import build_sixdof_plant
     from ftc_mc.sim.monitor import rocking_table
 
@@ -145,8 +147,10 @@ def rocking_setup(measured):
         hold=six.u0 - u0,
         **rocking_table(lo, hi, 6, (1, 3), 2, (12.0, 30.0, -8.0, 12.0, 60.0)))
     Mon = namedtuple("Mon", ["states", "u0"])
-    Pl = namedtuple("Pl", ["p", "x0", "dt", "monitor"])
-    pl = Pl(p=six.trim.params, x0=six.trim.x0, dt=0.1,
+    Pl = namedtuple("Pl", ["kind", "p", "x0", "dt", "A", "B", "C", "y0", "u0", "monitor"])
+    pl = Pl(kind=SIXDOF_LINEAR if kind == "linear" else SIXDOF_NONLINEAR,
+            p=six.trim.params, x0=six.trim.x0, dt=0.1, A=six.A, B=six.B, C=six.C,
+            y0=six.trim.y0, u0=six.u0,
             monitor=Mon(states=np.array([STATE[n] for n in MONITOR_STATES]), u0=u0))
     return tab, pl, lo, hi
 
@@ -178,18 +182,20 @@ def test_rocking_candidates(levels, switches):
                 n_p * (n_p - 1)
 
 
-@pytest.mark.parametrize("measured", [True, False])
-def test_rocking_law_matches_its_twin(measured):
+@pytest.mark.parametrize("measured, kind", [(True, "nonlinear"), (False, "nonlinear"),
+                                            (True, "linear")])
+def test_rocking_law_matches_its_twin(measured, kind):
     """Locks beyond the steady band either side, from trim and from rolled,
     pitched and slowed states: the kernel sends the first pair of the
     candidate the twin chooses, and the choices differ (throttle and elevon,
     held and switching) from state to state; from a state already outside
-    the envelope, or one not finite, both hold the trim commands."""
+    the envelope, or one not finite, both hold the trim commands.  On the
+    linear plant the candidates fly its own model."""
     from ftc_mc.core.sixdof.layout import MONITOR_STATES
     from ftc_mc.core.sixdof.lockturn import rocking_law
     from ftc_mc.sim.monitor import MEASURED
 
-    tab, pl, lo, hi = rocking_setup(measured)
+    tab, pl, lo, hi = rocking_setup(measured, kind)
     assert tab.ro_first.shape == (66,) and tab.ro_u.shape == (2, 66, 2, 2)
     rng = np.random.default_rng(26)
     nm, L = len(MONITOR_STATES), 5
@@ -255,8 +261,9 @@ def test_rocking_law_matches_its_twin(measured):
         np.testing.assert_array_equal(u, np.clip(want, lo[:, None], hi[:, None]))
 
 
-@pytest.mark.parametrize("measured", [True, False])
-def test_guarded_law_matches_its_twin(measured):
+@pytest.mark.parametrize("measured, kind", [(True, "nonlinear"), (False, "nonlinear"),
+                                            (True, "linear")])
+def test_guarded_law_matches_its_twin(measured, kind):
     """The rollout guard on designs about steady flights (random gains and
     design states near trim, guard candidates holding for 1 and 3 periods of
     a 0.6 s horizon): from trim, rolled either way, slowed, and past the
@@ -267,7 +274,7 @@ def test_guarded_law_matches_its_twin(measured):
     from ftc_mc.core.sixdof.lockturn import guarded_law
     from ftc_mc.sim.monitor import rocking_table
 
-    tab, pl, lo, hi = rocking_setup(measured)
+    tab, pl, lo, hi = rocking_setup(measured, kind)
     tab = tab._replace(**{k: v for k, v in rocking_table(
         lo, hi, 6, (1, 3), 2, (12.0, 30.0, -8.0, 12.0, 60.0), 3, holds=(1, 3)).items()
         if k.startswith("gd_")})

@@ -140,6 +140,10 @@ Y_NX, Y_NY, Y_NZ = OUTPUT["n_x"], OUTPUT["n_y"], OUTPUT["n_z"]
 Y_ALPHA, Y_BETA, Y_GAMMA, Y_VA = (OUTPUT["alpha"], OUTPUT["beta"], OUTPUT["gamma"],
                                   OUTPUT["Va"])
 
+SIXDOF_NONLINEAR, SIXDOF_LINEAR = 2, 3
+"""``SixDofTruth.kind`` (after the longitudinal ``TruthPlant.kind`` 0 and 1): the
+airframe's equations, or the 6-DOF linear model (``plant.kind``)."""
+
 assert LAYOUT.states[:N_RIGID] == LAYOUT.rigid
 assert LAYOUT.outputs[:N_RIGID] == LAYOUT.rigid
 assert tuple(LAYOUT.states[N_RIGID:]) == LAYOUT.actuators

@@ -33,7 +33,9 @@ step, from the lane's state (the monitor's estimate on its rows, the law's
 fed-back states from their sensors where ``meas`` says so, the rest of the
 6-DOF trim), the airframe's equations (:func:`~ftc_mc.core.sixdof.plant.propagate`,
 ``ro_sub`` RK4 sub-steps per period, still air, the named elevon at ``p``)
-fly each candidate command history for ``ro_steps`` periods.  A candidate
+fly each candidate command history for ``ro_steps`` periods; on the linear
+plant its own model flies them (:func:`rollout_step`: ``x+ = A x + B u`` in
+deviations, the air data from its output map, as the truth).  A candidate
 holds one pair (throttle, healthy elevon) for its first ``ro_first`` periods
 and a second pair after (``ro_u``; a pair from the throttle's two limits and
 ``monitor.rollout_elevon_levels`` positions of the healthy elevon from limit
@@ -63,8 +65,8 @@ trim, turns at 50 deg of bank and 12.5-14.7 m/s) has a design about its
 own.  Flown directly from the nominal glide, such a design overshoots the
 bank bound (oracle, designs at 59.5 deg: within 1.1-2.4 s; true lock and
 state from 0.1 s after the lock).  So every step, before the LQR's command
-is sent, the airframe's equations fly the LQR ``ro_steps`` periods from the
-lane's state (as the rocking law does, the LQR applied to the flown state);
+is sent, the airframe's equations (the linear plant's model on the linear
+plant) fly the LQR ``ro_steps`` periods from the lane's state (as the rocking law does, the LQR applied to the flown state);
 if it leaves, candidates that first hold a pair (throttle, healthy elevon)
 for ``gd_holds`` periods and then hand over to the LQR are flown too, and
 the first pair of the one that stays inside longest (then with the widest
@@ -139,7 +141,8 @@ import numpy as np
 from ...conventions import LONGITUDINAL, NO_RESET
 from ..jit import kernel
 from ..shared.excitation import signal_3211, signal_3211_length
-from .layout import N_COMMAND, N_STATE, N_WIND, X_PHI, X_U, X_V, X_W
+from .layout import (N_COMMAND, N_STATE, N_WIND, SIXDOF_LINEAR, X_PHI, X_U, X_V, X_W,
+                     Y_ALPHA, Y_VA)
 from .monitor import on_trim
 from .plant import N_WORK, propagate
 
@@ -197,8 +200,10 @@ def lock_turn_law(tab, pl, s, p, mx, z, lat, l, lo_dev, hi_dev, u):
     ----------
     tab : LockTurnTable
     pl : SixDofTruth
-        The airframe's equations (``p``, ``x0``, ``dt``) and the monitor
-        (``monitor.states``, ``monitor.u0``), for the rocking law.
+        The plant's model (``kind``; the airframe's equations ``p``, ``dt``;
+        the linear model ``A``, ``B``, ``C``, ``y0``, ``u0``), its trim
+        ``x0`` and the monitor (``monitor.states``, ``monitor.u0``), for the
+        rocking law and the guard.
     s : int
         Side: 0 left, 1 right.
     p : float
@@ -238,7 +243,8 @@ def lock_turn_law(tab, pl, s, p, mx, z, lat, l, lo_dev, hi_dev, u):
 def rocking_law(tab, pl, s, p, mx, z, lat, l, lo_dev, hi_dev, u):
     """The throttle and healthy elevon commands of lane ``l`` under the rocking
     law (module docstring): the first pair of the candidate history that
-    the airframe's equations keep inside the envelope longest.  Arguments as
+    the plant's model (:func:`rollout_step`) keeps inside the envelope
+    longest.  Arguments as
     :func:`lock_turn_law`'s.  Returns False, writing nothing, when every
     candidate leaves within the first period (or the state is not finite)."""
     x6, xs, cmd, wd, rk = rollout_start(tab, pl, s, mx, z, lat, l)
@@ -292,8 +298,9 @@ def rollout_start(tab, pl, s, mx, z, lat, l):
 def guarded_law(tab, pl, s, i, j1, w, p, mx, z, lat, l, lo_dev, hi_dev, u):
     """The rollout guard on the lock-turn LQR (``monitor.turn_beyond:
     guarded``; module docstring).  From the lane's state (:func:`rollout_start`),
-    the airframe's equations fly ``tab.ro_steps`` periods under the LQR of the
-    designs ``i`` and ``j1`` (weight ``w`` on ``j1``; :func:`turn_command`).
+    the plant's model (:func:`rollout_step`) flies ``tab.ro_steps`` periods
+    under the LQR of the designs ``i`` and ``j1`` (weight ``w`` on ``j1``;
+    :func:`turn_command`).
     If that flight stays inside the envelope, returns False and writes
     nothing: :func:`turn_law` flies.  Else each of the guard's candidates
     holds one of the first ``tab.gd_pairs`` pairs of ``tab.ro_u`` (the held
@@ -331,14 +338,15 @@ def guarded_law(tab, pl, s, i, j1, w, p, mx, z, lat, l, lo_dev, hi_dev, u):
 @kernel(inline="always")
 def fly_history(tab, pl, s, p, x6, c, first, lqr_from, i, j1, w, lo_dev, hi_dev, xs, cmd, wd,
                 rk):
-    """Fly one command history ``tab.ro_steps`` periods on the airframe's
-    equations from the absolute 6-DOF state ``x6`` (into ``xs``; still air,
-    ``tab.ro_sub`` RK4 sub-steps, the named elevon of side ``s`` at ``p``):
+    """Fly one command history ``tab.ro_steps`` periods (:func:`rollout_step`:
+    the airframe's equations, or the linear plant's own model) from the
+    absolute 6-DOF state ``x6`` (into ``xs``; still air, the named elevon of
+    side ``s`` at ``p``):
     the first pair of candidate ``c`` (``tab.ro_u``) for ``first`` periods,
     its second after, and from period ``lqr_from`` on the LQR of the designs
     ``i`` and ``j1`` (weight ``w`` on ``j1``; :func:`turn_command`).  Returns
     the period in which the flight leaves the envelope (``tab.ro_steps`` if it
-    stays in) and its largest excess before (:func:`envelope_excess`;
+    stays in) and its largest excess before (:func:`excess_of`;
     ``-inf`` if it leaves in the first).  ``cmd``, ``wd``, ``rk``: work
     arrays."""
     for q in range(N_STATE):
@@ -354,8 +362,7 @@ def fly_history(tab, pl, s, p, x6, c, first, lqr_from, i, j1, w, lo_dev, hi_dev,
             ph = 0 if k < first else 1
             cmd[a_thr] = pl.monitor.u0[a_thr] + tab.ro_u[s, c, ph, 0]
             cmd[a_free] = pl.monitor.u0[a_free] + tab.ro_u[s, c, ph, 1]
-        propagate(xs, cmd, pl.p, wd, pl.dt, tab.ro_sub, rk)
-        e = envelope_excess(tab.ro_env, xs)
+        e = rollout_step(tab, pl, xs, cmd, wd, rk)
         if e > 0.0:
             return k, worst
         worst = max(worst, e)
@@ -382,17 +389,46 @@ def turn_command(tab, pl, s, i, j1, w, xs, lo_dev, hi_dev, cmd):
 
 
 @kernel(inline="always")
-def envelope_excess(env, x):
-    """The envelope's excess at the 6-DOF state ``x`` (absolute, still air):
-    the largest of ``env[0] - Va``, ``Va - env[1]`` [m/s], ``env[2] - alpha``,
-    ``alpha - env[3]``, ``|phi| - env[4]`` [deg]; ``inf`` where the state is
-    not finite."""
-    uu = x[X_U]
-    vv = x[X_V]
-    ww = x[X_W]
-    va = math.sqrt(uu * uu + vv * vv + ww * ww)
-    alpha = math.degrees(math.atan2(ww, uu))
-    bank = math.degrees(abs(x[X_PHI]))
+def rollout_step(tab, pl, xs, cmd, wd, rk):
+    """One period of a rollout, in place on the absolute 6-DOF state ``xs``
+    under the absolute commands ``cmd`` (still air), and the envelope's excess
+    after it (:func:`excess_of`), both on the model of the plant flown: on the
+    linear plant (``pl.kind``) its own ``x+ = A x + B u`` in deviations from
+    the trim and the air data of its output map, as the truth steps and
+    checks them; else the airframe's equations (``tab.ro_sub`` RK4 sub-steps)
+    and the air data of ``u, v, w``.  ``wd``, ``rk``: work arrays."""
+    if pl.kind == SIXDOF_LINEAR:
+        dev = rk[0]
+        for q in range(N_STATE):
+            dev[q] = xs[q] - pl.x0[q]
+        for q in range(N_STATE):
+            acc = pl.x0[q]
+            for j in range(N_STATE):
+                acc += pl.A[q, j] * dev[j]
+            for j in range(N_COMMAND):
+                acc += pl.B[q, j] * (cmd[j] - pl.u0[j])
+            xs[q] = acc
+        va = pl.y0[Y_VA]
+        alpha = pl.y0[Y_ALPHA]
+        for j in range(N_STATE):
+            d = xs[j] - pl.x0[j]
+            va += pl.C[Y_VA, j] * d
+            alpha += pl.C[Y_ALPHA, j] * d
+        return excess_of(tab.ro_env, va, math.degrees(alpha), math.degrees(abs(xs[X_PHI])))
+    propagate(xs, cmd, pl.p, wd, pl.dt, tab.ro_sub, rk)
+    uu = xs[X_U]
+    vv = xs[X_V]
+    ww = xs[X_W]
+    return excess_of(tab.ro_env, math.sqrt(uu * uu + vv * vv + ww * ww),
+                     math.degrees(math.atan2(ww, uu)), math.degrees(abs(xs[X_PHI])))
+
+
+@kernel(inline="always")
+def excess_of(env, va, alpha, bank):
+    """The envelope's excess at airspeed ``va`` [m/s], angle of attack
+    ``alpha`` and bank ``bank`` [deg]: the largest of ``env[0] - Va``,
+    ``Va - env[1]`` [m/s], ``env[2] - alpha``, ``alpha - env[3]``,
+    ``|phi| - env[4]`` [deg]; ``inf`` where one is not finite."""
     if not (math.isfinite(va) and math.isfinite(alpha) and math.isfinite(bank)):
         return np.inf
     return max(env[0] - va, va - env[1], env[2] - alpha, alpha - env[3], bank - env[4])

@@ -76,13 +76,11 @@ from ...conventions import (C_ENGINE, C_NOMINAL, I_B0_THRUST, I_B1_THRUST, LONGI
 from ..jit import kernel
 from ..longitudinal.plant import actuator_effect, gust_lanes, schedule_entry, sensor_fault
 from ..shared.interp import engine_controller
-from .layout import (N_OUTPUT, N_STATE, N_WIND, OUTPUT, STATE, U_LEFT, U_RIGHT, W_P, W_Q,
-                     W_R, W_U, W_V, W_W, X_PHI, X_PSI, Y_ALPHA, Y_VA, sixdof_name)
+from .layout import (N_OUTPUT, N_STATE, N_WIND, OUTPUT, SIXDOF_LINEAR, SIXDOF_NONLINEAR,
+                     STATE, U_LEFT, U_RIGHT, W_P, W_Q, W_R, W_U, W_V, W_W, X_PHI, X_PSI,
+                     Y_ALPHA, Y_VA, sixdof_name)
 from .lockturn import LOCK_TURN, hands_back, lock_turn_law, turn_probe
 from .plant import N_WORK, outputs, propagate
-
-SIXDOF_NONLINEAR, SIXDOF_LINEAR = 2, 3
-"""``SixDofTruth.kind`` (after the longitudinal ``TruthPlant.kind`` 0 and 1)."""
 
 LATERAL_LOOP = ("phi", "v", "p", "r", "psi", "left", "right")
 """Rows of ``LaneState.lat``: the lateral loop's measured states, then its
