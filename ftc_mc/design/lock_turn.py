@@ -61,6 +61,15 @@ with the locked elevon's command its lock position.
    on disk; the ``lock_turn`` controller of the trial loop flies them,
    interpolated on the side monitor's lock estimate, with measurements in
    place of the oracle's true state (:mod:`ftc_mc.core.sixdof.lockturn`).
+6. **On the linear plant** (``monitor.turn_model: linear``, or ``auto``
+   there): the plant flies the 6-DOF linear model, whose steady flights are
+   not the equations' (:class:`ftc_mc.model.trimmable.LinearSteady`: a plane
+   per lock, found by the same cost in the same boxes on a convex problem;
+   the side monitor gives such a table the wide box too), and steps 3-4 use
+   its own discrete matrices,
+   the held offset entering through the locked elevon's actuator and command
+   columns.  On ``x8-pyfly`` its trimmable set is -4.75 to +5.5 deg (left),
+   against -29 to +2.25 deg for the equations (``docs/airframes.md``).
 """
 
 from __future__ import annotations
