@@ -468,17 +468,21 @@ def test_the_guard_flies_locks_the_design_box_cannot(tmp_path):
     assert (guard["status"] == "ok").all(), guard[["status", "stop_s"]]
 
 
-def test_on_the_linear_plant_the_table_is_the_linear_models(tmp_path):
+def test_on_the_linear_plant_the_table_is_the_linear_models(tmp_path, capfd):
     """On the linear plant, locks 4.3-5.2 deg above trim have steady flights
     of the linear model (which the plant flies) but none of the airframe's
     equations (their band ends near +2.25 deg): with the table designed on
     the linear model (``monitor.turn_model: auto`` there) every trial stays
     inside the envelope for the 30 s flown; with the table designed on the
     equations (``nonlinear``) every one of the same trials leaves within 5 s
-    of the lock (docs/airframes.md has the campaign)."""
+    of the lock (docs/airframes.md has the campaign).  Each run notes once
+    that the table's -2 deg ends lie inside the steady band (the linear
+    model's, -4.75 / -5.25 to +5.5 deg; the equations', -29 to +2.25 deg),
+    and not its +6 deg ends, beyond both."""
     trim = float(build_setup(api.campaign_config(
         {"plant": {"kind": "linear", "dof": 6}})).truth.u0[1])
     out = {}
+    capfd.readouterr()
     for model in ("auto", "nonlinear"):
         cfg = flies_on_config(trim)
         cfg["campaign"].update(trials=2, chunk_size=2, signature="none")
@@ -489,6 +493,9 @@ def test_on_the_linear_plant_the_table_is_the_linear_models(tmp_path):
         cfg["monitor"].update(turn_offsets_deg=[-2.0, 6.0], turn_model=model)
         t = api.run_campaign(cfg, jobs=1, progress=False, out=tmp_path / model).trials
         out[model] = t.set_index(["transition", "trial_id"])
+        notes = [ln for ln in capfd.readouterr().err.splitlines() if "note: the lock-turn" in ln]
+        assert len(notes) == 1 and "(left -2 deg, right -2 deg)" in notes[0], notes
+        assert ("linear model" if model == "auto" else "airframe's equations") in notes[0]
     lin, eq = out["auto"], out["nonlinear"]
     assert (lin["lock_position"] == eq["lock_position"]).all()
     assert (lin["side_correct"] == 1).all()

@@ -425,7 +425,7 @@ class MonitorConfig(_Strict):
     """Time after the first decision at or after the switch at which the
     monitor's estimate (lock position, b0, b1) is recorded [s]."""
     turn_offsets_deg: tuple[Finite, Finite] = (-14.0, 4.0)
-    """Lock offsets from trim [deg] the lock-turn table of a ``controller: lock_turn`` design spans, each side (``ftc_mc/design/lock_turn.py``; an estimate beyond them flies the end's design). Where neither design bracketing the estimate has a steady flight of its own, the law holds the trim commands instead, or flies the rocking law (turn_beyond). Designed once per airframe and cached (about 1-10 s per lock)."""
+    """Lock offsets from trim [deg] the lock-turn table of a ``controller: lock_turn`` design spans, each side (``ftc_mc/design/lock_turn.py``; an estimate beyond them flies the end's design, and a run notes an end with a steady flight of its own). Where neither design bracketing the estimate has a steady flight of its own, the law holds the trim commands instead, or flies the rocking law (turn_beyond). Designed once per airframe and cached (about 1-10 s per lock)."""
     turn_step_deg: Pos = 1.0
     """Step of that table [deg]: its range must hold a whole number of steps."""
     turn_feedback: Literal["measured", "estimate"] = "measured"

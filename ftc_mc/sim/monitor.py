@@ -30,6 +30,7 @@ Imported only on the 6-DOF path (by :func:`ftc_mc.sim.truth.sixdof_truth_plant`)
 
 from __future__ import annotations
 
+import math
 import sys
 from dataclasses import dataclass, field
 
@@ -342,6 +343,14 @@ def lock_turn_table(six, u0: np.ndarray, offsets=(), airframe=None,
     d = cached_lock_turn_designs(airframe, off, float(six.trim.V0),
                                  float(np.degrees(six.trim.gamma0)), six.dt,
                                  stream=sys.stderr, wide=wide, linear=linear)
+    ends = [f"{SIDES[s]} {math.degrees(off[i]):+g} deg" for s in range(2) for i in (0, -1)
+            if d.steady[s, i]]
+    if ends:
+        model = "linear model" if linear else "airframe's equations"
+        print(f"ftc-mc: note: the lock-turn table ends in a steady flight of the {model} "
+              f"({', '.join(ends)}); locks beyond an end fly its design, which does not "
+              "hold them: monitor.turn_offsets_deg should reach past the steady band "
+              "(docs/airframes.md)", file=sys.stderr, flush=True)
     idx = np.array([[STATE[n] for n in turn_states(side)] for side in SIDES])
     x = np.stack([d.x[s][:, idx[s]] - six.trim.x0[idx[s]] for s in range(2)])
     c = np.ascontiguousarray
