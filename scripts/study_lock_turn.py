@@ -84,12 +84,16 @@ def turbulence_record(n, seed, V0=20.0, h=100.0):
 
 
 def fly(tp, K_nom, lower, upper, side, lock, turn=None, delay=math.inf, winds=None,
-        pre="nominal"):
+        pre="nominal", linear=None):
     """One run (module docstring); returns a dict of results.
 
     ``pre``: what flies before the switch to ``turn`` (or throughout without
     one): ``"nominal"`` the nominal 6-DOF LQR, ``"hold"`` the trim commands.
+    ``linear``: a ``SixDofPlant`` whose linear model flies in place of the
+    equations (the linear plant: ``x+ = A x + B u`` in deviations from its
+    trim, the outputs ``y0 + C dx``; still air only).
     """
+    assert linear is None or winds is None, "the linear flights are in still air"
     p = tp.params
     x = tp.x0.copy()
     work = np.zeros((kernels.N_WORK, N_STATE))
@@ -109,11 +113,17 @@ def fly(tp, K_nom, lower, upper, side, lock, turn=None, delay=math.inf, winds=No
             u = np.clip(tp.u0 - K_nom @ (x - tp.x0), lower, upper)
         u[COMMAND[side]] = lock
         w = still if winds is None else winds[k]
-        kernels.propagate(x, u, p, w, DT, N_SUB, work)
+        if linear is None:
+            kernels.propagate(x, u, p, w, DT, N_SUB, work)
+        else:
+            x = tp.x0 + linear.A @ (x - tp.x0) + linear.B @ (u - linear.u0)
         if not np.all(np.isfinite(x)):
             left_at, why = t + DT, "diverged"
             break
-        kernels.outputs(x, p, w, y)
+        if linear is None:
+            kernels.outputs(x, p, w, y)
+        else:
+            y = tp.y0 + linear.C @ (x - tp.x0)
         va, alpha, phi = y[OUTPUT["Va"]], y[OUTPUT["alpha"]], x[STATE["phi"]]
         bank_max = max(bank_max, abs(phi))
         if not ENVELOPE["va"][0] <= va <= ENVELOPE["va"][1]:

@@ -56,6 +56,11 @@ Per side and lock offset from trim, four questions:
    26's "the reconfiguring loop at least doubles the time to leave" can reach
    for that lock.
 
+``--plant linear`` asks the same of the linear plant: the 6-DOF linear model
+at the nominal glide (``x+ = A x + B u`` in deviations) flies every history,
+the air data come from its output map, and its steady flights, designs and
+trimmable set are the linear model's (``ftc_mc.model.trimmable.LinearSteady``).
+
 ``--delay`` holds the trim commands for that long before every history (the
 detection's delay; the side monitor names the side a median 0.1 s after the
 lock, ``docs/airframes.md``).
@@ -71,8 +76,8 @@ question 1 found no 3 s history where question 4's bisection found one of
 ends and, last, the bands per side.
 
     python scripts/study_recoverable.py [--airframe x8-pyfly]
-        [--offsets -30:5:1,6,7,8,10,12,15,20,25] [--sides left,right]
-        [--delay 0] [--jobs 2] [--json out.json]
+        [--offsets=-30:5:1,6,7,8,10,12,15,20,25] [--sides left,right]
+        [--delay 0] [--plant nonlinear] [--jobs 2] [--json out.json]
 """
 
 from __future__ import annotations
@@ -88,12 +93,12 @@ from joblib import Parallel, delayed
 from scipy.optimize import minimize
 
 from ftc_mc.core.sixdof import plant as kernels
-from ftc_mc.core.sixdof.layout import COMMAND, N_STATE, N_WIND, STATE
+from ftc_mc.core.sixdof.layout import COMMAND, N_STATE, N_WIND, OUTPUT, STATE
 from ftc_mc.design.lock_turn import design_point, envelope_box, healthy, lock_turn_lqr
 from ftc_mc.io.atomic import write_text
 from ftc_mc.model.presets import PRESETS
 from ftc_mc.model.sixdof import build_sixdof_plant
-from ftc_mc.model.trimmable import steady_flight
+from ftc_mc.model.trimmable import linear_steady_flight, steady_flight
 from study_lock_turn import fly, nominal_gain  # this script's folder
 
 DT, N_SUB, NODE = 0.1, 10, 0.2
@@ -120,8 +125,10 @@ AGREE = 0.05
 class Problem:
     """One side and lock: the shooting problem of the module docstring."""
 
-    def __init__(self, plant, side, lock, horizon, delay, node=NODE, coarse=None):
+    def __init__(self, plant, side, lock, horizon, delay, node=NODE, coarse=None,
+                 linear=False):
         self.tp, self.side, self.lock = plant.trim, side, lock
+        self.plant, self.linear = plant, linear
         self.lo, self.hi = plant.u_lower, plant.u_upper
         self.thr, self.free = COMMAND["throttle"], COMMAND[healthy(side)]
         self.n_hold = int(round(delay / DT))
@@ -141,9 +148,15 @@ class Problem:
         return c
 
     def flight(self, z):
-        """States (n + 1, 15) from the nominal trim."""
+        """States (n + 1, 15) from the nominal trim (on the linear plant's
+        model with ``linear``: ``x+ = A x + B u`` in deviations)."""
         x = self.tp.x0.copy()
         out = np.empty((self.n + 1, N_STATE))
+        if self.linear:
+            pl, out[0] = self.plant, x
+            for k, c in enumerate(self.commands(z)):
+                out[k + 1] = x = self.tp.x0 + pl.A @ (x - self.tp.x0) + pl.B @ (c - pl.u0)
+            return out
         kernels.simulate(x, self.commands(z), self.tp.params, self.winds, DT, N_SUB, out)
         return out
 
@@ -151,7 +164,7 @@ class Problem:
         """The envelope's excess at every sample after the start (module
         docstring), all bounds stacked [m/s or deg]; large where the flight
         diverged."""
-        return excess(self.flight(z)[1:])
+        return excess(self.flight(z)[1:], self.plant if self.linear else None)
 
     def bounds(self):
         return ([(self.lo[self.thr], self.hi[self.thr])] * self.nn
@@ -180,11 +193,17 @@ def node_times(horizon, node, coarse=None):
     return np.r_[fine, late[late < horizon - 1e-9], horizon]
 
 
-def excess(states):
-    """Envelope excess (module docstring) of states (n, 15) in still air."""
-    u, v, w = (states[:, STATE[k]] for k in ("u", "v", "w"))
-    va = np.sqrt(u * u + v * v + w * w)
-    alpha = np.degrees(np.arctan2(w, u))
+def excess(states, linear=None):
+    """Envelope excess (module docstring) of states (n, 15) in still air; with
+    ``linear`` (a ``SixDofPlant``), the air data of its output map, as the
+    linear plant's truth reads them."""
+    if linear is None:
+        u, v, w = (states[:, STATE[k]] for k in ("u", "v", "w"))
+        va = np.sqrt(u * u + v * v + w * w)
+        alpha = np.degrees(np.arctan2(w, u))
+    else:
+        y = linear.trim.y0 + (states - linear.trim.x0) @ linear.C.T
+        va, alpha = y[:, OUTPUT["Va"]], np.degrees(y[:, OUTPUT["alpha"]])
     bank = np.degrees(np.abs(states[:, STATE["phi"]]))
     g = np.concatenate([ENVELOPE["va"][0] - va, va - ENVELOPE["va"][1],
                         ENVELOPE["alpha"][0] - alpha, alpha - ENVELOPE["alpha"][1],
@@ -232,36 +251,40 @@ class Replay:
 
 
 def study_lock(airframe_name, side, offset_deg, horizon, delay, transient_s, long_horizon,
-               seed):
-    """The four questions for one side and lock offset [deg]; a dict of results."""
+               seed, linear=False):
+    """The four questions for one side and lock offset [deg]; a dict of results.
+    ``linear``: on the linear plant's model (its steady flights, designs,
+    flights and air data) instead of the airframe's equations."""
     af = PRESETS[airframe_name].airframe
     plant = build_sixdof_plant(af)
     tp = plant.trim
+    lin = plant if linear else None
     lock = float(tp.u0[COMMAND[side]] + math.radians(offset_deg))
     row = dict(side=side, offset_deg=offset_deg)
-    row["trimmable"] = bool(steady_flight(af, side, lock).steady)
+    row["trimmable"] = bool(linear_steady_flight(plant, side, lock) if linear
+                            else steady_flight(af, side, lock).steady)
     try:
-        pt = design_point(af, side, lock, box=WIDE)
-        design = lock_turn_lqr(af, side, lock, point=pt)
+        pt = design_point(af, side, lock, box=WIDE, plant=lin)
+        design = lock_turn_lqr(af, side, lock, point=pt, plant=lin)
         design_cmd = pt.cmd
         row["design_offset_deg"] = pt.design_offset_deg
     except ValueError:
         design, design_cmd = None, tp.u0
     rng = np.random.default_rng(seed)
-    short = Problem(plant, side, lock, horizon, delay)
+    short = Problem(plant, side, lock, horizon, delay, linear=linear)
     found = sorted((least_excess(short, z0) for z0 in short.starts(design_cmd, rng)),
                    key=lambda r: r[0])
     row["least_excess"] = found[0][0]
     row["agree"] = sum(s <= found[0][0] + AGREE for s, _ in found)
     row["survived_s"], row["left_by"] = None, ""
     if design is not None and found[0][0] < -MARGIN:
-        long = Problem(plant, side, lock, transient_s, delay)
+        long = Problem(plant, side, lock, transient_s, delay, linear=linear)
         for z0 in long.starts(design_cmd, np.random.default_rng(seed))[:5]:
             z = transient(long, design, z0)
             if z is None:
                 continue
             flown = fly(tp, None, plant.u_lower, plant.u_upper, side, lock,
-                        Replay(long.commands(z), design), delay=0.0)
+                        Replay(long.commands(z), design), delay=0.0, linear=lin)
             if flown["survived"]:
                 row["survived_s"] = T_END
                 break
@@ -269,15 +292,15 @@ def study_lock(airframe_name, side, offset_deg, horizon, delay, transient_s, lon
                 row["survived_s"], row["left_by"] = flown["t_leave"], flown["why"]
     row["least_excess_long"] = None
     if row["survived_s"] != T_END and row["least_excess"] <= 0.0:
-        long = Problem(plant, side, lock, long_horizon, delay, coarse=LONG_NODE)
+        long = Problem(plant, side, lock, long_horizon, delay, coarse=LONG_NODE, linear=linear)
         row["least_excess_long"] = min(least_excess(long, z0)[0] for z0 in
                                        long.starts(design_cmd, np.random.default_rng(seed)))
     row["longest_stay_s"] = row["nominal_exit_s"] = None
     if row["survived_s"] != T_END:
         row["longest_stay_s"] = longest_stay(plant, side, lock, delay, long_horizon,
-                                             design_cmd, seed)
+                                             design_cmd, seed, linear)
         gain = nominal_gain(airframe_name, plant)
-        flown = fly(tp, gain, plant.u_lower, plant.u_upper, side, lock)
+        flown = fly(tp, gain, plant.u_lower, plant.u_upper, side, lock, linear=lin)
         row["nominal_exit_s"] = flown["t_leave"]
     row["verdict"] = verdict(row, horizon, long_horizon)
     return row
@@ -298,12 +321,12 @@ def verdict(row, horizon, long_horizon):
     return "none found" if stay < long_horizon else "undecided"
 
 
-def longest_stay(plant, side, lock, delay, limit, design_cmd, seed):
+def longest_stay(plant, side, lock, delay, limit, design_cmd, seed, linear=False):
     """Question 4: the longest horizon [s] (0.1 s samples, at most ``limit``)
     over which some start's least excess is not positive."""
     def inside(k):
         h = k * DT
-        prob = Problem(plant, side, lock, h, delay, node=0.1, coarse=LONG_NODE)
+        prob = Problem(plant, side, lock, h, delay, node=0.1, coarse=LONG_NODE, linear=linear)
         starts = prob.starts(design_cmd, np.random.default_rng(seed))
         return any(least_excess(prob, z0)[0] <= 0.0 for z0 in starts)
 
@@ -376,6 +399,8 @@ def main(argv=None):
     ap.add_argument("--long-horizon", type=float, default=20.0,
                     help="question 1 again, for locks neither flown nor lost [s]")
     ap.add_argument("--delay", type=float, default=0.0, help="trim held first [s]")
+    ap.add_argument("--plant", choices=("nonlinear", "linear"), default="nonlinear",
+                    help="linear: the linear plant's model (steady flights, designs, flights)")
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--json", default=None)
     a = ap.parse_args(argv)
@@ -385,7 +410,7 @@ def main(argv=None):
     rows = []
     for r in Parallel(n_jobs=a.jobs, return_as="generator")(
             delayed(study_lock)(a.airframe, side, off, a.horizon, a.delay, a.transient,
-                                a.long_horizon, seed_of(side, off))
+                                a.long_horizon, seed_of(side, off), a.plant == "linear")
             for side, off in tasks):
         rows.append(r)
         print(line_of(r, a), flush=True)
