@@ -66,6 +66,13 @@ until the side monitor names an elevon, then the lock-turn controller of that
 side (``ftc_mc/core/sixdof/lockturn.py``; docs/airframes.md)."""
 
 
+SIXDOF_TABLE_DEG = (-14.0, 8.0)
+"""The lock-turn table of the still-air 6-DOF configs [deg from trim]: past the
+steady band of the airframe's equations (-29 to +2.25 deg on x8-pyfly, in the
+design box about -10 to +2) and of the linear model (-4.75 to +5.5 deg), so
+that ``--plant linear`` runs fly no end design beyond its end."""
+
+
 SIXDOF_ROBUST = {**ROBUST_MODERATE, "controller": "lock_turn"}
 """The 6-DOF design for moderate turbulence: ``robust``'s filter, test and
 thresholds, and the lock-turn controller once the side monitor names an elevon."""
@@ -165,6 +172,7 @@ def campaign_configs() -> dict:
         "campaign": {"transitions": list(TRANSITION_TABLE), "signature": "both",
                      "designs": ["robust", "sixdof"]},
         "plant": {"kind": "nonlinear", "dof": 6},
+        "monitor": {"turn_offsets_deg": SIXDOF_TABLE_DEG},
         "designs": {"robust": ROBUST_MODERATE, "sixdof": SIXDOF}})
     files["sixdof_tables.yaml"] = render_yaml(
         cfg, "ftc-mc run configs/sixdof_tables.yaml -- the paper's scheme on the 6-DOF "
@@ -192,6 +200,7 @@ def campaign_configs() -> dict:
                      "signature": "paper", "designs": ["paper_nominal", "sixdof"]},
         "plant": {"kind": "nonlinear", "dof": 6},
         "timing": {"duration_s": 80.0},
+        "monitor": {"turn_offsets_deg": SIXDOF_TABLE_DEG},
         "designs": {"paper_nominal": {"signature": "paper", "controller": "nominal"},
                     "sixdof": SIXDOF}})
     files["sixdof_survival.yaml"] = render_yaml(
@@ -203,16 +212,6 @@ def campaign_configs() -> dict:
              "the lock-turn controller once the side monitor names the elevon), on the "
              "same trials; --dof 3 --design paper --design paper_nominal for the "
              "longitudinal plant", omit=six)
-    linear = cfg.model_copy(update={
-        "plant": cfg.plant.model_copy(update={"kind": "linear"}),
-        "monitor": cfg.monitor.model_copy(update={"turn_offsets_deg": (-8.0, 8.0)})})
-    files["sixdof_survival_linear.yaml"] = render_yaml(
-        linear, "ftc-mc run configs/sixdof_survival_linear.yaml -- configs/sixdof_survival"
-                ".yaml's trials on the 6-DOF linear plant (issue 26's setting): sixdof's "
-                "lock-turn table is designed on the linear model the plant flies "
-                "(monitor.turn_model: auto), whose steady flights span -4.75 to +5.5 deg "
-                "of trim (left elevon) and -5.25 to +5.5 deg (right) on x8-pyfly, so the "
-                "table spans -8 to +8 deg", omit=six)
     cfg = cfg.model_copy(update={"monitor": cfg.monitor.model_copy(
         update={"turn_beyond": "rollout"})})
     files["sixdof_rocking.yaml"] = render_yaml(
