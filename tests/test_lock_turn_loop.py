@@ -131,7 +131,7 @@ def rocking_setup(measured, kind="nonlinear"):
     """A table with the rocking law's candidates (0.6 s horizon, switches at 0.1
     and 0.3 s, 2 RK4 sub-steps, the trials' envelope) on the default 6-DOF
     model, and the truth plant fields it reads (``kind``, the equations' ``p``
-    and ``dt``, the linear model's ``A``, ``B``, ``C``, ``y0``, ``u0``, the
+    and ``dt``, the linear model's ``A``, ``B``, ``Bw``, ``C``, ``Dw``, ``y0``, ``u0``, the
     trim ``x0``, ``monitor.states``, ``monitor.u0``) of a ``kind`` plant."""
     from collections import namedtuple
 
@@ -147,10 +147,11 @@ def rocking_setup(measured, kind="nonlinear"):
         hold=six.u0 - u0,
         **rocking_table(lo, hi, 6, (1, 3), 2, (12.0, 30.0, -8.0, 12.0, 60.0)))
     Mon = namedtuple("Mon", ["states", "u0"])
-    Pl = namedtuple("Pl", ["kind", "p", "x0", "dt", "A", "B", "C", "y0", "u0", "monitor"])
+    Pl = namedtuple("Pl", ["kind", "p", "x0", "dt", "A", "B", "Bw", "C", "Dw", "y0", "u0",
+                           "monitor"])
     pl = Pl(kind=SIXDOF_LINEAR if kind == "linear" else SIXDOF_NONLINEAR,
-            p=six.trim.params, x0=six.trim.x0, dt=0.1, A=six.A, B=six.B, C=six.C,
-            y0=six.trim.y0, u0=six.u0,
+            p=six.trim.params, x0=six.trim.x0, dt=0.1, A=six.A, B=six.B, Bw=six.Bw, C=six.C,
+            Dw=six.Dw, y0=six.trim.y0, u0=six.u0,
             monitor=Mon(states=np.array([STATE[n] for n in MONITOR_STATES]), u0=u0))
     return tab, pl, lo, hi
 
@@ -286,7 +287,8 @@ def test_guarded_law_matches_its_twin(measured, kind):
     hold_dev = np.broadcast_to(tab.hold, (2, n, 3))
     flew, held, holds = 0, 0, set()
     for s in (0, 1):
-        t = tab._replace(lo=pl.monitor.u0[1:] - math.radians(16.0), step=math.radians(2.0), x=rng.normal(0, 0.01, (2, n, nf)),
+        t = tab._replace(lo=pl.monitor.u0[1:] - math.radians(16.0), step=math.radians(2.0),
+                         x=rng.normal(0, 0.01, (2, n, nf)),
                          u=hold_dev + rng.normal(0, 0.01, (2, n, 3)),
                          K=rng.normal(0, 0.05, (2, n, 2, nf)), k=np.zeros((2, n, 2)),
                          steady=np.ones((2, n)))

@@ -66,8 +66,8 @@ own.  Flown directly from the nominal glide, such a design overshoots the
 bank bound (oracle, designs at 59.5 deg: within 1.1-2.4 s; true lock and
 state from 0.1 s after the lock).  So every step, before the LQR's command
 is sent, the airframe's equations (the linear plant's model on the linear
-plant) fly the LQR ``ro_steps`` periods from the lane's state (as the rocking law does, the LQR applied to the flown state);
-if it leaves, candidates that first hold a pair (throttle, healthy elevon)
+plant) fly the LQR ``ro_steps`` periods from the lane's state (as the
+rocking law does, the LQR applied to the flown state); if it leaves, candidates that first hold a pair (throttle, healthy elevon)
 for ``gd_holds`` periods and then hand over to the LQR are flown too, and
 the first pair of the one that stays inside longest (then with the widest
 margin) is sent.  On the oracle's flights (designs at 59.5 deg) this kept
@@ -144,7 +144,7 @@ from ..shared.excitation import signal_3211, signal_3211_length
 from .layout import (N_COMMAND, N_STATE, N_WIND, SIXDOF_LINEAR, X_PHI, X_U, X_V, X_W,
                      Y_ALPHA, Y_VA)
 from .monitor import on_trim
-from .plant import N_WORK, propagate
+from .plant import N_WORK, linear_output, linear_step, propagate
 
 LOCK_TURN = 2
 """``Reconfig.kind`` of a ``controller: lock_turn`` design (after 0 nominal and
@@ -201,7 +201,7 @@ def lock_turn_law(tab, pl, s, p, mx, z, lat, l, lo_dev, hi_dev, u):
     tab : LockTurnTable
     pl : SixDofTruth
         The plant's model (``kind``; the airframe's equations ``p``, ``dt``;
-        the linear model ``A``, ``B``, ``C``, ``y0``, ``u0``), its trim
+        the linear model ``A``, ``B``, ``Bw``, ``C``, ``Dw``, ``y0``, ``u0``), its trim
         ``x0`` and the monitor (``monitor.states``, ``monitor.u0``), for the
         rocking law and the guard.
     s : int
@@ -379,12 +379,10 @@ def turn_command(tab, pl, s, i, j1, w, xs, lo_dev, hi_dev, cmd):
     nf = tab.x.shape[2]
     for c in range(2):
         a = tab.cmd[s, c]
-        v = (1.0 - w) * (tab.u[s, i, a] - tab.k[s, i, c]) + w * (tab.u[s, j1, a]
-                                                                  - tab.k[s, j1, c])
+        v = law_base(tab, s, i, j1, w, c)
         for r in range(nf):
             q = mon.states[tab.rows[s, r]]
-            dev = xs[q] - pl.x0[q] - ((1.0 - w) * tab.x[s, i, r] + w * tab.x[s, j1, r])
-            v -= ((1.0 - w) * tab.K[s, i, c, r] + w * tab.K[s, j1, c, r]) * dev
+            v -= law_term(tab, s, i, j1, w, c, r, xs[q] - pl.x0[q])
         cmd[a] = mon.u0[a] + min(hi_dev[a], max(lo_dev[a], v))
 
 
@@ -401,20 +399,12 @@ def rollout_step(tab, pl, xs, cmd, wd, rk):
         dev = rk[0]
         for q in range(N_STATE):
             dev[q] = xs[q] - pl.x0[q]
+        linear_step(pl, dev, cmd, wd, rk[1])
         for q in range(N_STATE):
-            acc = pl.x0[q]
-            for j in range(N_STATE):
-                acc += pl.A[q, j] * dev[j]
-            for j in range(N_COMMAND):
-                acc += pl.B[q, j] * (cmd[j] - pl.u0[j])
-            xs[q] = acc
-        va = pl.y0[Y_VA]
-        alpha = pl.y0[Y_ALPHA]
-        for j in range(N_STATE):
-            d = xs[j] - pl.x0[j]
-            va += pl.C[Y_VA, j] * d
-            alpha += pl.C[Y_ALPHA, j] * d
-        return excess_of(tab.ro_env, va, math.degrees(alpha), math.degrees(abs(xs[X_PHI])))
+            xs[q] = pl.x0[q] + rk[1, q]
+        return excess_of(tab.ro_env, linear_output(pl, rk[1], wd, Y_VA),
+                         math.degrees(linear_output(pl, rk[1], wd, Y_ALPHA)),
+                         math.degrees(abs(xs[X_PHI])))
     propagate(xs, cmd, pl.p, wd, pl.dt, tab.ro_sub, rk)
     uu = xs[X_U]
     vv = xs[X_V]
@@ -462,8 +452,7 @@ def turn_law(tab, s, i, j1, w, mx, z, lat, l, lo_dev, hi_dev, u):
     nz = z.shape[0]
     for c in range(2):
         a = tab.cmd[s, c]
-        v = (1.0 - w) * (tab.u[s, i, a] - tab.k[s, i, c]) + w * (tab.u[s, j1, a]
-                                                                  - tab.k[s, j1, c])
+        v = law_base(tab, s, i, j1, w, c)
         for r in range(nf):
             o = tab.meas[s, r]
             if o < 0:
@@ -472,9 +461,26 @@ def turn_law(tab, s, i, j1, w, mx, z, lat, l, lo_dev, hi_dev, u):
                 xr = z[o, l]
             else:
                 xr = lat[o - nz, l]
-            dev = xr - ((1.0 - w) * tab.x[s, i, r] + w * tab.x[s, j1, r])
-            v -= ((1.0 - w) * tab.K[s, i, c, r] + w * tab.K[s, j1, c, r]) * dev
+            v -= law_term(tab, s, i, j1, w, c, r, xr)
         u[a, l] = min(hi_dev[a], max(lo_dev[a], v))
+
+
+@kernel(inline="always")
+def law_base(tab, s, i, j1, w, c):
+    """Command ``c`` (0 throttle, 1 healthy elevon) of side ``s``'s law at its
+    interpolated design point, less the longitudinal trim: ``u* - k`` of the
+    designs ``i`` and ``j1`` (weight ``w`` on ``j1``)."""
+    a = tab.cmd[s, c]
+    return (1.0 - w) * (tab.u[s, i, a] - tab.k[s, i, c]) + w * (tab.u[s, j1, a]
+                                                                 - tab.k[s, j1, c])
+
+
+@kernel(inline="always")
+def law_term(tab, s, i, j1, w, c, r, xr):
+    """The feedback of fed-back state ``r`` (its deviation from the 6-DOF trim
+    ``xr``) on command ``c``: ``K (xr - x*)`` of the interpolated designs."""
+    dev = xr - ((1.0 - w) * tab.x[s, i, r] + w * tab.x[s, j1, r])
+    return ((1.0 - w) * tab.K[s, i, c, r] + w * tab.K[s, j1, c, r]) * dev
 
 
 @kernel(internal=True)

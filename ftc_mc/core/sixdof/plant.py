@@ -44,6 +44,9 @@ Actuators: first order, throttle ``tau_thrust``, each elevon ``tau_elevon``
 held over the control period, ``n_sub`` sub-steps (10 at 0.1 s, as the
 longitudinal plant: the fastest mode, the roll subsidence at -38.5 1/s, gives
 h lambda = 0.39 at h = 0.01 s, well inside RK4's stability region).
+
+The linear 6-DOF plant (``plant.kind: linear``) steps the discrete model in
+deviations from the trim instead (:func:`linear_step`, :func:`linear_output`).
 """
 
 from __future__ import annotations
@@ -327,3 +330,31 @@ def simulate(x, cmds, p, winds, dt, n_sub, out):
         propagate(x, cmds[k], p, winds[k], dt, n_sub, work)
         for i in range(N_STATE):
             out[k + 1, i] = x[i]
+
+
+@kernel(inline="always")
+def linear_step(pl, x, cmd, wd, xn):
+    """One period of the linear 6-DOF plant: ``xn = A x + B (cmd - u0) + Bw wd``
+    (deviations from the trim; ``cmd`` absolute, ``wd`` the held wind) from the
+    model's fields of ``pl`` (``A``, ``B``, ``Bw``, ``u0``)."""
+    for i in range(N_STATE):
+        acc = 0.0
+        for j in range(N_STATE):
+            acc += pl.A[i, j] * x[j]
+        for j in range(cmd.shape[0]):
+            acc += pl.B[i, j] * (cmd[j] - pl.u0[j])
+        for j in range(wd.shape[0]):
+            acc += pl.Bw[i, j] * wd[j]
+        xn[i] = acc
+
+
+@kernel(inline="always")
+def linear_output(pl, x, wd, r):
+    """Output ``r`` of the linear 6-DOF plant at the deviation ``x``:
+    ``y0[r] + C[r] x + Dw[r] wd`` (``pl``'s ``y0``, ``C``, ``Dw``)."""
+    acc = pl.y0[r]
+    for j in range(N_STATE):
+        acc += pl.C[r, j] * x[j]
+    for j in range(wd.shape[0]):
+        acc += pl.Dw[r, j] * wd[j]
+    return acc

@@ -80,7 +80,7 @@ from .layout import (N_OUTPUT, N_STATE, N_WIND, OUTPUT, SIXDOF_LINEAR, SIXDOF_NO
                      STATE, U_LEFT, U_RIGHT, W_P, W_Q, W_R, W_U, W_V, W_W, X_PHI, X_PSI,
                      Y_ALPHA, Y_VA, sixdof_name)
 from .lockturn import LOCK_TURN, hands_back, lock_turn_law, turn_probe
-from .plant import N_WORK, outputs, propagate
+from .plant import N_WORK, linear_output, linear_step, outputs, propagate
 
 LATERAL_LOOP = ("phi", "v", "p", "r", "psi", "left", "right")
 """Rows of ``LaneState.lat``: the lateral loop's measured states, then its
@@ -287,15 +287,7 @@ def sixdof_truth(plant, scheme, flight, inp, k, st, work, rec):
             cmd[i] = u0[i] + work.e[i, l]
         wind6(work.wind, wlat, l, wd)
         if linear:
-            for i in range(N_STATE):
-                acc = 0.0
-                for j in range(N_STATE):
-                    acc += pl.A[i, j] * st.x[j, l]
-                for j in range(N_U):
-                    acc += pl.B[i, j] * (cmd[j] - pl.u0[j])
-                for j in range(N_WIND):
-                    acc += pl.Bw[i, j] * wd[j]
-                xn[i] = acc
+            linear_step(pl, st.x[:, l], cmd, wd, xn)
             for i in range(N_STATE):
                 st.x[i, l] = xn[i]
         else:
@@ -309,12 +301,7 @@ def sixdof_truth(plant, scheme, flight, inp, k, st, work, rec):
         wind6(work.wind_next, wlat_next, l, wd)
         if linear:
             for r in range(N_OUTPUT):
-                acc = pl.y0[r]
-                for j in range(N_STATE):
-                    acc += pl.C[r, j] * st.x[j, l]
-                for j in range(N_WIND):
-                    acc += pl.Dw[r, j] * wd[j]
-                y[r] = acc
+                y[r] = linear_output(pl, st.x[:, l], wd, r)
         else:
             for i in range(N_STATE):
                 x6[i] = pl.x0[i] + st.x[i, l]
