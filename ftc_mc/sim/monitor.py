@@ -313,7 +313,7 @@ def lock_turn_table(six, u0: np.ndarray, offsets=(), airframe=None,
         default :data:`NO_ROLLOUT`.
     wide : DesignBox, optional
         The designs' wide box (:func:`ftc_mc.design.lock_turn.envelope_box`;
-        the rollout guard's), or None.
+        the rollout guard's, and a table's on the linear model), or None.
     linear : bool
         Design on the 6-DOF linear model (``monitor.turn_model: linear``).
 
