@@ -129,3 +129,66 @@ def test_the_report_loads_the_columns_it_needs(tmp_path):
     assert len(survival_table(r.tables["trials"], 20.0, 100.0)) == 2
     lines = survival_lines(r.tables["trials"], cfg, tmp_path / "s.png", tmp_path / "r.md")
     assert lines and "### Survival after an elevon lock" in lines[0]
+
+
+TRIM = 0.05
+"""The trim command of the hand-made trials [rad]: ``lock_position = TRIM + lock_offset``."""
+
+
+def test_inside_and_outside_the_trimmable_set(tmp_path):
+    """:func:`trimmable_table` splits each row's trials at its set's ends: with
+    the set from trim to 5 deg above it, the 3 deg locks are inside (the 2 to 5
+    bin's figures) and the -1 deg ones outside (the -2 to -0.5 bin's); the ends
+    are reported as offsets of the trials' own frame; rows without a set are
+    left out; the Markdown and the figure's shading follow."""
+    from ftc_mc.campaign.survival import trimmable_markdown, trimmable_table
+    from ftc_mc.plots.campaign import survival_figure
+
+    t = _trials()
+    t = pd.concat([t, t[t["transition"] == "elevon_lock"].assign(transition="right_elevon_lock")])
+    t = t.assign(lock_position=TRIM + t["lock_offset"])
+    sets = {"elevon_lock": (TRIM, TRIM + math.radians(5.0))}
+    tab = trimmable_table(t, 20.0, 100.0, sets)
+    assert set(tab["transition"]) == {"elevon_lock"}
+    bins = survival_table(t, 20.0, 100.0).set_index(["transition", "offset_lo_deg"])
+    for where, lo in (("inside", 2.0), ("outside", -2.0)):
+        row = tab[tab["where"] == where].iloc[0]
+        ref = bins.loc[("elevon_lock", lo)]
+        for col in ("flying", "left", "unknown", "survived_rate", "height_lost_median_m"):
+            assert row[col] == ref[col] or (np.isnan(row[col]) and np.isnan(ref[col])), col
+    assert tab["set_lo_deg"].iloc[0] == 0.0 and abs(tab["set_hi_deg"].iloc[0] - 5.0) < 1e-12
+    md = trimmable_markdown(tab)
+    assert "## Inside and outside the trimmable set" in md
+    assert "+0.00 to +5.00" in md and "5/8 (62.5 %" in md and "2/3 (66.7 %" in md
+    assert trimmable_markdown(trimmable_table(t, 20.0, 100.0, {})) == ""
+    png = survival_figure(survival_table(t, 20.0, 100.0), tmp_path / "s.png", None, tab)
+    assert png.stat().st_size > 1000
+
+
+def test_the_trimmable_sets_of_a_run():
+    """:func:`trimmable_sets`: on the 6-DOF linear plant, each elevon-lock row's
+    set is :func:`~ftc_mc.model.trimmable.linear_trimmable_set` of its side,
+    in the run's validity envelope (a narrower bank bound narrows it); on the
+    nonlinear or the longitudinal plant, none."""
+    from ftc_mc.campaign.runner import resolve_config
+    from ftc_mc.campaign.survival import trimmable_sets
+    from ftc_mc.model.presets import PRESETS
+    from ftc_mc.model.sixdof import build_sixdof_plant
+    from ftc_mc.model.trimmable import linear_trimmable_set
+
+    def config(**over):
+        plant = {"kind": "linear", "dof": 6, **over.pop("plant", {})}
+        return resolve_config({"model": {"airframe": "x8-pyfly"}, "plant": plant,
+                               "campaign": {"transitions": ["elevon_lock", "engine_lock",
+                                                            "right_elevon_lock"]},
+                               **over})
+
+    sets = trimmable_sets(config())
+    pl = build_sixdof_plant(PRESETS["x8-pyfly"].airframe)
+    assert sets == {"elevon_lock": linear_trimmable_set(pl, "left"),
+                    "right_elevon_lock": linear_trimmable_set(pl, "right")}
+    narrow = trimmable_sets(config(validity={"bank_max_deg": 20.0}))
+    lo, hi = sets["elevon_lock"]
+    assert lo < narrow["elevon_lock"][0] and narrow["elevon_lock"][1] < hi
+    assert trimmable_sets(config(plant={"kind": "nonlinear"})) == {}
+    assert trimmable_sets(config(plant={"dof": 3})) == {}

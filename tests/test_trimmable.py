@@ -121,3 +121,28 @@ def test_the_linear_trimmable_set_agrees_with_a_search_of_its_plane(offset_deg):
           & (lo_e <= v["free_elevon"]) & (v["free_elevon"] <= hi_e))
     assert linear_steady_flight(pl, "left", lock) == bool(ok.any())
     assert bool(ok.any()) == (offset_deg in (-3.0, 0.0, 4.0))
+
+
+@pytest.mark.parametrize("side", ["left", "right"])
+def test_the_linear_trimmable_set_is_the_interval_its_ends_bound(side):
+    """:func:`linear_trimmable_set` (two linear programmes over lock and plane)
+    against :func:`linear_steady_flight` lock by lock: every lock 0.01 deg
+    inside its ends has a steady flight, none 0.01 deg outside them, and a
+    grid of locks every 0.25 deg from -12 to +12 deg of trim has one exactly
+    where the interval holds it.  The ends lie inside the grid search's bands
+    of docs/airframes.md (x8-pyfly, linear model: -4.75 to +5.5 deg left,
+    -5.25 to +5.5 deg right), within one step of 0.25 deg."""
+    from ftc_mc.core.sixdof.layout import COMMAND
+    from ftc_mc.model.trimmable import linear_steady_flight, linear_trimmable_set
+
+    pl = linear_plant()
+    lo, hi = linear_trimmable_set(pl, side)
+    eps = math.radians(0.01)
+    assert [linear_steady_flight(pl, side, v) for v in (lo + eps, hi - eps, lo - eps, hi + eps)] \
+        == [True, True, False, False]
+    trim = pl.u0[COMMAND[side]]
+    grid = trim + np.radians(np.arange(-12.0, 12.0 + 1e-9, 0.25))
+    assert [linear_steady_flight(pl, side, v) for v in grid] == list((grid >= lo) & (grid <= hi))
+    band = {"left": (-4.75, 5.5), "right": (-5.25, 5.5)}[side]
+    offsets = np.degrees([lo - trim, hi - trim])
+    assert band[0] - 0.25 < offsets[0] <= band[0] and band[1] <= offsets[1] < band[1] + 0.25

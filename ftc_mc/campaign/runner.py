@@ -24,7 +24,8 @@ from .chunk import chunk_spec
 from .parallel import run_chunks
 from .summary import markdown_table, summarize
 from .side import SIDE_COLUMNS, side_markdown, side_table
-from .survival import survival_markdown, survival_table
+from .survival import (survival_markdown, survival_table, trimmable_markdown,
+                       trimmable_sets, trimmable_table)
 
 
 class CampaignResult:
@@ -82,6 +83,18 @@ class CampaignResult:
         t = self.config.timing
         return survival_table(trials, t.fault_time_s, t.duration_s)
 
+    def trimmable(self) -> pd.DataFrame:
+        """Survival inside and outside the trimmable set
+        (:func:`~.survival.trimmable_table`; empty but on the 6-DOF linear plant)."""
+        sets = trimmable_sets(self.config)
+        if not sets:
+            return pd.DataFrame()
+        trials = self._trial_columns(["transition", "variant", "lock_offset",
+                                      "lock_position", "status", "stop_s",
+                                      "height_lost_m"])
+        t = self.config.timing
+        return trimmable_table(trials, t.fault_time_s, t.duration_s, sets)
+
     def side(self) -> pd.DataFrame:
         """Which actuator the 6-DOF side monitor named, per row and design
         (:func:`~.side.side_table`; empty without the monitor)."""
@@ -97,6 +110,7 @@ class CampaignResult:
         extra = ""
         if self.config is not None:
             extra = "".join("\n\n" + s for s in (survival_markdown(self.survival()),
+                                                  trimmable_markdown(self.trimmable()),
                                                   side_markdown(self.side())) if s)
         return markdown_table(self.summary) + extra
 

@@ -34,7 +34,7 @@ import pandas as pd
 from ..conventions import (STATUS_AIRSPEED, STATUS_ALPHA, STATUS_BANK, STATUS_NAMES,
                            STATUS_NONFINITE, STATUS_NOT_PSD)
 from ..stats import wilson
-from .transitions import transition_of
+from .transitions import LEFT, transition_of
 
 HORIZON_S = 60.0
 """Time after the lock over which survival is judged [s] (issue 26)."""
@@ -102,41 +102,139 @@ def survival_table(trials: pd.DataFrame, fault_time_s: float, duration_s: float,
     if not need <= set(trials.columns):
         return pd.DataFrame(rows)
     horizon = horizon_of(fault_time_s, duration_s)
+    edges = np.asarray(edges, dtype=float)
+    for name, variant, g, fate in _lock_groups(trials, fault_time_s, horizon):
+        off = np.degrees(g["lock_offset"].to_numpy(dtype=float))
+        which = np.digitize(off, edges[1:-1])
+        for b in range(len(edges) - 1):
+            row = _stats(fate, which == b, g)
+            if row is not None:
+                rows.append({"transition": name, "variant": variant,
+                             "offset_lo_deg": edges[b], "offset_hi_deg": edges[b + 1],
+                             "bin": bin_label(edges[b], edges[b + 1]), **row,
+                             "horizon_s": horizon})
+    return pd.DataFrame(rows)
+
+
+def _lock_groups(trials: pd.DataFrame, fault_time_s: float, horizon: float):
+    """Per elevon-lock row and design: ``(name, variant, trials, fate)``, the
+    trials with a lock offset and their fate over ``horizon`` (:func:`_fate`)."""
     # a trial without an offset (an older chunk of a resumed run) is in no bin
     locks = trials[trials["transition"].map(_is_elevon_lock)
                    & np.isfinite(trials["lock_offset"].to_numpy(dtype=float))]
-    edges = np.asarray(edges, dtype=float)
     for (name, variant), g in locks.groupby(["transition", "variant"], sort=False):
-        off = np.degrees(g["lock_offset"].to_numpy(dtype=float))
-        status = g["status"].to_numpy()
-        after = g["stop_s"].to_numpy(dtype=float) - fault_time_s
-        stopped = np.isfinite(after)
-        before_switch = stopped & (after <= 0.0)
-        within = stopped & (after <= horizon) & ~before_switch
-        numeric = within & np.isin(status, NUMERIC)
-        left = within & np.isin(status, EXITS)
-        keep = ~before_switch & ~numeric
-        which = np.digitize(off, edges[1:-1])
-        for b in range(len(edges) - 1):
-            in_bin = which == b
-            n = int((in_bin & keep).sum())
-            if not n and not (in_bin & numeric).any():
-                continue
-            k_left = int((in_bin & left).sum())
-            lo, hi = wilson(n - k_left, n) if n else (math.nan, math.nan)
-            leave = np.where(left, after, math.inf)[in_bin & keep]
-            median = float(np.median(leave)) if n and k_left * 2 > n else math.nan
-            lost = g["height_lost_m"].to_numpy(dtype=float)[in_bin & left]
-            rows.append({
-                "transition": name, "variant": variant,
-                "offset_lo_deg": edges[b], "offset_hi_deg": edges[b + 1],
-                "bin": bin_label(edges[b], edges[b + 1]), "flying": n, "left": k_left,
-                "survived_rate": (n - k_left) / n if n else math.nan,
-                "survived_ci_low": lo, "survived_ci_high": hi,
-                "median_leave_s": median,
-                "height_lost_median_m": float(np.median(lost)) if len(lost) else math.nan,
-                "unknown": int((in_bin & numeric).sum()), "horizon_s": horizon})
+        yield name, variant, g, _fate(g, fault_time_s, horizon)
+
+
+def _fate(g: pd.DataFrame, fault_time_s: float, horizon: float) -> dict:
+    """What became of each trial of ``g`` over ``horizon`` after the lock:
+    ``after`` (its stop from the lock [s]), ``left`` (left the envelope
+    within the horizon), ``numeric`` (stopped numerically within it) and
+    ``keep`` (counted: neither that nor stopped before the lock)."""
+    status = g["status"].to_numpy()
+    after = g["stop_s"].to_numpy(dtype=float) - fault_time_s
+    stopped = np.isfinite(after)
+    before_switch = stopped & (after <= 0.0)
+    within = stopped & (after <= horizon) & ~before_switch
+    numeric = within & np.isin(status, NUMERIC)
+    return {"after": after, "left": within & np.isin(status, EXITS), "numeric": numeric,
+            "keep": ~before_switch & ~numeric}
+
+
+def _stats(fate: dict, sel: np.ndarray, g: pd.DataFrame):
+    """The survival figures of the trials ``sel`` selects (module docstring),
+    or None when it selects none."""
+    n = int((sel & fate["keep"]).sum())
+    unknown = int((sel & fate["numeric"]).sum())
+    if not n and not unknown:
+        return None
+    left = fate["left"]
+    k_left = int((sel & left).sum())
+    lo, hi = wilson(n - k_left, n) if n else (math.nan, math.nan)
+    leave = np.where(left, fate["after"], math.inf)[sel & fate["keep"]]
+    lost = g["height_lost_m"].to_numpy(dtype=float)[sel & left]
+    return {"flying": n, "left": k_left,
+            "survived_rate": (n - k_left) / n if n else math.nan,
+            "survived_ci_low": lo, "survived_ci_high": hi,
+            "median_leave_s": float(np.median(leave)) if n and k_left * 2 > n else math.nan,
+            "height_lost_median_m": float(np.median(lost)) if len(lost) else math.nan,
+            "unknown": unknown}
+
+
+def trimmable_table(trials: pd.DataFrame, fault_time_s: float, duration_s: float,
+                    sets: dict) -> pd.DataFrame:
+    """Survival inside and outside the trimmable set of each elevon-lock row
+    (issue 26's targets: 90 % of the locks inside stay in; outside, the median
+    time to leave).
+
+    Parameters
+    ----------
+    trials : DataFrame
+        As :func:`survival_table`'s, with ``lock_position`` [rad].
+    fault_time_s, duration_s : float
+        The run's ``timing`` [s].
+    sets : dict
+        Transition name -> ``(lo, hi)``: the locks [rad, absolute] of its
+        elevon with a steady flight (:func:`trimmable_sets`); rows not in it
+        are left out.
+
+    Returns
+    -------
+    DataFrame
+        Per row, design and ``where`` (``inside``, ``outside``): the columns of
+        :func:`survival_table` but the bin's, with ``set_lo_deg`` and
+        ``set_hi_deg``, the set's ends as offsets from the trim command of the
+        trials' ``lock_offset`` [deg].
+    """
+    rows = []
+    if not {"lock_offset", "lock_position", "height_lost_m", "status",
+            "stop_s"} <= set(trials.columns):
+        return pd.DataFrame(rows)
+    horizon = horizon_of(fault_time_s, duration_s)
+    for name, variant, g, fate in _lock_groups(trials, fault_time_s, horizon):
+        if name not in sets:
+            continue
+        lo, hi = sets[name]
+        pos = g["lock_position"].to_numpy(dtype=float)
+        trim = float(np.median(pos - g["lock_offset"].to_numpy(dtype=float)))
+        inside = (pos >= lo) & (pos <= hi)
+        for where, sel in (("inside", inside), ("outside", ~inside)):
+            row = _stats(fate, sel, g)
+            if row is not None:
+                rows.append({"transition": name, "variant": variant, "where": where,
+                             "set_lo_deg": math.degrees(lo - trim),
+                             "set_hi_deg": math.degrees(hi - trim), **row,
+                             "horizon_s": horizon})
     return pd.DataFrame(rows)
+
+
+def trimmable_sets(config) -> dict:
+    """The trimmable set of each elevon-lock row of a run on the 6-DOF linear
+    plant: transition name -> ``(lo, hi)``, the locks [rad, absolute] of its
+    elevon for which the linear model has a steady flight inside the run's
+    validity envelope (:func:`ftc_mc.model.trimmable.linear_trimmable_set`,
+    exact); ``{}`` for any other run.  The equations' set (nonlinear plant) is
+    not an interval found in closed form: ``scripts/study_trimmable.py``."""
+    if config.plant.dof != 6 or config.plant.kind != "linear":
+        return {}
+    from ..model.presets import resolve_airframe
+    from ..model.sixdof import build_sixdof_plant
+    from ..model.trimmable import Envelope, linear_trimmable_set
+
+    m, v = config.model, config.validity
+    plant = build_sixdof_plant(resolve_airframe(m.airframe), m.airspeed_mps, m.gamma_deg,
+                               m.dt_s)
+    env = Envelope(airspeed=(v.airspeed_min_mps, v.airspeed_max_mps),
+                   alpha=(math.radians(v.alpha_min_deg), math.radians(v.alpha_max_deg)),
+                   bank=math.radians(v.bank_max_deg))
+    out = {}
+    for name in config.campaign.transitions:
+        if _is_elevon_lock(name):
+            side = "left" if transition_of(name).actuator == LEFT else "right"
+            ends = linear_trimmable_set(plant, side, env)
+            if ends is not None:
+                out[name] = ends
+    return out
 
 
 def survival_markdown(table: pd.DataFrame, level: int = 2) -> str:
@@ -176,3 +274,34 @@ def survival_markdown(table: pd.DataFrame, level: int = 2) -> str:
             rows.append(row)
         out += [pd.DataFrame(rows).fillna("-").to_markdown(index=False), ""]
     return "\n".join(out)
+
+
+def trimmable_markdown(table: pd.DataFrame, level: int = 2) -> str:
+    """:func:`trimmable_table` in Markdown: a line per elevon-lock row and
+    design, the locks inside the trimmable set beside those outside it;
+    headings at ``level``; ``""`` for an empty table."""
+    if not len(table):
+        return ""
+    horizon = table["horizon_s"].iloc[0]
+    out = ["#" * level + " Inside and outside the trimmable set", "",
+           "The trimmable set: the locks for which the 6-DOF linear model has a steady "
+           "flight, straight or turning, inside the validity envelope with the healthy "
+           "elevon and the throttle within their limits (exact: two linear programmes, "
+           "`ftc_mc/model/trimmable.py`). Share staying inside the envelope for "
+           f"{horizon:g} s after the lock (95 % Wilson interval) and median time from the "
+           "lock to the exit (`>H`: at least half stay in), as in the survival table.", ""]
+    rows = []
+    for (name, variant), g in table.groupby(["transition", "variant"], sort=False):
+        row = {"row": f"`{name}`", "design": variant,
+               "trimmable set [deg]": f"{g['set_lo_deg'].iloc[0]:+.2f} to "
+                                      f"{g['set_hi_deg'].iloc[0]:+.2f}"}
+        for _, r in g.iterrows():
+            w = r["where"]
+            row[f"{w}: stay in"] = (f"{r['flying'] - r['left']}/{r['flying']} "
+                                    f"({100 * r['survived_rate']:.1f} %, "
+                                    f"{100 * r['survived_ci_low']:.1f}-"
+                                    f"{100 * r['survived_ci_high']:.1f})")
+            row[f"{w}: median exit [s]"] = (f">{horizon:g}" if not np.isfinite(
+                r["median_leave_s"]) else f"{r['median_leave_s']:.1f}")
+        rows.append(row)
+    return "\n".join(out + [pd.DataFrame(rows).fillna("-").to_markdown(index=False)])

@@ -320,15 +320,57 @@ def linear_closest(plant, s: LinearSteady, bounds: dict, cost=None):
     return z
 
 
+def _linear_bounds(plant, envelope: Envelope) -> dict:
+    """The bounds of :func:`linear_steady_flight` (:func:`linear_closest`'s form)."""
+    af = plant.airframe
+    return {"Va": envelope.airspeed, "alpha": envelope.alpha,
+            "phi": (-envelope.bank, envelope.bank), "beta": (-0.5, 0.5),
+            "theta": (-1.2, 1.2), "r": (-2.0, 2.0), "throttle": af.throttle_limits,
+            "free_elevon": af.elevon_limits}
+
+
 def linear_steady_flight(plant, side: str, lock: float,
                          envelope: Envelope = Envelope()) -> bool:
     """Whether the 6-DOF linear model has a steady flight (:class:`LinearSteady`)
     with the ``side`` elevon locked at ``lock`` [rad] inside ``envelope``, with
     the throttle and the healthy elevon within the airframe's limits and the
     sideslip, pitch and yaw rate within :func:`steady_flight`'s bounds."""
-    af = plant.airframe
-    bounds = {"Va": envelope.airspeed, "alpha": envelope.alpha,
-              "phi": (-envelope.bank, envelope.bank), "beta": (-0.5, 0.5),
-              "theta": (-1.2, 1.2), "r": (-2.0, 2.0), "throttle": af.throttle_limits,
-              "free_elevon": af.elevon_limits}
-    return linear_closest(plant, linear_steady(plant, side, lock), bounds) is not None
+    return linear_closest(plant, linear_steady(plant, side, lock),
+                          _linear_bounds(plant, envelope)) is not None
+
+
+def linear_trimmable_set(plant, side: str, envelope: Envelope = Envelope()):
+    """The locks of the ``side`` elevon [rad, absolute] for which
+    :func:`linear_steady_flight` holds: an interval, ``(lo, hi)``, or None when
+    no lock has a steady flight inside ``envelope``.
+
+    Every term of :class:`LinearSteady` and :func:`linear_quantities` is affine
+    in the lock, so the pairs (lock, ``z``) of steady flights inside the bounds
+    form a polytope, and the trimmable locks its projection: an interval,
+    whose ends two linear programmes (``scipy.optimize.linprog``) find.  The
+    lock itself is bounded only by the airframe's elevon limits.
+    """
+    lo_lim, hi_lim = plant.airframe.elevon_limits
+    base, unit = linear_steady(plant, side, 0.0), linear_steady(plant, side, 1.0)
+    q0, q1 = linear_quantities(plant, base), linear_quantities(plant, unit)
+    rows, rhs = [], []
+    for name, (lo, hi) in _linear_bounds(plant, envelope).items():
+        a, b = q0[name]
+        slope = q1[name][0] - a  # the value's change per radian of lock
+        for bound, sign in ((lo, -1.0), (hi, 1.0)):
+            if bound is not None:  # sign (a + slope lock + b z) <= sign bound
+                rows.append(sign * np.append(b, slope))
+                rhs.append(sign * (bound - a))
+    A_eq = np.column_stack([base.M, unit.c - base.c])
+    ends = []
+    for direction in (1.0, -1.0):  # the lowest lock, then the highest
+        cost = np.zeros(A_eq.shape[1])
+        cost[-1] = direction
+        sol = scipy.optimize.linprog(cost, A_ub=np.array(rows), b_ub=np.array(rhs),
+                                     A_eq=A_eq, b_eq=-base.c,
+                                     bounds=[(None, None)] * base.M.shape[1]
+                                     + [(lo_lim, hi_lim)], method="highs")
+        if sol.status != 0:
+            return None
+        ends.append(float(sol.x[-1]))
+    return tuple(ends)

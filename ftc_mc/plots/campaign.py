@@ -120,10 +120,12 @@ def delay_figure(trials: pd.DataFrame, path: Path, labels=None) -> Path:
     return save(fig, path)
 
 
-def survival_figure(table: pd.DataFrame, path: Path, labels=None) -> Path:
+def survival_figure(table: pd.DataFrame, path: Path, labels=None,
+                    trimmable: pd.DataFrame | None = None) -> Path:
     """Share of trials staying inside the envelope after an elevon lock, against
     the lock offset from trim, one panel per elevon-lock row and one line per
-    design (95 % Wilson intervals as bars).
+    design (95 % Wilson intervals as bars); the trimmable set shaded where it
+    is known.
 
     Parameters
     ----------
@@ -133,6 +135,9 @@ def survival_figure(table: pd.DataFrame, path: Path, labels=None) -> Path:
         PNG file, written atomically.
     labels : mapping of str to str, optional
         Display label of each transition name.
+    trimmable : DataFrame, optional
+        :func:`ftc_mc.campaign.survival.trimmable_table` of the run: each row's
+        set is shaded, its ends placed in their bins in proportion.
 
     Returns
     -------
@@ -143,10 +148,23 @@ def survival_figure(table: pd.DataFrame, path: Path, labels=None) -> Path:
     bins = (table[["offset_lo_deg", "offset_hi_deg", "bin"]].drop_duplicates()
             .sort_values("offset_lo_deg"))
     pos = {b: i for i, b in enumerate(bins["bin"])}
+
+    def x_of(offset):
+        """Position of a lock offset [deg] on the binned axis."""
+        for i, (lo, hi) in enumerate(zip(bins["offset_lo_deg"], bins["offset_hi_deg"])):
+            if lo <= offset < hi:
+                frac = (offset - lo) / (hi - lo) if np.isfinite(lo) and np.isfinite(hi) else 0.5
+                return i - 0.5 + frac
+        return -0.5 if offset < bins["offset_lo_deg"].iloc[0] else len(pos) - 0.5
     styles = design_styles(list(dict.fromkeys(table["variant"])))
     fig, axs = plt.subplots(1, len(names), figsize=(5.5 * len(names), 3.8), sharey=True,
                             layout="constrained", squeeze=False)
     for ax, name in zip(axs[0], names):
+        sets = (trimmable[trimmable["transition"] == name] if trimmable is not None
+                and len(trimmable) else ())
+        if len(sets):
+            ax.axvspan(x_of(sets["set_lo_deg"].iloc[0]), x_of(sets["set_hi_deg"].iloc[0]),
+                       color="0.9", zorder=0, label="trimmable set")
         for variant, g in table[table["transition"] == name].groupby("variant", sort=False):
             g = g[g["flying"] > 0]
             x = np.array([pos[b] for b in g["bin"]])

@@ -434,7 +434,8 @@ def run_section(r: ResultDir, fig_dir: Path, slug: str, report: Path) -> list:
 def survival_lines(trials: pd.DataFrame, cfg: dict, fig_path: Path, report: Path) -> list:
     """The survival after an elevon lock (:mod:`ftc_mc.campaign.survival`) with its
     figure; nothing for a run without elevon-lock rows."""
-    from ..campaign.survival import survival_markdown, survival_table
+    from ..campaign.survival import (survival_markdown, survival_table, trimmable_markdown,
+                                     trimmable_table)
     from ..plots.campaign import survival_figure
 
     timing = cfg.get("timing", {})
@@ -443,9 +444,26 @@ def survival_lines(trials: pd.DataFrame, cfg: dict, fig_path: Path, report: Path
     table = survival_table(trials, timing["fault_time_s"], timing["duration_s"])
     if not len(table):
         return []
-    fig = survival_figure(table, fig_path, LABELS)
-    return [survival_markdown(table, level=3), "",
-            f"![survival of {fig_path.stem}]({rel_link(fig, report)})", ""]
+    sets = _trimmable_sets(cfg)
+    inside = trimmable_table(trials, timing["fault_time_s"], timing["duration_s"], sets)
+    fig = survival_figure(table, fig_path, LABELS, inside)
+    return ([survival_markdown(table, level=3), ""]
+            + ([trimmable_markdown(inside, level=3), ""] if len(inside) else [])
+            + [f"![survival of {fig_path.stem}]({rel_link(fig, report)})", ""])
+
+
+def _trimmable_sets(cfg: dict) -> dict:
+    """:func:`ftc_mc.campaign.survival.trimmable_sets` of a run's stored
+    configuration; ``{}`` when it no longer parses (a run of an older
+    version) or its airframe file is gone."""
+    from ..campaign.survival import trimmable_sets
+    from ..config.load import parse_config
+    from ..errors import UserError
+
+    try:
+        return trimmable_sets(parse_config(cfg))
+    except (ValueError, UserError):
+        return {}
 
 
 def side_lines(trials: pd.DataFrame, cfg: dict) -> list:
