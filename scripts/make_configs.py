@@ -69,7 +69,7 @@ side (``ftc_mc/core/sixdof/lockturn.py``; docs/airframes.md)."""
 SIXDOF_TABLE_DEG = (-14.0, 8.0)
 """The lock-turn table of the still-air 6-DOF configs [deg from trim]: past the
 steady band of the airframe's equations (-29 to +2.25 deg on x8-pyfly, in the
-design box about -10 to +2) and of the linear model (-4.75 to +5.5 deg), so
+design box about -10 to +2) and of the linear model (-4.87 to +5.68 deg), so
 that ``--plant linear`` runs fly no end design beyond its end."""
 
 

@@ -13,7 +13,9 @@ deg), with the healthy elevon and the throttle within the airframe's limits:
   a linear programme; milliseconds per lock).
 
 Prints, per airframe, model and side, the band of trimmable offsets on the
-grid and whether it is one interval.
+grid and whether it is one interval; for the linear model also the set's
+exact ends (``ftc_mc.model.trimmable.linear_trimmable_set``: the set is one
+interval, whose ends two linear programmes find).
 
     python scripts/study_trimmable.py [--airframe x8-pyfly,x8-gryte2018]
         [--models linear,nonlinear] [--offsets=-12:12:0.25]
@@ -31,7 +33,7 @@ import numpy as np
 from ftc_mc.core.sixdof.layout import COMMAND
 from ftc_mc.model.presets import resolve_airframe
 from ftc_mc.model.sixdof import build_sixdof_plant
-from ftc_mc.model.trimmable import linear_steady_flight, steady_flight
+from ftc_mc.model.trimmable import linear_steady_flight, linear_trimmable_set, steady_flight
 
 SIDES = ("left", "right")
 
@@ -45,6 +47,16 @@ def trimmable(name: str, model: str, side: str, offsets_deg) -> list:
     if model == "linear":
         return [linear_steady_flight(plant, side, lock) for lock in locks]
     return [steady_flight(af, side, lock).steady for lock in locks]
+
+
+def exact(name: str, side: str) -> str:
+    """The linear model's trimmable set of ``side`` as offsets from trim [deg]."""
+    plant = build_sixdof_plant(resolve_airframe(name))
+    ends = linear_trimmable_set(plant, side)
+    if ends is None:
+        return "none"
+    trim = plant.u0[COMMAND[side]]
+    return " to ".join(f"{math.degrees(e - trim):+.2f}" for e in ends) + " deg"
 
 
 def band(offsets_deg, ok) -> str:
@@ -71,8 +83,9 @@ def main(argv=None):
             for side in SIDES:
                 t0 = time.perf_counter()
                 ok = trimmable(name, model, side, offsets)
-                print(f"{name} {model:9s} {side:5s}: {band(offsets, ok)} "
-                      f"[{time.perf_counter() - t0:.1f} s]", flush=True)
+                print(f"{name} {model:9s} {side:5s}: {band(offsets, ok)}"
+                      + (f"; exact {exact(name, side)}" if model == "linear" else "")
+                      + f" [{time.perf_counter() - t0:.1f} s]", flush=True)
 
 
 if __name__ == "__main__":

@@ -68,7 +68,7 @@ with the locked elevon's command its lock position.
    the side monitor gives such a table the wide box too), and steps 3-4 use
    its own discrete matrices,
    the held offset entering through the locked elevon's actuator and command
-   columns.  On ``x8-pyfly`` its trimmable set is -4.75 to +5.5 deg (left),
+   columns.  On ``x8-pyfly`` its trimmable set is -4.87 to +5.68 deg (left),
    against -29 to +2.25 deg for the equations (``docs/airframes.md``).
 """
 
