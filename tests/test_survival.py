@@ -8,6 +8,7 @@ import math
 
 import numpy as np
 import pandas as pd
+import pytest
 
 from ftc_mc.campaign.survival import (OFFSET_EDGES_DEG, horizon_of, survival_markdown,
                                       survival_table)
@@ -169,7 +170,7 @@ def test_the_trimmable_sets_of_a_run():
     """:func:`trimmable_sets`: on the 6-DOF linear plant, each elevon-lock row's
     set is :func:`~ftc_mc.model.trimmable.linear_trimmable_set` of its side,
     in the run's validity envelope (a narrower bank bound narrows it); on the
-    nonlinear or the longitudinal plant, none."""
+    longitudinal plant, none."""
     from ftc_mc.campaign.runner import resolve_config
     from ftc_mc.campaign.survival import trimmable_sets
     from ftc_mc.model.presets import PRESETS
@@ -190,5 +191,69 @@ def test_the_trimmable_sets_of_a_run():
     narrow = trimmable_sets(config(validity={"bank_max_deg": 20.0}))
     lo, hi = sets["elevon_lock"]
     assert lo < narrow["elevon_lock"][0] and narrow["elevon_lock"][1] < hi
-    assert trimmable_sets(config(plant={"kind": "nonlinear"})) == {}
     assert trimmable_sets(config(plant={"dof": 3})) == {}
+
+
+def test_bisect_band_finds_the_ends_of_an_interval():
+    """:func:`bisect_band` on a known interval: its ends within the tolerance
+    and inside it; a limit inside the interval is its end; a start outside
+    gives None."""
+    from ftc_mc.model.trimmable import bisect_band
+
+    calls = []
+
+    def steady(lock):
+        calls.append(lock)
+        return -0.3 <= lock <= 0.05
+
+    lo, hi = bisect_band(steady, 0.0, (-0.6, 0.6), 1e-4)
+    assert -0.3 <= lo < -0.3 + 1e-4 and 0.05 - 1e-4 < hi <= 0.05
+    assert len(calls) < 40
+    assert bisect_band(steady, 0.0, (-0.2, 0.6), 1e-4)[0] == -0.2
+    assert bisect_band(steady, 0.4, (-0.6, 0.6), 1e-4) is None
+
+
+@pytest.mark.trimmable_search
+def test_the_equations_set_is_searched_once_and_cached(tmp_path, monkeypatch):
+    """:func:`cached_trimmable_sets`: the first call searches (one notice) and
+    writes the cache; the next reads it without searching; an unreadable file
+    is searched again; another envelope is another key.  On the 6-DOF
+    nonlinear plant, :func:`trimmable_sets` reads the same cache (the search
+    stubbed: the real one takes about a minute per side)."""
+    import io
+
+    import ftc_mc.design.trimmable_cache as tc
+    from ftc_mc.campaign.runner import resolve_config
+    from ftc_mc.campaign.survival import trimmable_sets
+    from ftc_mc.model.presets import PRESETS
+    from ftc_mc.model.trimmable import Envelope
+
+    searched = []
+
+    def search(airframe, side, envelope):
+        searched.append((side, envelope))
+        return (-0.5, 0.1)
+
+    monkeypatch.setattr(tc, "equations_trimmable_set", search)
+    af = PRESETS["x8-pyfly"].airframe
+    out = io.StringIO()
+    assert tc.cached_trimmable_sets(af, ["left"], cache_dir=tmp_path / "design", stream=out) \
+        == {"left": (-0.5, 0.1)}
+    assert "finding the trimmable set" in out.getvalue() and len(searched) == 1
+    out = io.StringIO()
+    assert tc.cached_trimmable_sets(af, ["left"], cache_dir=tmp_path / "design", stream=out) \
+        == {"left": (-0.5, 0.1)}
+    assert out.getvalue() == "" and len(searched) == 1
+    (file,) = (tmp_path / "design" / "trimmable").glob("*.json")
+    file.write_text("{not json")
+    tc.cached_trimmable_sets(af, ["left"], cache_dir=tmp_path / "design", stream=io.StringIO())
+    assert len(searched) == 2
+    tc.cached_trimmable_sets(af, ["left"], Envelope(bank=0.5), cache_dir=tmp_path / "design",
+                             stream=io.StringIO())
+    assert len(searched) == 3 and len(list((tmp_path / "design" / "trimmable").glob("*.json"))) == 2
+    monkeypatch.setenv("FTC_MC_CACHE_DIR", str(tmp_path))
+    cfg = resolve_config({"model": {"airframe": "x8-pyfly"},
+                          "plant": {"kind": "nonlinear", "dof": 6},
+                          "campaign": {"transitions": ["elevon_lock", "engine_lock"]}})
+    assert trimmable_sets(cfg, stream=io.StringIO()) == {"elevon_lock": (-0.5, 0.1)}
+    assert len(searched) == 3  # the default envelope's file, written above

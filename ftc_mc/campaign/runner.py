@@ -85,7 +85,8 @@ class CampaignResult:
 
     def trimmable(self) -> pd.DataFrame:
         """Survival inside and outside the trimmable set
-        (:func:`~.survival.trimmable_table`; empty but on the 6-DOF linear plant)."""
+        (:func:`~.survival.trimmable_table`; empty but on the 6-DOF plant; its
+        first run per airframe on the nonlinear one searches the set, a minute or two)."""
         sets = trimmable_sets(self.config)
         if not sets:
             return pd.DataFrame()
@@ -110,7 +111,9 @@ class CampaignResult:
         extra = ""
         if self.config is not None:
             extra = "".join("\n\n" + s for s in (survival_markdown(self.survival()),
-                                                  trimmable_markdown(self.trimmable()),
+                                                  trimmable_markdown(
+                                                      self.trimmable(),
+                                                      kind=self.config.plant.kind),
                                                   side_markdown(self.side())) if s)
         return markdown_table(self.summary) + extra
 

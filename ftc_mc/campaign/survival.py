@@ -208,33 +208,52 @@ def trimmable_table(trials: pd.DataFrame, fault_time_s: float, duration_s: float
     return pd.DataFrame(rows)
 
 
-def trimmable_sets(config) -> dict:
-    """The trimmable set of each elevon-lock row of a run on the 6-DOF linear
-    plant: transition name -> ``(lo, hi)``, the locks [rad, absolute] of its
-    elevon for which the linear model has a steady flight inside the run's
-    validity envelope (:func:`ftc_mc.model.trimmable.linear_trimmable_set`,
-    exact); ``{}`` for any other run.  The equations' set (nonlinear plant) is
-    not an interval found in closed form: ``scripts/study_trimmable.py``."""
-    if config.plant.dof != 6 or config.plant.kind != "linear":
+def trimmable_sets(config, stream=None) -> dict:
+    """The trimmable set of each elevon-lock row of a run on the 6-DOF plant:
+    transition name -> ``(lo, hi)``, the locks [rad, absolute] of its elevon
+    with a steady flight inside the run's validity envelope, of the model the
+    truth flies (:data:`SET_MODELS`); ``{}`` on the longitudinal plants.
+
+    * linear plant: the linear model's set, exact
+      (:func:`ftc_mc.model.trimmable.linear_trimmable_set`);
+    * nonlinear plant: the airframe's equations' set, by bisection of
+      steady-flight searches from the trim (a minute or two on the first run per
+      airframe and envelope, then cached:
+      :func:`ftc_mc.design.trimmable_cache.cached_trimmable_sets`; ``stream``
+      gets its notice).
+    """
+    if config.plant.dof != 6:
         return {}
     from ..model.presets import resolve_airframe
-    from ..model.sixdof import build_sixdof_plant
-    from ..model.trimmable import Envelope, linear_trimmable_set
+    from ..model.trimmable import Envelope
 
     m, v = config.model, config.validity
-    plant = build_sixdof_plant(resolve_airframe(m.airframe), m.airspeed_mps, m.gamma_deg,
-                               m.dt_s)
+    af = resolve_airframe(m.airframe)
     env = Envelope(airspeed=(v.airspeed_min_mps, v.airspeed_max_mps),
                    alpha=(math.radians(v.alpha_min_deg), math.radians(v.alpha_max_deg)),
                    bank=math.radians(v.bank_max_deg))
-    out = {}
-    for name in config.campaign.transitions:
-        if _is_elevon_lock(name):
-            side = "left" if transition_of(name).actuator == LEFT else "right"
-            ends = linear_trimmable_set(plant, side, env)
-            if ends is not None:
-                out[name] = ends
-    return out
+    rows = {name: "left" if transition_of(name).actuator == LEFT else "right"
+            for name in config.campaign.transitions if _is_elevon_lock(name)}
+    if not rows:
+        return {}
+    if config.plant.kind == "linear":
+        from ..model.sixdof import build_sixdof_plant
+        from ..model.trimmable import linear_trimmable_set
+
+        plant = build_sixdof_plant(af, m.airspeed_mps, m.gamma_deg, m.dt_s)
+        ends = {side: linear_trimmable_set(plant, side, env) for side in set(rows.values())}
+    else:
+        from ..design.trimmable_cache import cached_trimmable_sets
+
+        ends = cached_trimmable_sets(af, sorted(set(rows.values())), env, name=m.airframe,
+                                     stream=stream)
+    return {name: ends[side] for name, side in rows.items() if ends[side] is not None}
+
+
+SET_MODELS = {"linear": "the 6-DOF linear model (exact: two linear programmes)",
+              "nonlinear": "the airframe's equations (bisection of steady-flight searches "
+                           "from the trim, to 0.05 deg)"}
+"""What the trimmable set is of, by truth plant kind (:func:`trimmable_sets`)."""
 
 
 def survival_markdown(table: pd.DataFrame, level: int = 2) -> str:
@@ -276,18 +295,19 @@ def survival_markdown(table: pd.DataFrame, level: int = 2) -> str:
     return "\n".join(out)
 
 
-def trimmable_markdown(table: pd.DataFrame, level: int = 2) -> str:
+def trimmable_markdown(table: pd.DataFrame, level: int = 2, kind: str = "linear") -> str:
     """:func:`trimmable_table` in Markdown: a line per elevon-lock row and
     design, the locks inside the trimmable set beside those outside it;
-    headings at ``level``; ``""`` for an empty table."""
+    headings at ``level``; ``kind``: the truth plant's (:data:`SET_MODELS`);
+    ``""`` for an empty table."""
     if not len(table):
         return ""
     horizon = table["horizon_s"].iloc[0]
     out = ["#" * level + " Inside and outside the trimmable set", "",
-           "The trimmable set: the locks for which the 6-DOF linear model has a steady "
-           "flight, straight or turning, inside the validity envelope with the healthy "
-           "elevon and the throttle within their limits (exact: two linear programmes, "
-           "`ftc_mc/model/trimmable.py`). Share staying inside the envelope for "
+           "The trimmable set: the locks with a steady flight, straight or turning, "
+           "inside the validity envelope with the healthy elevon and the throttle within "
+           f"their limits, of {SET_MODELS[kind]} (`ftc_mc/model/trimmable.py`). "
+           "Share staying inside the envelope for "
            f"{horizon:g} s after the lock (95 % Wilson interval) and median time from the "
            "lock to the exit (`>H`: at least half stay in), as in the survival table.", ""]
     rows = []

@@ -181,6 +181,59 @@ def trimmable_set(airframe: Airframe, side: str, offsets_deg, **kw) -> list:
             for o in offsets_deg]
 
 
+def bisect_band(steady, start: float, limits, tol: float):
+    """The band of locks around ``start`` for which ``steady`` holds, its ends
+    found by bisection towards each limit.
+
+    Parameters
+    ----------
+    steady : callable
+        ``steady(lock) -> bool``.
+    start : float
+        A lock for which it holds [rad].
+    limits : (float, float)
+        The lowest and highest locks [rad]: an end that holds is the band's.
+    tol : float
+        Largest distance of each end from the nearest lock where it fails [rad].
+
+    Returns
+    -------
+    (float, float) or None
+        The lowest and highest locks found to hold; None when ``start`` does
+        not.  Bisection assumes one interval: a lock beyond a failing one is
+        not tried (``scripts/study_trimmable.py`` checks a grid).
+    """
+    if not steady(start):
+        return None
+    ends = []
+    for limit in limits:
+        inside, outside = start, limit
+        if steady(limit):
+            ends.append(float(limit))
+            continue
+        while abs(outside - inside) > tol:
+            mid = 0.5 * (inside + outside)
+            inside, outside = (mid, outside) if steady(mid) else (inside, mid)
+        ends.append(float(inside))
+    return tuple(ends)
+
+
+def equations_trimmable_set(airframe: Airframe, side: str, envelope: Envelope = Envelope(),
+                            tol: float = math.radians(0.05)):
+    """The locks of the ``side`` elevon [rad, absolute] for which
+    :func:`steady_flight` finds a steady flight of the airframe's equations
+    inside ``envelope``: :func:`bisect_band` from the trim towards the elevon
+    limits, to ``tol`` [rad] (about 20 searches per side, 0.1 s for a lock
+    that has one and up to 13 s for one that has none).  From the 6-DOF trim:
+    ``x8-pyfly`` -29.27 to +2.34 deg (left elevon) and -28.85 to +2.62 deg
+    (right), where a 0.25 deg grid from -30 to +6 deg finds one interval each,
+    -29.25 to +2.25 and -28.75 to +2.5 deg; ``x8-gryte2018`` -33.52 to +6.26
+    deg on both sides."""
+    start = trim6(airframe).u0[COMMAND[side]]
+    return bisect_band(lambda lock: steady_flight(airframe, side, lock, envelope).steady,
+                       start, airframe.elevon_limits, tol)
+
+
 LINEAR_FREE = ("phi", "theta", "u", "v", "w", "p", "q", "r")
 """The rigid-body states of a steady flight of the 6-DOF linear model (its
 unknowns, with the throttle and the healthy elevon)."""

@@ -448,7 +448,9 @@ def survival_lines(trials: pd.DataFrame, cfg: dict, fig_path: Path, report: Path
     inside = trimmable_table(trials, timing["fault_time_s"], timing["duration_s"], sets)
     fig = survival_figure(table, fig_path, LABELS, inside)
     return ([survival_markdown(table, level=3), ""]
-            + ([trimmable_markdown(inside, level=3), ""] if len(inside) else [])
+            + ([trimmable_markdown(inside, level=3,
+                                                kind=cfg.get("plant", {}).get("kind", "linear")), ""]
+               if len(inside) else [])
             + [f"![survival of {fig_path.stem}]({rel_link(fig, report)})", ""])
 
 
