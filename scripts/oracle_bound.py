@@ -7,12 +7,14 @@ offset, the longest stay any command history it searched keeps the aircraft
 inside (an oracle: side and lock known from the lock's first instant).  This
 script puts that beside a run's trials:
 
-* the run's elevon-lock trials of the studied side outside the trimmable set:
-  on the 6-DOF linear plant the exact set of the run's validity envelope
-  (:func:`ftc_mc.campaign.survival.trimmable_sets`), elsewhere the study's
-  own ``trimmable`` verdict at the nearest studied offset;
-* per design, their median time from the lock to the exit (a trial that
-  stays in counts as never leaving);
+* the run's elevon-lock trials of the studied side outside the trimmable set
+  of the model the run flies, in its validity envelope
+  (:func:`ftc_mc.campaign.survival.trimmable_sets`: on the linear plant
+  exact, on the nonlinear one from its cache or searched);
+* per design, their median time from the lock to the exit as the run's
+  survival tables count it (:func:`ftc_mc.campaign.survival.lock_fate`: a
+  trial that stays in the horizon counts as never leaving, one that stopped
+  numerically or before the lock is left out);
 * the oracle's median over the same trials: each trial's longest stay
   interpolated linearly in its offset from the 6-DOF trim (the study's
   offsets; ends held beyond the studied range; a lock the study flew for
@@ -35,7 +37,7 @@ import math
 import ftc_mc  # noqa: F401 -- the package first (its numba settings)
 import numpy as np
 
-from ftc_mc.campaign.survival import trimmable_sets
+from ftc_mc.campaign.survival import horizon_of, lock_fate, trimmable_sets
 from ftc_mc.campaign.transitions import LEFT, transition_of
 from ftc_mc.config.load import parse_config
 from ftc_mc.core.sixdof.layout import COMMAND
@@ -48,22 +50,15 @@ T_END = 60.0
 
 
 def oracle_stays(rows: list, side: str):
-    """Offsets [deg] (increasing), longest stays [s] (``inf`` where the study
-    flew 60 s) and trimmable verdicts of the study's rows of ``side``."""
+    """Offsets [deg] (increasing) and longest stays [s] (``inf`` where the
+    study flew 60 s) of the study's rows of ``side``."""
     mine = sorted((r for r in rows if r["side"] == side), key=lambda r: r["offset_deg"])
     if not mine:
         raise SystemExit(f"the study has no {side} rows")
     off = np.array([r["offset_deg"] for r in mine])
     stay = np.array([math.inf if r["survived_s"] == T_END else r["longest_stay_s"]
                      for r in mine], dtype=float)
-    return off, stay, np.array([r["trimmable"] for r in mine])
-
-
-def exits(g) -> np.ndarray:
-    """Time from the lock to the exit [s] of each trial; ``inf`` for one that
-    stayed in."""
-    return np.where(g["status"] == "ok", math.inf,
-                    g["stop_s"].to_numpy(dtype=float) - g.attrs["fault_time_s"])
+    return off, stay
 
 
 def main(argv=None):
@@ -72,7 +67,7 @@ def main(argv=None):
     ap.add_argument("run", help="a run's folder (trials.parquet)")
     ap.add_argument("--side", choices=("left", "right"), default="left")
     a = ap.parse_args(argv)
-    off, stay, trimmable = oracle_stays(json.load(open(a.study)), a.side)
+    off, stay = oracle_stays(json.load(open(a.study)), a.side)
     r = load_result_dir(a.run)
     cfg = parse_config(r.meta["config"])
     m = cfg.model
@@ -83,32 +78,32 @@ def main(argv=None):
             and transition_of(n).kind == "lock" and transition_of(n).onset
             and (transition_of(n).actuator == LEFT) == (a.side == "left")]
     sets = trimmable_sets(cfg)
+    t_lock = cfg.timing.fault_time_s
+    horizon = horizon_of(t_lock, cfg.timing.duration_s)
+    trim = six.u0[COMMAND[a.side]]
     for name in rows:
+        if name not in sets:
+            print(f"{name}: no trimmable set (a longitudinal run, or no steady flight "
+                  "at trim)")
+            continue
+        lo, hi = sets[name]
         t = trials[trials["transition"] == name]
         pos = t["lock_position"].to_numpy(dtype=float)
-        off6 = np.degrees(pos - six.u0[COMMAND[a.side]])
-        if name in sets:
-            lo, hi = sets[name]
-            outside = (pos < lo) | (pos > hi)
-            where = (f"exact set {math.degrees(lo - six.u0[COMMAND[a.side]]):+.2f} to "
-                     f"{math.degrees(hi - six.u0[COMMAND[a.side]]):+.2f} deg")
-        else:
-            nearest = np.abs(off6[:, None] - off[None, :]).argmin(axis=1)
-            outside = ~trimmable[nearest]
-            where = "the study's verdicts at the nearest offsets"
-        t = t[outside]
-        t.attrs["fault_time_s"] = cfg.timing.fault_time_s
-        o = off6[outside]
-        bound = np.interp(o, off, stay)
-        print(f"{name}: {len(t) // t['variant'].nunique()} trials per design outside "
-              f"the trimmable set ({where}); their offsets from the 6-DOF trim "
-              f"{o.min():+.1f} to {o.max():+.1f} deg, the study's {off[0]:+g} to "
-              f"{off[-1]:+g} deg")
+        t = t[(pos < lo) | (pos > hi)]
+        if not len(t):
+            print(f"{name}: no trials outside the trimmable set")
+            continue
+        o = np.degrees(t["lock_position"].to_numpy(dtype=float) - trim)
+        print(f"{name}: {len(t) // t['variant'].nunique()} trials per design outside the "
+              f"trimmable set ({math.degrees(lo - trim):+.2f} to {math.degrees(hi - trim):+.2f}"
+              f" deg); their offsets from the 6-DOF trim {o.min():+.1f} to {o.max():+.1f} "
+              f"deg, the study's {off[0]:+g} to {off[-1]:+g} deg")
         for variant, g in t.groupby("variant", sort=False):
-            g.attrs["fault_time_s"] = cfg.timing.fault_time_s
-            leave = exits(g)
-            b = np.interp(np.degrees(g["lock_position"].to_numpy(dtype=float)
-                                     - six.u0[COMMAND[a.side]]), off, stay)
+            fate = lock_fate(g, t_lock, horizon)
+            keep = fate["keep"]
+            leave = np.where(fate["left"], fate["after"], math.inf)[keep]
+            b = np.interp(np.degrees(g["lock_position"].to_numpy(dtype=float) - trim),
+                          off, stay)[keep]
             print(f"  {variant:16s} median exit {np.median(leave):5.2f} s | oracle "
                   f"{np.median(b):5.2f} s | oracle >= 2 x this design's exit in "
                   f"{100 * np.mean(b >= 2 * leave):5.1f} % of the trials")

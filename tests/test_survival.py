@@ -162,6 +162,10 @@ def test_inside_and_outside_the_trimmable_set(tmp_path):
     assert "## Inside and outside the trimmable set" in md
     assert "+0.00 to +5.00" in md and "5/8 (62.5 %" in md and "2/3 (66.7 %" in md
     assert trimmable_markdown(trimmable_table(t, 20.0, 100.0, {})) == ""
+    # a split where every trial stopped numerically: no share, its count shown
+    odd = t[(t["transition"] == "elevon_lock") & (t["status"] == "nonfinite")]
+    md = trimmable_markdown(trimmable_table(odd, 20.0, 100.0, sets))
+    assert "-, 1 unknown" in md and "nan" not in md
     png = survival_figure(survival_table(t, 20.0, 100.0), tmp_path / "s.png", None, tab)
     assert png.stat().st_size > 1000
 
@@ -211,15 +215,51 @@ def test_bisect_band_finds_the_ends_of_an_interval():
     assert len(calls) < 40
     assert bisect_band(steady, 0.0, (-0.2, 0.6), 1e-4)[0] == -0.2
     assert bisect_band(steady, 0.4, (-0.6, 0.6), 1e-4) is None
+    # a tolerance finer than the floats' spacing ends at adjacent floats
+    lo, hi = bisect_band(steady, 0.0, (-0.6, 0.6), 1e-300)
+    assert lo == -0.3 and np.nextafter(hi, 1.0) > 0.05
+    with pytest.raises(ValueError, match="tol"):
+        bisect_band(steady, 0.0, (-0.6, 0.6), 0.0)
+
+
+def test_the_equations_set_searches_from_the_trim_to_the_elevon_limits(monkeypatch):
+    """:func:`equations_trimmable_set` starts at the 6-DOF trim's position of
+    the elevon, bisects towards the airframe's elevon limits and asks
+    :func:`steady_flight` of that side in the given envelope (its search
+    stubbed by a band 3 deg below and 1 deg above the trim)."""
+    import ftc_mc.model.trimmable as tm
+    from ftc_mc.core.sixdof.layout import COMMAND
+    from ftc_mc.model.presets import PRESETS
+    from ftc_mc.model.sixdof import trim6
+
+    af = PRESETS["x8-pyfly"].airframe
+    trim = trim6(af).u0[COMMAND["right"]]
+    env = tm.Envelope(bank=0.7)
+    asked = []
+
+    def steady_flight(airframe, side, lock, envelope):
+        asked.append((side, lock, envelope))
+        ok = trim - math.radians(3.0) <= lock <= trim + math.radians(1.0)
+        return tm.SteadyFlight(side, lock, lock - trim, 0.0 if ok else 1.0, {})
+
+    monkeypatch.setattr(tm, "steady_flight", steady_flight)
+    lo, hi = tm.equations_trimmable_set(af, "right", env, tol=1e-6)
+    assert asked[0][1] == trim and {a[0] for a in asked} == {"right"}
+    assert all(a[2] is env for a in asked)
+    assert set(af.elevon_limits) <= {a[1] for a in asked}
+    assert abs(lo - (trim - math.radians(3.0))) < 1e-6
+    assert abs(hi - (trim + math.radians(1.0))) < 1e-6
 
 
 @pytest.mark.trimmable_search
 def test_the_equations_set_is_searched_once_and_cached(tmp_path, monkeypatch):
     """:func:`cached_trimmable_sets`: the first call searches (one notice) and
-    writes the cache; the next reads it without searching; an unreadable file
-    is searched again; another envelope is another key.  On the 6-DOF
-    nonlinear plant, :func:`trimmable_sets` reads the same cache (the search
-    stubbed: the real one takes about a minute per side)."""
+    writes the cache; the next reads it without searching; an unreadable or
+    malformed file is searched again; an unwritable cache still gives the set;
+    another envelope is another key.  On the 6-DOF nonlinear plant,
+    :func:`trimmable_sets` reads the same cache.  The search is stubbed (the
+    real one takes about a minute per side), one side at a time, so that
+    joblib runs it in this process, where the stub holds."""
     import io
 
     import ftc_mc.design.trimmable_cache as tc
@@ -245,15 +285,33 @@ def test_the_equations_set_is_searched_once_and_cached(tmp_path, monkeypatch):
         == {"left": (-0.5, 0.1)}
     assert out.getvalue() == "" and len(searched) == 1
     (file,) = (tmp_path / "design" / "trimmable").glob("*.json")
-    file.write_text("{not json")
-    tc.cached_trimmable_sets(af, ["left"], cache_dir=tmp_path / "design", stream=io.StringIO())
-    assert len(searched) == 2
+    for bad in ("{not json", "[]", '{"key": "%s", "ends": [1, 2, 3]}' % file.stem,
+                '{"key": "%s", "ends": [0.2, 0.1]}' % file.stem):
+        file.write_text(bad)
+        n = len(searched)
+        tc.cached_trimmable_sets(af, ["left"], cache_dir=tmp_path / "design",
+                                 stream=io.StringIO())
+        assert len(searched) == n + 1, bad
+    # an unwritable cache: the set is still returned, with a warning
+    real_write = tc.write_atomic
+
+    def refuse(path, write):
+        raise PermissionError(13, "Permission denied")
+
+    monkeypatch.setattr(tc, "write_atomic", refuse)
+    out = io.StringIO()
+    assert tc.cached_trimmable_sets(af, ["right"], cache_dir=tmp_path / "design",
+                                    stream=out) == {"right": (-0.5, 0.1)}
+    assert "could not cache" in out.getvalue()
+    monkeypatch.setattr(tc, "write_atomic", real_write)
+    n = len(searched)
     tc.cached_trimmable_sets(af, ["left"], Envelope(bank=0.5), cache_dir=tmp_path / "design",
                              stream=io.StringIO())
-    assert len(searched) == 3 and len(list((tmp_path / "design" / "trimmable").glob("*.json"))) == 2
+    assert len(searched) == n + 1
+    assert len(list((tmp_path / "design" / "trimmable").glob("*.json"))) == 2
     monkeypatch.setenv("FTC_MC_CACHE_DIR", str(tmp_path))
     cfg = resolve_config({"model": {"airframe": "x8-pyfly"},
                           "plant": {"kind": "nonlinear", "dof": 6},
                           "campaign": {"transitions": ["elevon_lock", "engine_lock"]}})
     assert trimmable_sets(cfg, stream=io.StringIO()) == {"elevon_lock": (-0.5, 0.1)}
-    assert len(searched) == 3  # the default envelope's file, written above
+    assert len(searched) == n + 1  # the default envelope's file, written above

@@ -129,9 +129,9 @@ def test_the_linear_trimmable_set_is_the_interval_its_ends_bound(side):
     against :func:`linear_steady_flight` lock by lock: every lock 0.01 deg
     inside its ends has a steady flight, none 0.01 deg outside them, and a
     grid of locks every 0.25 deg from -12 to +12 deg of trim has one exactly
-    where the interval holds it.  The ends lie inside the grid search's bands
-    of docs/airframes.md (x8-pyfly, linear model: -4.75 to +5.5 deg left,
-    -5.25 to +5.5 deg right), within one step of 0.25 deg."""
+    where the interval holds it.  The ends lie at or beyond the grid search's
+    bands (x8-pyfly, linear model: -4.75 to +5.5 deg left, -5.25 to +5.5 deg
+    right), within one step of 0.25 deg."""
     from ftc_mc.core.sixdof.layout import COMMAND
     from ftc_mc.model.trimmable import linear_steady_flight, linear_trimmable_set
 

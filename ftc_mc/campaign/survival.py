@@ -118,15 +118,15 @@ def survival_table(trials: pd.DataFrame, fault_time_s: float, duration_s: float,
 
 def _lock_groups(trials: pd.DataFrame, fault_time_s: float, horizon: float):
     """Per elevon-lock row and design: ``(name, variant, trials, fate)``, the
-    trials with a lock offset and their fate over ``horizon`` (:func:`_fate`)."""
+    trials with a lock offset and their fate over ``horizon`` (:func:`lock_fate`)."""
     # a trial without an offset (an older chunk of a resumed run) is in no bin
     locks = trials[trials["transition"].map(_is_elevon_lock)
                    & np.isfinite(trials["lock_offset"].to_numpy(dtype=float))]
     for (name, variant), g in locks.groupby(["transition", "variant"], sort=False):
-        yield name, variant, g, _fate(g, fault_time_s, horizon)
+        yield name, variant, g, lock_fate(g, fault_time_s, horizon)
 
 
-def _fate(g: pd.DataFrame, fault_time_s: float, horizon: float) -> dict:
+def lock_fate(g: pd.DataFrame, fault_time_s: float, horizon: float) -> dict:
     """What became of each trial of ``g`` over ``horizon`` after the lock:
     ``after`` (its stop from the lock [s]), ``left`` (left the envelope
     within the horizon), ``numeric`` (stopped numerically within it) and
@@ -195,9 +195,9 @@ def trimmable_table(trials: pd.DataFrame, fault_time_s: float, duration_s: float
         if name not in sets:
             continue
         lo, hi = sets[name]
-        pos = g["lock_position"].to_numpy(dtype=float)
-        trim = float(np.median(pos - g["lock_offset"].to_numpy(dtype=float)))
-        inside = (pos >= lo) & (pos <= hi)
+        off = g["lock_offset"].to_numpy(dtype=float)
+        trim = float(np.nanmedian(g["lock_position"].to_numpy(dtype=float) - off))
+        inside = (off >= lo - trim) & (off <= hi - trim)
         for where, sel in (("inside", inside), ("outside", ~inside)):
             row = _stats(fate, sel, g)
             if row is not None:
@@ -250,9 +250,10 @@ def trimmable_sets(config, stream=None) -> dict:
     return {name: ends[side] for name, side in rows.items() if ends[side] is not None}
 
 
-SET_MODELS = {"linear": "the 6-DOF linear model (exact: two linear programmes)",
-              "nonlinear": "the airframe's equations (bisection of steady-flight searches "
-                           "from the trim, to 0.05 deg)"}
+SET_MODELS = {"linear": "the 6-DOF linear model (exact: two linear programmes, "
+                        "`ftc_mc/model/trimmable.py`)",
+              "nonlinear": "the airframe's equations (a bisection of steady-flight searches "
+                           "from the trim, to 0.05 deg, `ftc_mc/model/trimmable.py`)"}
 """What the trimmable set is of, by truth plant kind (:func:`trimmable_sets`)."""
 
 
@@ -306,22 +307,26 @@ def trimmable_markdown(table: pd.DataFrame, level: int = 2, kind: str = "linear"
     out = ["#" * level + " Inside and outside the trimmable set", "",
            "The trimmable set: the locks with a steady flight, straight or turning, "
            "inside the validity envelope with the healthy elevon and the throttle within "
-           f"their limits, of {SET_MODELS[kind]} (`ftc_mc/model/trimmable.py`). "
-           "Share staying inside the envelope for "
+           f"their limits, of {SET_MODELS[kind]}; its ends from the trim command, as the "
+           "survival table's offsets. Share staying inside the envelope for "
            f"{horizon:g} s after the lock (95 % Wilson interval) and median time from the "
            "lock to the exit (`>H`: at least half stay in), as in the survival table.", ""]
     rows = []
     for (name, variant), g in table.groupby(["transition", "variant"], sort=False):
         row = {"row": f"`{name}`", "design": variant,
-               "trimmable set [deg]": f"{g['set_lo_deg'].iloc[0]:+.2f} to "
-                                      f"{g['set_hi_deg'].iloc[0]:+.2f}"}
+               "trimmable set [deg from trim]": f"{g['set_lo_deg'].iloc[0]:+.2f} to "
+                                                f"{g['set_hi_deg'].iloc[0]:+.2f}"}
         for _, r in g.iterrows():
             w = r["where"]
             row[f"{w}: stay in"] = (f"{r['flying'] - r['left']}/{r['flying']} "
                                     f"({100 * r['survived_rate']:.1f} %, "
                                     f"{100 * r['survived_ci_low']:.1f}-"
-                                    f"{100 * r['survived_ci_high']:.1f})")
-            row[f"{w}: median exit [s]"] = (f">{horizon:g}" if not np.isfinite(
-                r["median_leave_s"]) else f"{r['median_leave_s']:.1f}")
+                                    f"{100 * r['survived_ci_high']:.1f})"
+                                    if r["flying"] else "-")
+            if r["unknown"]:
+                row[f"{w}: stay in"] += f", {r['unknown']} unknown"
+            row[f"{w}: median exit [s]"] = ("-" if not r["flying"] else f">{horizon:g}"
+                                            if not np.isfinite(r["median_leave_s"])
+                                            else f"{r['median_leave_s']:.1f}")
         rows.append(row)
     return "\n".join(out + [pd.DataFrame(rows).fillna("-").to_markdown(index=False)])

@@ -15,6 +15,7 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import json
+import math
 import os
 import sys
 from pathlib import Path
@@ -74,13 +75,10 @@ def cached_trimmable_sets(airframe: Airframe, sides, envelope: Envelope = Envelo
     for side in sides:
         key = trimmable_set_key(airframe, side, envelope)
         path = folder / f"{key}.json"
-        try:
-            data = json.loads(path.read_text())
-            if data.get("key") == key:
-                out[side] = None if data["ends"] is None else tuple(data["ends"])
-                continue
-        except (OSError, ValueError, KeyError, TypeError):
-            pass  # missing or unreadable: found again
+        ends = _read(path, key)
+        if ends is not _MISSING:
+            out[side] = ends
+            continue
         todo.append((side, key, path))
     if todo:
         print(f"ftc-mc: finding the trimmable set of {name}'s equations "
@@ -94,5 +92,34 @@ def cached_trimmable_sets(airframe: Airframe, sides, envelope: Envelope = Envelo
         for (side, key, path), ends in zip(todo, found):
             out[side] = ends
             text = json.dumps({"key": key, "ends": None if ends is None else list(ends)})
-            write_atomic(path, lambda f, t=text: f.write(t.encode()))
+            try:
+                write_atomic(path, lambda f, t=text: f.write(t.encode()))
+            except OSError as e:  # a read-only or full cache: the set is still known
+                print(f"ftc-mc: warning: could not cache the trimmable set in {path.parent} "
+                      f"({e.strerror or e}); it is searched again next time",
+                      file=stream or sys.stderr, flush=True)
     return out
+
+
+_MISSING = object()
+"""What :func:`_read` returns for a cache file that is absent or unusable."""
+
+
+def _read(path: Path, key: str):
+    """The cached ends of ``path`` (``(lo, hi)`` or None), or :data:`_MISSING`
+    when the file is absent, unreadable, of another key, or not two finite
+    increasing numbers."""
+    try:
+        data = json.loads(path.read_text())
+    except (OSError, ValueError):
+        return _MISSING
+    if not isinstance(data, dict) or data.get("key") != key or "ends" not in data:
+        return _MISSING
+    ends = data["ends"]
+    if ends is None:
+        return None
+    if (isinstance(ends, list) and len(ends) == 2
+            and all(isinstance(v, (int, float)) and math.isfinite(v) for v in ends)
+            and ends[0] <= ends[1]):
+        return (float(ends[0]), float(ends[1]))
+    return _MISSING

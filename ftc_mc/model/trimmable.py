@@ -203,6 +203,8 @@ def bisect_band(steady, start: float, limits, tol: float):
         not.  Bisection assumes one interval: a lock beyond a failing one is
         not tried (``scripts/study_trimmable.py`` checks a grid).
     """
+    if not tol > 0.0:
+        raise ValueError(f"bisect_band: tol must be > 0, got {tol!r}")
     if not steady(start):
         return None
     ends = []
@@ -213,6 +215,8 @@ def bisect_band(steady, start: float, limits, tol: float):
             continue
         while abs(outside - inside) > tol:
             mid = 0.5 * (inside + outside)
+            if mid in (inside, outside):  # adjacent floats: no finer lock exists
+                break
             inside, outside = (mid, outside) if steady(mid) else (inside, mid)
         ends.append(float(inside))
     return tuple(ends)
@@ -228,7 +232,7 @@ def equations_trimmable_set(airframe: Airframe, side: str, envelope: Envelope = 
     ``x8-pyfly`` -29.27 to +2.34 deg (left elevon) and -28.85 to +2.62 deg
     (right), where a 0.25 deg grid from -30 to +6 deg finds one interval each,
     -29.25 to +2.25 and -28.75 to +2.5 deg; ``x8-gryte2018`` -33.52 to +6.26
-    deg on both sides."""
+    deg on both sides, whose lower end is the elevon's limit (-30 deg)."""
     start = trim6(airframe).u0[COMMAND[side]]
     return bisect_band(lambda lock: steady_flight(airframe, side, lock, envelope).steady,
                        start, airframe.elevon_limits, tol)
@@ -319,6 +323,22 @@ def linear_quantities(plant, s: LinearSteady) -> dict:
     return out
 
 
+def _bound_rows(q: dict, bounds: dict, slopes: dict | None = None):
+    """``G v <= h`` for the bounds on the quantities ``q``
+    (:func:`linear_quantities`): ``v`` is ``z``, or ``z`` and the lock when
+    ``slopes`` gives each quantity's change per radian of lock."""
+    rows, rhs = [], []
+    for name, (lo, hi) in bounds.items():
+        a, b = q[name]
+        if slopes is not None:
+            b = np.append(b, slopes[name])
+        for bound, sign in ((lo, -1.0), (hi, 1.0)):
+            if bound is not None:  # sign (a + b v) <= sign bound
+                rows.append(sign * b)
+                rhs.append(sign * (bound - a))
+    return np.array(rows), np.array(rhs)
+
+
 def linear_closest(plant, s: LinearSteady, bounds: dict, cost=None):
     """A steady flight of ``s`` inside ``bounds``, or None.
 
@@ -340,16 +360,7 @@ def linear_closest(plant, s: LinearSteady, bounds: dict, cost=None):
         ``z`` (:class:`LinearSteady`).
     """
     q = linear_quantities(plant, s)
-    rows, rhs = [], []
-    for name, (lo, hi) in bounds.items():
-        a, b = q[name]
-        if lo is not None:
-            rows.append(-b)
-            rhs.append(a - lo)
-        if hi is not None:
-            rows.append(b)
-            rhs.append(hi - a)
-    G, h = np.array(rows), np.array(rhs)
+    G, h = _bound_rows(q, bounds)
     if cost is None:
         sol = scipy.optimize.linprog(np.zeros(s.M.shape[1]), A_ub=G, b_ub=h, A_eq=s.M,
                                      b_eq=-s.c, bounds=(None, None), method="highs")
@@ -406,24 +417,20 @@ def linear_trimmable_set(plant, side: str, envelope: Envelope = Envelope()):
     lo_lim, hi_lim = plant.airframe.elevon_limits
     base, unit = linear_steady(plant, side, 0.0), linear_steady(plant, side, 1.0)
     q0, q1 = linear_quantities(plant, base), linear_quantities(plant, unit)
-    rows, rhs = [], []
-    for name, (lo, hi) in _linear_bounds(plant, envelope).items():
-        a, b = q0[name]
-        slope = q1[name][0] - a  # the value's change per radian of lock
-        for bound, sign in ((lo, -1.0), (hi, 1.0)):
-            if bound is not None:  # sign (a + slope lock + b z) <= sign bound
-                rows.append(sign * np.append(b, slope))
-                rhs.append(sign * (bound - a))
+    G, h = _bound_rows(q0, _linear_bounds(plant, envelope),
+                       {n: q1[n][0] - q0[n][0] for n in q0})  # change per radian of lock
     A_eq = np.column_stack([base.M, unit.c - base.c])
     ends = []
     for direction in (1.0, -1.0):  # the lowest lock, then the highest
         cost = np.zeros(A_eq.shape[1])
         cost[-1] = direction
-        sol = scipy.optimize.linprog(cost, A_ub=np.array(rows), b_ub=np.array(rhs),
-                                     A_eq=A_eq, b_eq=-base.c,
+        sol = scipy.optimize.linprog(cost, A_ub=G, b_ub=h, A_eq=A_eq, b_eq=-base.c,
                                      bounds=[(None, None)] * base.M.shape[1]
                                      + [(lo_lim, hi_lim)], method="highs")
-        if sol.status != 0:
+        if sol.status == 2:  # infeasible: no lock has a steady flight
             return None
+        if sol.status != 0:
+            raise RuntimeError(f"linear_trimmable_set ({side}): linprog failed: "
+                               f"{sol.message}")
         ends.append(float(sol.x[-1]))
     return tuple(ends)

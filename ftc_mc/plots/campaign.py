@@ -150,12 +150,16 @@ def survival_figure(table: pd.DataFrame, path: Path, labels=None,
     pos = {b: i for i, b in enumerate(bins["bin"])}
 
     def x_of(offset):
-        """Position of a lock offset [deg] on the binned axis."""
+        """Position of a lock offset [deg] on the binned axis: in proportion
+        inside a bin shown (the middle of an open-ended one), else at the edge
+        of the next bin shown."""
         for i, (lo, hi) in enumerate(zip(bins["offset_lo_deg"], bins["offset_hi_deg"])):
-            if lo <= offset < hi:
+            if offset < lo:
+                return i - 0.5
+            if offset < hi:
                 frac = (offset - lo) / (hi - lo) if np.isfinite(lo) and np.isfinite(hi) else 0.5
                 return i - 0.5 + frac
-        return -0.5 if offset < bins["offset_lo_deg"].iloc[0] else len(pos) - 0.5
+        return len(pos) - 0.5
     styles = design_styles(list(dict.fromkeys(table["variant"])))
     fig, axs = plt.subplots(1, len(names), figsize=(5.5 * len(names), 3.8), sharey=True,
                             layout="constrained", squeeze=False)

@@ -456,15 +456,16 @@ def survival_lines(trials: pd.DataFrame, cfg: dict, fig_path: Path, report: Path
 
 def _trimmable_sets(cfg: dict) -> dict:
     """:func:`ftc_mc.campaign.survival.trimmable_sets` of a run's stored
-    configuration; ``{}`` when it no longer parses (a run of an older
-    version) or its airframe file is gone."""
+    configuration, found again by today's code (on the nonlinear plant from
+    its cache); ``{}`` when it no longer parses (a run of an older version)
+    or its airframe file is gone."""
     from ..campaign.survival import trimmable_sets
     from ..config.load import parse_config
     from ..errors import UserError
 
     try:
         return trimmable_sets(parse_config(cfg))
-    except (ValueError, UserError):
+    except UserError:
         return {}
 
 
