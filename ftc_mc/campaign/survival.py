@@ -280,20 +280,24 @@ def survival_markdown(table: pd.DataFrame, level: int = 2) -> str:
             row = {"lock offset [deg]": b}
             for _, r in gb.iterrows():
                 v = r["variant"]
-                row[f"{v}: stay in"] = (f"{r['flying'] - r['left']}/{r['flying']} "
-                                        f"({100 * r['survived_rate']:.0f} %, "
-                                        f"{100 * r['survived_ci_low']:.0f}-"
-                                        f"{100 * r['survived_ci_high']:.0f})"
-                                        if r["flying"] else "-")
+                row[f"{v}: stay in"] = _stay_text(r, 0)
                 row[f"{v}: median exit [s]"] = (f">{horizon:g}" if not np.isfinite(
                     r["median_leave_s"]) else f"{r['median_leave_s']:.1f}")
                 row[f"{v}: height lost [m]"] = ("-" if not np.isfinite(
                     r["height_lost_median_m"]) else f"{r['height_lost_median_m']:.1f}")
-                if r["unknown"]:
-                    row[f"{v}: stay in"] += f", {r['unknown']} unknown"
             rows.append(row)
         out += [pd.DataFrame(rows).fillna("-").to_markdown(index=False), ""]
     return "\n".join(out)
+
+
+def _stay_text(r, digits: int) -> str:
+    """``stayed/flying (share %, 95 % interval)`` of a survival row, its
+    percentages to ``digits`` decimals, ``-`` when none flew, and the count
+    of numerical stops when there are some."""
+    text = (f"{r['flying'] - r['left']}/{r['flying']} "
+            f"({100 * r['survived_rate']:.{digits}f} %, {100 * r['survived_ci_low']:.{digits}f}-"
+            f"{100 * r['survived_ci_high']:.{digits}f})" if r["flying"] else "-")
+    return text + (f", {r['unknown']} unknown" if r["unknown"] else "")
 
 
 def trimmable_markdown(table: pd.DataFrame, level: int = 2, kind: str = "linear") -> str:
@@ -318,13 +322,7 @@ def trimmable_markdown(table: pd.DataFrame, level: int = 2, kind: str = "linear"
                                                 f"{g['set_hi_deg'].iloc[0]:+.2f}"}
         for _, r in g.iterrows():
             w = r["where"]
-            row[f"{w}: stay in"] = (f"{r['flying'] - r['left']}/{r['flying']} "
-                                    f"({100 * r['survived_rate']:.1f} %, "
-                                    f"{100 * r['survived_ci_low']:.1f}-"
-                                    f"{100 * r['survived_ci_high']:.1f})"
-                                    if r["flying"] else "-")
-            if r["unknown"]:
-                row[f"{w}: stay in"] += f", {r['unknown']} unknown"
+            row[f"{w}: stay in"] = _stay_text(r, 1)
             row[f"{w}: median exit [s]"] = ("-" if not r["flying"] else f">{horizon:g}"
                                             if not np.isfinite(r["median_leave_s"])
                                             else f"{r['median_leave_s']:.1f}")
