@@ -364,7 +364,10 @@ def run_campaign(config, *, trials=None, seed=None, signature=None, controller=N
             store.discard_if_empty()
             raise
         md = "# ftc-mc run summary\n\n" + result.markdown() + "\n"
-        write_summary(out_dir, result.summary, md, meta)
+        sets = result.trimmable_sets()  # the split summary.md shows, for the report
+        write_summary(out_dir, result.summary, md,
+                      {**meta, "trimmable_sets": {n: list(v) for n, v in sets.items()}}
+                      if sets else meta)
         store.remove()
     return result
 

@@ -384,7 +384,7 @@ def flies_on_config(trim):
             "designs": {"sixdof": {"controller": "lock_turn"}}}
 
 
-def test_lock_turn_design_flies_on(tmp_path):
+def test_lock_turn_design_flies_on(tmp_path, monkeypatch):
     """Every trial of the lock-turn design stays inside the envelope for the
     60 s after a lock within -4 to +1 deg of trim (issue 26's trimmable band;
     the oracle study flies -10 to +2 deg), where the paper's loop keeps at most
@@ -406,9 +406,29 @@ def test_lock_turn_design_flies_on(tmp_path):
     summary = (tmp_path / "run" / "summary.md").read_text()
     assert "sixdof: stay in" in summary
     # the split at the trimmable set, of the equations the truth flies (its
-    # search replaced by the linear model's set here, tests/conftest.py)
+    # search replaced by the linear model's set here, tests/conftest.py); the
+    # run keeps the sets in summary.parquet's metadata, and the report splits
+    # at those without finding them again
     assert "## Inside and outside the trimmable set" in summary
     assert "of the airframe's equations" in summary
+    from ftc_mc.campaign import survival
+    from ftc_mc.io.results import read_metadata
+    from ftc_mc.report.load import load_result_dir
+    from ftc_mc.report.runs import survival_lines
+
+    stored = read_metadata(tmp_path / "run" / "summary.parquet")["trimmable_sets"]
+    assert set(stored) == {"elevon_lock", "right_elevon_lock"}
+    r = load_result_dir(tmp_path / "run")
+
+    def not_again(config, stream=None):
+        raise AssertionError("the report found the sets again")
+
+    monkeypatch.setattr(survival, "trimmable_sets", not_again)
+    lines = "\n".join(survival_lines(r.tables["trials"], r.meta["config"],
+                                      tmp_path / "s.png", tmp_path / "r.md",
+                                      r.meta.get("trimmable_sets")))
+    table = summary[summary.index("## Inside and outside"):].split("\n\n")[2]
+    assert table in lines
     # from the monitor's decision on, the lock-turn design resets only the
     # elevon block (core/sixdof/lockturn.side_blocks); the paper's Table 1 on
     # the same flights does not

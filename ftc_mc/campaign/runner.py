@@ -52,6 +52,7 @@ class CampaignResult:
         self._trials, self._resets = trials, resets
         self.summary, self.config = summary, config
         self.out = None if out is None else Path(out)
+        self._sets = None
 
     @property
     def trials(self) -> pd.DataFrame:
@@ -83,11 +84,18 @@ class CampaignResult:
         t = self.config.timing
         return survival_table(trials, t.fault_time_s, t.duration_s)
 
+    def trimmable_sets(self) -> dict:
+        """:func:`~.survival.trimmable_sets` of the run's configuration, found
+        once (``summary.parquet``'s metadata keeps them for the report)."""
+        if self._sets is None:
+            self._sets = trimmable_sets(self.config)
+        return self._sets
+
     def trimmable(self) -> pd.DataFrame:
         """Survival inside and outside the trimmable set
         (:func:`~.survival.trimmable_table`; empty but on the 6-DOF plant; its
         first run per airframe on the nonlinear one searches the set, a minute or two)."""
-        sets = trimmable_sets(self.config)
+        sets = self.trimmable_sets()
         if not sets:
             return pd.DataFrame()
         trials = self._trial_columns(["transition", "variant", "lock_offset",

@@ -427,13 +427,17 @@ def run_section(r: ResultDir, fig_dir: Path, slug: str, report: Path) -> list:
             + [_comparison_heading(trials), ""] + variant_comparison(trials)
             + ["### Delay distributions", "", f"![delays of {slug}]({rel_link(fig, report)})",
                ""] + real_flight_lines(trials)
-            + survival_lines(trials, cfg, fig_dir / f"{slug}_survival.png", report)
+            + survival_lines(trials, cfg, fig_dir / f"{slug}_survival.png", report,
+                             r.meta.get("trimmable_sets"))
             + side_lines(r.tables["trials"], cfg) + sensor)
 
 
-def survival_lines(trials: pd.DataFrame, cfg: dict, fig_path: Path, report: Path) -> list:
+def survival_lines(trials: pd.DataFrame, cfg: dict, fig_path: Path, report: Path,
+                   stored_sets: dict | None = None) -> list:
     """The survival after an elevon lock (:mod:`ftc_mc.campaign.survival`) with its
-    figure; nothing for a run without elevon-lock rows."""
+    figure; nothing for a run without elevon-lock rows.  ``stored_sets``: the
+    trimmable sets the run split its survival at (``summary.parquet``'s
+    metadata); a run written before them has them found again."""
     from ..campaign.survival import (survival_markdown, survival_table, trimmable_markdown,
                                      trimmable_table)
     from ..plots.campaign import survival_figure
@@ -444,7 +448,8 @@ def survival_lines(trials: pd.DataFrame, cfg: dict, fig_path: Path, report: Path
     table = survival_table(trials, timing["fault_time_s"], timing["duration_s"])
     if not len(table):
         return []
-    sets = _trimmable_sets(cfg)
+    sets = ({name: tuple(ends) for name, ends in stored_sets.items()}
+            if isinstance(stored_sets, dict) else _trimmable_sets(cfg))
     inside = trimmable_table(trials, timing["fault_time_s"], timing["duration_s"], sets)
     fig = survival_figure(table, fig_path, LABELS, inside)
     return ([survival_markdown(table, level=3), ""]
