@@ -64,8 +64,14 @@ def cli():
               "pitch), 6 the full rigid body with lateral-directional dynamics "
               "(trim and the named modes: short period, phugoid, roll, Dutch roll, "
               "spiral; needs an airframe with lateral data).")
+@click.option("--trimmable", is_flag=True,
+              help="With --dof 6: also the trimmable set of each elevon, the locks with "
+              "a steady flight inside the default validity envelope, of the 6-DOF "
+              "linear model (exact) and of the airframe's equations (a bisection of "
+              "steady-flight searches, up to a minute or two the first time per "
+              "airframe, then cached).")
 @user_errors
-def model(as_json, airframe, save, export, airspeed, gamma_deg, dt, dof):
+def model(as_json, airframe, save, export, airspeed, gamma_deg, dt, dof, trimmable):
     """Trim point, named eigenvalues and redundancy check of the linear model."""
     from .io.atomic import atomic_path
     from .model.airframe_files import export_airframe
@@ -82,8 +88,12 @@ def model(as_json, airframe, save, export, airspeed, gamma_deg, dt, dof):
     if export is not None and is_linear_model(spec):
         raise UserError(f"--export: {spec} is a linear model, it has no airframe "
                         "parameters to export")
+    if trimmable and dof != "6":
+        raise UserError("--trimmable: needs --dof 6 (a locked elevon is the 6-DOF "
+                        "plant's fault)")
     if dof == "6":
-        return _model_sixdof(spec, as_json, save, export, airspeed, gamma_deg, dt, suffix)
+        return _model_sixdof(spec, as_json, save, export, airspeed, gamma_deg, dt, suffix,
+                             trimmable)
     plant = load_plant(spec, airspeed, gamma_deg, dt)
     summary = model_summary(plant) if plant.airframe is not None else None
     if save is not None:
@@ -104,9 +114,11 @@ def model(as_json, airframe, save, export, airspeed, gamma_deg, dt, dof):
             click.echo(f"wrote the {what} to {path}")
 
 
-def _model_sixdof(spec, as_json, save, export, airspeed, gamma_deg, dt, suffix):
+def _model_sixdof(spec, as_json, save, export, airspeed, gamma_deg, dt, suffix,
+                  trimmable=False):
     """``ftc-mc model --dof 6``: the 6-DOF trim and named modes (its own import
-    path, so a longitudinal ``model`` never loads the 6-DOF kernels)."""
+    path, so a longitudinal ``model`` never loads the 6-DOF kernels); with
+    ``trimmable``, the trimmable sets (:func:`ftc_mc.model.sixdof.trimmable_summary`)."""
     from .io.atomic import atomic_path
     from .model.airframe_files import export_airframe
     from .model.presets import PRESETS, resolve_airframe
@@ -120,6 +132,10 @@ def _model_sixdof(spec, as_json, save, export, airspeed, gamma_deg, dt, suffix):
     af = resolve_airframe(spec)
     plant = build_sixdof_plant(af, airspeed, gamma_deg, dt, where=f"airframe {spec}")
     summary = sixdof_summary(plant)
+    if trimmable:
+        from .model.sixdof import trimmable_summary
+
+        summary["trimmable_set"] = trimmable_summary(plant, spec)
     source = str(PRESETS[spec].source) if spec in PRESETS else str(spec)
     if save is not None:
         with atomic_path(save) as tmp, open(tmp, "wb") as f:

@@ -288,6 +288,33 @@ def test_cli_model_dof6_json_names_the_modes():
         assert mode in text
 
 
+def test_cli_model_dof6_prints_the_trimmable_sets():
+    """``ftc-mc model --dof 6 --trimmable``: each elevon's trimmable set, of the
+    linear model (:func:`linear_trimmable_set`, as offsets from the trim) and
+    of the equations (its search replaced by the linear model's here,
+    tests/conftest.py), as JSON and as text; without ``--dof 6``, one line
+    and exit 2."""
+    from ftc_mc.model.trimmable import linear_trimmable_set
+
+    res = CliRunner().invoke(cli, ["model", "--dof", "6", "--trimmable", "--json"])
+    assert res.exit_code == 0, res.output
+    sets = json.loads(res.output)["trimmable_set"]
+    plant = build_sixdof_plant(PRESETS["x8-pyfly"].airframe)
+    for side in ("left", "right"):
+        lo, hi = linear_trimmable_set(plant, side)
+        got = sets["linear"][side]
+        assert (got["lo_rad"], got["hi_rad"]) == (lo, hi)
+        assert got["lo_deg"] == pytest.approx(math.degrees(lo - plant.u0[COMMAND[side]]))
+        assert sets["equations"][side] is not None
+    text = CliRunner().invoke(cli, ["model", "--dof", "6", "--trimmable"]).output
+    left = sets["linear"]["left"]
+    assert f"left {left['lo_deg']:+.2f} to {left['hi_deg']:+.2f} deg" in text
+    assert "linear model (exact)" in text and "equations (bisection" in text
+    res = CliRunner().invoke(cli, ["model", "--trimmable"])
+    assert res.exit_code == 2 and len(res.output.strip().splitlines()) == 1
+    assert "--trimmable: needs --dof 6" in res.output
+
+
 def test_cli_model_dof6_refuses_a_longitudinal_only_file(tmp_path):
     path = tmp_path / "lon.yaml"
     export_airframe(X8, path)
