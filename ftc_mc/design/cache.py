@@ -7,9 +7,12 @@ file and concurrent processes at worst compute the same design twice.
 
 from __future__ import annotations
 
+import hashlib
 import os
 import tempfile
 from pathlib import Path
+
+import numpy as np
 
 from ..io.atomic import new_file_mode
 
@@ -49,3 +52,19 @@ def write_atomic(path: Path, write) -> None:
     finally:
         if os.path.exists(tmp):
             os.unlink(tmp)
+
+
+def design_key(version: str, *parts, arrays=()) -> str:
+    """SHA-256 cache key of a design: ``version``, the OpenBLAS kernels in
+    force (``ftc_mc/blas.py``: they decide a design's last bits), each of
+    ``parts`` as text, then each of ``arrays`` as float64 with its shape."""
+    h = hashlib.sha256()
+    h.update(version.encode())
+    h.update(f"blas:{os.environ.get('OPENBLAS_CORETYPE')}".encode())
+    for part in parts:
+        h.update(part.encode() if isinstance(part, str) else part)
+    for a in arrays:
+        b = np.ascontiguousarray(a, dtype=np.float64)
+        h.update(repr(b.shape).encode())
+        h.update(b.tobytes())
+    return h.hexdigest()

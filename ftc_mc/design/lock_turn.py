@@ -75,9 +75,7 @@ with the locked elevon's command its lock position.
 from __future__ import annotations
 
 import dataclasses
-import hashlib
 import math
-import os
 import time
 from pathlib import Path
 
@@ -91,7 +89,7 @@ from ..model.linear import jacobian, zoh
 from ..model.sixdof import build_sixdof_plant, derivatives, outputs, trim6
 from ..model.trimmable import (UNKNOWNS, _state, linear_closest, linear_quantities,
                                linear_steady, steady_flight)
-from .cache import default_cache_dir, write_atomic
+from .cache import default_cache_dir, design_key, write_atomic
 from .theorem41 import ALPHA, biased_discounted_lqr
 
 TURN_RIGID = ("phi", "theta", "u", "v", "w", "p", "q", "r")
@@ -739,20 +737,14 @@ def lock_turn_designs_key(airframe: Airframe, offsets, V0: float, gamma0_deg: fl
     linear model if designed on it,
     :data:`LOCK_TURN_TABLE_VERSION` and the OpenBLAS kernels in force
     (``ftc_mc/blas.py``)."""
-    h = hashlib.sha256()
-    h.update(LOCK_TURN_TABLE_VERSION.encode())
-    h.update(f"blas:{os.environ.get('OPENBLAS_CORETYPE')}".encode())
-    h.update(repr((DesignBox(), DesignWeights(), TurnWeights(), ALPHA, LOCK_TOLERANCE)).encode())
+    parts = [repr((DesignBox(), DesignWeights(), TurnWeights(), ALPHA, LOCK_TOLERANCE))]
     if wide is not None:
-        h.update(f"wide:{wide!r}".encode())
+        parts.append(f"wide:{wide!r}")
     if linear:
-        h.update(b"model:linear")
-    for a in (trim6(airframe, V0, gamma0_deg).params, airframe.command_lower,
-              airframe.command_upper, offsets, [V0, gamma0_deg, dt]):
-        b = np.ascontiguousarray(a, dtype=np.float64)
-        h.update(repr(b.shape).encode())
-        h.update(b.tobytes())
-    return h.hexdigest()
+        parts.append("model:linear")
+    return design_key(LOCK_TURN_TABLE_VERSION, *parts,
+                      arrays=(trim6(airframe, V0, gamma0_deg).params, airframe.command_lower,
+                              airframe.command_upper, offsets, [V0, gamma0_deg, dt]))
 
 
 def cached_lock_turn_designs(airframe: Airframe, offsets, V0: float = 20.0,

@@ -13,19 +13,15 @@ written atomically.  The two elevons are searched in parallel.
 from __future__ import annotations
 
 import dataclasses
-import hashlib
 import json
 import math
-import os
 import sys
 from pathlib import Path
-
-import numpy as np
 
 from ..model.airframe import Airframe
 from ..model.sixdof import trim6
 from ..model.trimmable import Envelope, equations_trimmable_set
-from .cache import default_cache_dir, write_atomic
+from .cache import default_cache_dir, design_key, write_atomic
 
 TRIMMABLE_SET_VERSION = "1"
 """Bump when :func:`~ftc_mc.model.trimmable.steady_flight` or the bisection
@@ -36,15 +32,9 @@ def trimmable_set_key(airframe: Airframe, side: str, envelope: Envelope) -> str:
     """SHA-256 key of every input of the search: the packed 6-DOF parameters
     and command limits of the airframe, the side, the envelope,
     :data:`TRIMMABLE_SET_VERSION` and the OpenBLAS kernels in force."""
-    h = hashlib.sha256()
-    h.update(TRIMMABLE_SET_VERSION.encode())
-    h.update(f"blas:{os.environ.get('OPENBLAS_CORETYPE')}".encode())
-    h.update(f"{side}:{dataclasses.astuple(envelope)!r}".encode())
-    for a in (trim6(airframe).params, airframe.command_lower, airframe.command_upper):
-        b = np.ascontiguousarray(a, dtype=np.float64)
-        h.update(repr(b.shape).encode())
-        h.update(b.tobytes())
-    return h.hexdigest()
+    return design_key(TRIMMABLE_SET_VERSION, f"{side}:{dataclasses.astuple(envelope)!r}",
+                      arrays=(trim6(airframe).params, airframe.command_lower,
+                              airframe.command_upper))
 
 
 def cached_trimmable_sets(airframe: Airframe, sides, envelope: Envelope = Envelope(),

@@ -576,9 +576,13 @@ def format_sixdof_summary(s: dict, name: str = "") -> str:
         "",
     ] + mode_table(s["eigenvalues"])
     if "trimmable_set" in s:
+        from .trimmable import Envelope
+
+        env = Envelope()
         lines += ["", "trimmable set: the elevon locks with a steady flight (straight or "
-                      "turning) inside the validity envelope (12-30 m/s, alpha -8 to 12 deg, "
-                      "bank up to 60 deg), offsets from trim"]
+                      "turning) inside the validity envelope ({:g}-{:g} m/s, alpha {:g} to "
+                      "{:g} deg, bank up to {:g} deg), offsets from trim".format(
+                          *env.airspeed, *np.degrees(env.alpha), math.degrees(env.bank))]
         for model_name, label in (("linear", "linear model (exact)"),
                                   ("equations", "equations (bisection, 0.05 deg)")):
             sets = s["trimmable_set"][model_name]
