@@ -115,6 +115,18 @@ def test_a_plan_of_another_numba_or_unreadable_is_not_used(tmp_path):
     assert load_plan(tmp_path / "missing.pkl") == {}
 
 
+def test_a_stage_the_plan_names_that_no_longer_exists_is_skipped():
+    """A plan written before a kernel moved or was renamed names a module or a
+    kernel that is no longer there: that stage is left to ``advance``'s
+    typing (no error), and the others are still shared."""
+    assert compile_helper._dispatcher(MODULE, NAME) is not None
+    assert compile_helper._dispatcher(MODULE, NAME + "_moved_away") is None
+    assert compile_helper._dispatcher("ftc_mc.core.no_such_module", NAME) is None
+    entry = {"before_s": 0.0, "stages": [(MODULE, NAME + "_moved_away", ARGS, 1.0),
+                                         ("ftc_mc.core.no_such_module", NAME, ARGS, 1.0)]}
+    assert compile_helper._to_compile(entry) == []
+
+
 def test_no_helper_when_switched_off_or_the_path_is_unknown(tmp_path, monkeypatch):
     from ftc_mc.core.shared.paths import (LINEAR_PLANT, ONE_STEP_TEST, PAPER_FILTER,
                                           RECONFIGURING, Path as Path_)

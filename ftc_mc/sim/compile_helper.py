@@ -202,10 +202,15 @@ def stop(proc) -> None:
 
 
 def _dispatcher(module: str, qualname: str):
-    """The kernel ``module.qualname`` if it is a cached kernel of ``core/``."""
-    obj = importlib.import_module(module)
-    for part in qualname.split("."):
-        obj = getattr(obj, part)
+    """The kernel ``module.qualname`` if it is a cached kernel of ``core/``;
+    None if it is not, or no longer exists (a stale plan: a kernel moved or
+    renamed since the plan was written)."""
+    try:
+        obj = importlib.import_module(module)
+        for part in qualname.split("."):
+            obj = getattr(obj, part)
+    except (ImportError, AttributeError):
+        return None
     return obj if isinstance(getattr(obj, "_cache", None), jit.ContentFunctionCache) else None
 
 
