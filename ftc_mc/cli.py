@@ -347,7 +347,8 @@ def terminal_table(summary) -> str:
 @click.option("--signature", type=click.Choice(["paper", "swapped", "both"]),
               help="Table 1 variant(s) (overrides the config).")
 @click.option("--design", "design", multiple=True, metavar="NAME", help=DESIGN_HELP)
-@click.option("--controller", type=click.Choice(["nominal", "reconfiguring", "lock_turn"]),
+@click.option("--controller", type=click.Choice(["nominal", "reconfiguring", "lock_turn",
+                                                "lock_turn_selected"]),
               help="Controller in the loop (overrides the config's controller.kind; a "
                    "design that sets its own controller keeps it).")
 @click.option("--overwrite", is_flag=True, help="Replace results already in --out.")

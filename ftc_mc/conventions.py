@@ -159,6 +159,11 @@ CONTROLLER_NAMES = ("c0 nominal", "c1 engine fault", "c2 elevon fault")
 """Controllers of section 4, indexed by their code."""
 N_CONTROLLERS = len(CONTROLLER_NAMES)
 C_NOMINAL, C_ENGINE, C_ELEVON = range(N_CONTROLLERS)
+SELECTED_CONTROLLER_NAMES = ("c0 nominal", "c1 engine fault", "c2 left elevon fault",
+                             "c3 right elevon fault")
+"""The four controllers a ``lock_turn_selected`` design chooses among on the
+6-DOF plant, indexed by their code (``ftc_mc/core/sixdof/selection.py``: c2
+and c3 the lock-turn controllers of the left and right elevon)."""
 
 # ------------------------------------------------------------------ trial status
 STATUS_OK = 0

@@ -66,6 +66,13 @@ until the side monitor names an elevon, then the lock-turn controller of that
 side (``ftc_mc/core/sixdof/lockturn.py``; docs/airframes.md)."""
 
 
+SIXDOF_SELECTED = {**SIXDOF, "controller": "lock_turn_selected"}
+"""The 6-DOF design with the paper's selection among four controllers (issue 26,
+item 4): every period eqs. 45-47 choose among c0, c1 and the lock-turn
+controllers of the left and the right elevon, on a belief read from the side
+monitor (``ftc_mc/core/sixdof/selection.py``; docs/airframes.md)."""
+
+
 SIXDOF_TABLE_DEG = (-14.0, 8.0)
 """The lock-turn table of the still-air 6-DOF configs [deg from trim]: past the
 steady band of the airframe's equations (-29 to +2.25 deg on x8-pyfly, in the
@@ -76,6 +83,10 @@ that ``--plant linear`` runs fly no end design beyond its end."""
 SIXDOF_ROBUST = {**ROBUST_MODERATE, "controller": "lock_turn"}
 """The 6-DOF design for moderate turbulence: ``robust``'s filter, test and
 thresholds, and the lock-turn controller once the side monitor names an elevon."""
+
+SIXDOF_ROBUST_SELECTED = {**ROBUST_MODERATE, "controller": "lock_turn_selected"}
+"""``sixdof_robust`` with the selection of eqs. 45-47 among the four 6-DOF
+controllers in place of the monitor's first decision (issue 26, item 4)."""
 
 MONITOR_MODERATE = {"design_turbulence": "moderate", "state_noise_scale": 100.0}
 """The side monitor for the nonlinear 6-DOF plant in moderate turbulence: its
@@ -173,14 +184,17 @@ def campaign_configs() -> dict:
                      "designs": ["robust", "sixdof"]},
         "plant": {"kind": "nonlinear", "dof": 6},
         "monitor": {"turn_offsets_deg": SIXDOF_TABLE_DEG},
-        "designs": {"robust": ROBUST_MODERATE, "sixdof": SIXDOF}})
+        "designs": {"robust": ROBUST_MODERATE, "sixdof": SIXDOF,
+                    "sixdof_selected": SIXDOF_SELECTED}})
     files["sixdof_tables.yaml"] = render_yaml(
         cfg, "ftc-mc run configs/sixdof_tables.yaml -- the paper's scheme on the 6-DOF "
              "flying wing (issue 24): the twelve rows (left and right elevon, engine), the "
              "paper's Table 1 (paper, swapped), the robust design and sixdof (the paper's "
              "loop until the side monitor names an elevon, then the lock-turn controller "
              "of the other elevon and the throttle; issue 26) side by side, with the "
-             "lateral autopilot beside the paper's loop; in gusts, "
+             "lateral autopilot beside the paper's loop; --design sixdof_selected flies "
+             "the selection of eqs. 45-47 among c0, c1 and the left and right lock-turn "
+             "controllers instead (issue 26, item 4); in gusts, "
              "configs/sixdof_moderate.yaml", omit=six)
     cfg = Config.model_validate({
         "campaign": {"transitions": list(TRANSITION_TABLE), "signature": "paper",
@@ -188,32 +202,38 @@ def campaign_configs() -> dict:
         "plant": {"kind": "nonlinear", "dof": 6, "turbulence": "moderate"},
         "monitor": MONITOR_MODERATE,
         "designs": {"robust": ROBUST_MODERATE, "sixdof": SIXDOF,
-                    "sixdof_robust": SIXDOF_ROBUST}})
+                    "sixdof_robust": SIXDOF_ROBUST,
+                    "sixdof_robust_selected": SIXDOF_ROBUST_SELECTED}})
     files["sixdof_moderate.yaml"] = render_yaml(
         cfg, "ftc-mc run configs/sixdof_moderate.yaml -- the 6-DOF flying wing in moderate "
              "turbulence (issue 26): the twelve rows, the paper's design (paper), the robust "
              "design, sixdof, and sixdof_robust (robust's filter and GLR test until the side "
              "monitor names an elevon, then the lock-turn controller) on the same trials; "
-             "the side monitor models the gusts (the extended filter)", omit=six)
+             "--design sixdof_robust_selected flies the selection of eqs. 45-47 among the "
+             "four 6-DOF controllers instead; the side monitor models the gusts (the "
+             "extended filter)", omit=six)
     cfg = Config.model_validate({
         "campaign": {"transitions": ["elevon_lock", "right_elevon_lock"],
-                     "signature": "paper", "designs": ["paper_nominal", "sixdof"]},
+                     "signature": "paper",
+                     "designs": ["paper_nominal", "sixdof", "sixdof_selected"]},
         "plant": {"kind": "nonlinear", "dof": 6},
         "timing": {"duration_s": 80.0},
         "monitor": {"turn_offsets_deg": SIXDOF_TABLE_DEG},
         "designs": {"paper_nominal": {"signature": "paper", "controller": "nominal"},
-                    "sixdof": SIXDOF}})
+                    "sixdof": SIXDOF, "sixdof_selected": SIXDOF_SELECTED}})
     files["sixdof_survival.yaml"] = render_yaml(
         cfg, "ftc-mc run configs/sixdof_survival.yaml -- survival after an elevon lock "
              "(issue 26): the share of trials inside the envelope 60 s after the lock, the "
              "median time to leave it and the height lost, by lock offset, on the 6-DOF "
              "flying wing under the paper's reconfiguring scheme (paper), the nominal "
              "controller alone (paper_nominal) and the reconfiguring 6-DOF loop (sixdof: "
-             "the lock-turn controller once the side monitor names the elevon), on the "
-             "same trials; --dof 3 --design paper --design paper_nominal for the "
-             "longitudinal plant", omit=six)
-    cfg = cfg.model_copy(update={"monitor": cfg.monitor.model_copy(
-        update={"turn_beyond": "rollout"})})
+             "the lock-turn controller once the side monitor names the elevon; "
+             "sixdof_selected: the selection of eqs. 45-47 among c0, c1 and the left and "
+             "right lock-turn controllers), on the same trials; --dof 3 --design paper "
+             "--design paper_nominal for the longitudinal plant", omit=six)
+    cfg = cfg.model_copy(update={
+        "monitor": cfg.monitor.model_copy(update={"turn_beyond": "rollout"}),
+        "campaign": cfg.campaign.model_copy(update={"designs": ["paper_nominal", "sixdof"]})})
     files["sixdof_rocking.yaml"] = render_yaml(
         cfg, "ftc-mc run configs/sixdof_rocking.yaml -- configs/sixdof_survival.yaml's "
              "trials with the rocking law (monitor.turn_beyond: rollout): where no steady "

@@ -1000,8 +1000,11 @@ def reconfigure_ref(scheme, timing, inp, st, kn, period, rec):
     for l in range(st.xa.shape[1]):
         # the paper's 14 states (a gust-aware filter's gust states are not used here)
         X, P = st.xa[:N_AUG, l], st.P[:N_AUG, :N_AUG, l]
-        b, best = belief_update_log_ref(st.belief[:, l], bs.TM, bs.lo, bs.hi, X[N_X:],
-                                        np.diag(P)[N_X:])
+        if bs.lo.shape[1] != N_AUG - N_X:  # the 6-DOF selection's belief: updated by its stage
+            b, best = st.belief[:, l].copy(), int(np.argmax(st.belief[:, l]))
+        else:
+            b, best = belief_update_log_ref(st.belief[:, l], bs.TM, bs.lo, bs.hi, X[N_X:],
+                                            np.diag(P)[N_X:])
         out["belief"][:, l] = out["rec_belief"][period, :, l] = b
         out["rec_bhat"][period, :, l] = X[N_X:]
         if scheme.reconfig.kind != 0:

@@ -641,13 +641,13 @@ def guarded_law_ref(tab, pl, s, p, x, lo_dev, hi_dev):
 
 def side_blocks_ref(kind, mside, mlast, block):
     """Twin of ``core/sixdof/lockturn.side_blocks``, from its docstring: in a
-    ``lock_turn`` design (``kind`` 2) each lane's Table 1 reset (``block`` 1
+    ``lock_turn`` or ``lock_turn_selected`` design (``kind`` 2 or 3) each lane's Table 1 reset (``block`` 1
     thrust or 2 elevons) goes to the block of the elevon the lane flies the
     law about (``mside`` > 0), else of the monitor's latest decision
     (``mlast``: 1 the throttle, 2 and 3 the elevons; 0 none: Table 1's
     stays).  Returns the new blocks."""
     out = np.array(block, copy=True)
-    if kind != 2:
+    if kind < 2:  # lock_turn (2) and lock_turn_selected (3) only
         return out
     for l in range(len(out)):
         named = mside[l] if mside[l] > 0 else mlast[l]
@@ -655,3 +655,104 @@ def side_blocks_ref(kind, mside, mlast, block):
             out[l] = 1 if named == 1 else 2
     return out
 
+
+
+def action_cost_ref(pl, ctl, tables, rc, a, xm, mlr, bhat, btrue, n_steps):
+    """Eq. (45) for one of the four 6-DOF controllers
+    (``ftc_mc/core/sixdof/selection.py``), written from that module's
+    docstring with whole vectors: the side monitor's linear model ``A``, ``B``
+    flown ``n_steps`` periods from ``xm`` with the faults ``btrue`` (eq. 2 per
+    actuator, ``[b0 (3), b1 (3)]``); c0 and c1 the paper's laws on the
+    longitudinal states of the same names and the faults ``bhat`` (the elevons'
+    ``b0`` summed), clipped, plus ``u_ff`` and the lateral loop's aileron (or
+    the coupled law's terms), clipped again; c2 and c3 :func:`lock_turn_law_ref`
+    at the lock position ``b0 + (1 - b1)(hold + u0)`` of the locked elevon, on
+    the fed-back states read by name; the lateral loop's elevon model
+    advanced; cost ``sum alpha^k (x' Q x + (u - u_ff)' R (u - u_ff))`` on the
+    predicted 6-DOF states.  ``inf`` when not finite."""
+    from ftc_mc.conventions import LONGITUDINAL
+    from ftc_mc.design.lock_turn import SIDES, turn_states
+    from naive import B0_E, B0_T, B1_L, B1_R, B1_T, C0, C1, controller_command_ref, engine_gain_ref
+
+    mon = pl.monitor
+    tab = mon.turn
+    n = len(mon.states)
+    lon = [LAYOUT.states.index(LONGITUDINAL_AS_SIXDOF.get(m, m)) for m in LONGITUDINAL.states]
+    lat = [LAYOUT.states.index(m) for m in LATERAL_MEASURED]
+    left, right = LAYOUT.commands.index("left"), LAYOUT.commands.index("right")
+    X = np.zeros(14)
+    X[B0_T], X[B0_E], X[B1_T], X[B1_L], X[B1_R] = (bhat[0], bhat[1] + bhat[2], bhat[3],
+                                                   bhat[4], bhat[5])
+    x = np.array(xm, dtype=float)
+    m = np.array(mlr, dtype=float)
+    if a >= 2:
+        s = a - 2
+        j = tab.locked[s]
+        p = bhat[j] + (1.0 - bhat[3 + j]) * (tab.hold[j] + mon.u0[j])
+        fed = [LAYOUT.states.index(name) for name in turn_states(SIDES[s])]
+    cost, disc = 0.0, 1.0
+    for _ in range(n_steps):
+        x6 = np.zeros(len(LAYOUT.states))
+        x6[mon.states] = x[:n]
+        if a < 2:
+            X[:9] = x6[lon]
+            U = np.clip(controller_command_ref(a, X, ctl.K, tables, mon.u0), ctl.lo_dev,
+                        ctl.hi_dev)
+            state = np.concatenate([X[:9], x6[lat], m])
+            if pl.coupled and a == C0:
+                extra = -pl.G0 @ state
+            elif pl.coupled and a == C1:
+                G, g = engine_gain_ref(pl.G1, X[B0_T], X[B1_T])
+                extra = -G @ state - g
+            else:
+                da = -pl.K_lat @ state[9:]
+                extra = np.zeros(3)
+                extra[left], extra[right] = da, -da
+            u = np.clip(U + pl.u_ff + extra, ctl.lo_dev, ctl.hi_dev)
+        else:
+            u = lock_turn_law_ref(tab, s, p, x6[fed], ctl.lo_dev, ctl.hi_dev)
+        m = pl.a_act * m + (1.0 - pl.a_act) * (u[[left, right]] - pl.u_ff[[left, right]])
+        e = (u - mon.u_ff) + btrue[:3] - (u + mon.u0) * btrue[3:]
+        x = mon.A @ x + mon.B @ e
+        disc *= rc.alpha
+        cost += disc * (rc.r_lqr @ (u - mon.u_ff) ** 2 + rc.q_lqr[mon.states] @ x[:n] ** 2)
+    return cost if np.isfinite(cost) else np.inf
+
+
+def sixdof_select_ref(pl, scheme, kn, st, u, horizon_cost=action_cost_ref):
+    """The belief and the selection of a ``lock_turn_selected`` design at a
+    period's end (``ftc_mc/core/sixdof/selection.py``), written from that
+    module's docstring: every lane's belief by eqs. (12)-(14) in log space on
+    the side monitor's six fault parameters and their variances; on each live
+    lane the controller minimising ``I^H(a) + sum_m b(m) (J^N(m, a) + P(c, a))``
+    (the first on a tie), its side and start step when it is c2 or c3 and new,
+    and the lock position of that elevon.  Returns a dict of ``belief``,
+    ``cur``, ``mside``, ``mturn``, ``mpos``."""
+    from naive import belief_update_log_ref
+
+    mon = pl.monitor
+    ns = mon.A.shape[0]
+    bs, rc = scheme.belief, scheme.reconfig
+    out = dict(belief=st.belief.copy(), cur=st.cur.copy(), mside=st.mside.copy(),
+               mturn=st.mturn.copy(), mpos=st.mpos.copy())
+    for l in range(st.mx.shape[1]):
+        bh = st.mx[ns:ns + 6, l]
+        var = np.diag(st.mP[:, :, l])[ns:ns + 6]
+        b, _ = belief_update_log_ref(st.belief[:, l], bs.TM, bs.lo, bs.hi, bh, var)
+        out["belief"][:, l] = b
+        if not st.alive[l]:
+            continue
+        cur = int(st.cur[l])
+        mlr = st.lat[[5, 6], l]
+        obj = [horizon_cost(pl, scheme.controller, scheme.engine, rc, a, st.mx[:ns, l], mlr,
+                            bh, bh, rc.horizon) + b @ (rc.JN[:, a] + rc.penalty[cur, a])
+               for a in range(4)]
+        best = int(np.argmin(obj))
+        out["cur"][l] = best
+        if best < 2:
+            out["mside"][l] = 0
+        elif st.mside[l] != best:
+            out["mside"][l], out["mturn"][l] = best, kn
+            j = best - 1
+            out["mpos"][l] = bh[j] + (1.0 - bh[3 + j]) * (u[j, l] + mon.u0[j])
+    return out

@@ -41,6 +41,10 @@ DoubletAmplitude = Annotated[float, NoBool, Field(gt=0, le=0.5, allow_inf_nan=Fa
 """An engine doublet amplitude [throttle fraction]: at most half the throttle range."""
 S3211Amplitude = Annotated[float, NoBool, Field(gt=0, le=0.3, allow_inf_nan=False)]
 """An elevon 3211 amplitude [rad]."""
+ControllerKind = Literal["nominal", "reconfiguring", "lock_turn", "lock_turn_selected"]
+"""The controllers a design flies (``ControllerConfig.kind``)."""
+LOCK_TURN_KINDS = ("lock_turn", "lock_turn_selected")
+"""The kinds that fly the lock-turn controllers (6-DOF plant, side monitor on)."""
 
 
 class _Strict(BaseModel):
@@ -160,8 +164,13 @@ class _Sampled(_Strict):
         return dc.controller if dc is not None and dc.controller else self.controller.kind
 
     def flies_lock_turn(self, runs) -> bool:
-        """Whether a design of ``runs`` flies ``controller: lock_turn``."""
-        return any(self.controller_of(r) == "lock_turn" for r in runs)
+        """Whether a design of ``runs`` flies the lock-turn controllers
+        (``controller: lock_turn`` or ``lock_turn_selected``)."""
+        return any(self.controller_of(r) in LOCK_TURN_KINDS for r in runs)
+
+    def selects_four(self, runs) -> bool:
+        """Whether a design of ``runs`` flies ``controller: lock_turn_selected``."""
+        return any(self.controller_of(r) == "lock_turn_selected" for r in runs)
 
 
 def _check_coupling(cfg) -> None:
@@ -176,16 +185,17 @@ def _check_lock_turn(cfg, runs) -> None:
     """A ``lock_turn`` controller needs the 6-DOF plant and its side monitor;
     the error names the field that asks for it."""
     for r in runs:
-        if cfg.controller_of(r) != "lock_turn":
+        kind = cfg.controller_of(r)
+        if kind not in LOCK_TURN_KINDS:
             continue
         dc = cfg.designs.get(r)
         field = (f"designs.{r}.controller" if dc is not None and dc.controller
                  else "controller.kind")
         if cfg.plant.dof != 6:
-            raise ValueError(f"{field}: lock_turn flies the 6-DOF plant (plant.dof: 6), "
+            raise ValueError(f"{field}: {kind} flies the 6-DOF plant (plant.dof: 6), "
                              f"got plant.dof {cfg.plant.dof}")
         if not cfg.monitor.enabled:
-            raise ValueError(f"{field}: lock_turn is scheduled on the side monitor, but "
+            raise ValueError(f"{field}: {kind} is scheduled on the side monitor, but "
                              "monitor.enabled is false")
 
 
@@ -256,8 +266,8 @@ class EstimatorConfig(_Strict):
 class ControllerConfig(_Strict):
     """Controllers and their selection (sections 4.1-4.2, 5.1)."""
 
-    kind: Literal["nominal", "reconfiguring", "lock_turn"] = "reconfiguring"
-    """``nominal``: c0 only; ``reconfiguring``: c0/c1/c2 chosen by eqs. 45-47; ``lock_turn`` (6-DOF plant, side monitor on): reconfiguring until the side monitor names an elevon, then the lock-turn controller of that side, scheduled on the monitor's lock estimate; the monitor also decides which block Table 1's resets open (``ftc_mc/core/sixdof/lockturn.py``)."""
+    kind: ControllerKind = "reconfiguring"
+    """``nominal``: c0 only; ``reconfiguring``: c0/c1/c2 chosen by eqs. 45-47; ``lock_turn`` (6-DOF plant, side monitor on): reconfiguring until the side monitor names an elevon, then the lock-turn controller of that side, scheduled on the monitor's lock estimate; the monitor also decides which block Table 1's resets open (``ftc_mc/core/sixdof/lockturn.py``); ``lock_turn_selected`` (6-DOF plant, side monitor on): eqs. 45-47 choose every period among c0, c1 and the lock-turn controllers of the left (c2) and the right (c3) elevon, on a belief read from the side monitor's fault estimates (``ftc_mc/core/sixdof/selection.py``); the monitor decides the blocks as for lock_turn."""
     discount: Annotated[float, NoBool, Field(gt=0, lt=1, allow_inf_nan=False)] = 0.999
     """Discount factor alpha (< 1: a locked engine needs it, section 4.1.2)."""
     r_lqr: Pos = 0.1
@@ -669,8 +679,8 @@ class DesignConfig(_Strict):
     excitation_residual: Pos | None = None
     """ambiguous: send when r_q or r_nx (the design's decision statistics: one-step residuals or GLR) reach this; null: never on the residuals. Below Table 1's thresholds it excites a suspected change before it is decided."""
 
-    controller: Literal["nominal", "reconfiguring", "lock_turn"] | None = None
-    """Controller of this design's flights: nominal (c0 throughout), reconfiguring (c0/c1/c2 chosen by eqs. 45-47) or lock_turn (6-DOF plant: reconfiguring until the side monitor names an elevon, then the lock-turn controller of that side; the monitor also decides which block Table 1's resets open), so one campaign compares them on the same trials; null: the controller section's kind."""
+    controller: ControllerKind | None = None
+    """Controller of this design's flights: nominal (c0 throughout), reconfiguring (c0/c1/c2 chosen by eqs. 45-47), lock_turn (6-DOF plant: reconfiguring until the side monitor names an elevon, then the lock-turn controller of that side; the monitor also decides which block Table 1's resets open) or lock_turn_selected (6-DOF plant: eqs. 45-47 choose among c0, c1 and the left and right lock-turn controllers c2, c3 on the side monitor's belief), so one campaign compares them on the same trials; null: the controller section's kind."""
 
     @model_validator(mode="after")
     def _biases(self):

@@ -38,11 +38,13 @@ ELEVON_LOCKS = (-0.4, -0.2, 0.0, 0.2, 0.4)
 LOSSES = (0.3, 0.6, 0.9)
 
 
-def representative_faults():
-    """Per mode, a list of per-actuator ``(b0, b1)`` truths (module docstring)."""
+def representative_faults(locks=(ENGINE_LOCKS, ELEVON_LOCKS, ELEVON_LOCKS)):
+    """Per mode, a list of per-actuator ``(b0, b1)`` truths (module docstring;
+    ``locks``: the lock positions of the throttle, the left and the right
+    elevon, absolute)."""
     modes = [[(np.zeros(3), np.zeros(3))], [], [], []]
-    for m, act, locks in ((1, 0, ENGINE_LOCKS), (2, 1, ELEVON_LOCKS), (3, 2, ELEVON_LOCKS)):
-        for p in locks:
+    for m, act in ((1, 0), (2, 1), (3, 2)):
+        for p in locks[act]:
             b0, b1 = np.zeros(3), np.zeros(3)
             b0[act], b1[act] = p, 1.0
             modes[m].append((b0, b1))

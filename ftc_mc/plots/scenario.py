@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from ..scenario.run import controller_names
 from .figure import plt, save
 
 
@@ -95,7 +96,9 @@ def scenario_figures(res, out: Path) -> list:
 
     fig, ax = plt.subplots(figsize=(8, 2.8))
     ax.step(t, ts.controller + 1, where="post")
-    ax.set_yticks([1, 2, 3], ["1 nominal", "2 thrust fault", "3 elevon fault"])
+    names = controller_names(res.config)
+    ax.set_yticks(range(1, len(names) + 1), [f"{i + 1} {n.split(' ', 1)[1]}"
+                                               for i, n in enumerate(names)])
     ax.set_xlabel("time [s]")
     _switch_lines(ax, res)
     ax.grid(alpha=0.3)

@@ -19,7 +19,8 @@ import numpy as np
 import pandas as pd
 
 from ..config.schema import ScenarioConfig
-from ..conventions import CONTROLLER_NAMES, LONGITUDINAL, MODE_NAMES, STATUS_NAMES
+from ..conventions import (CONTROLLER_NAMES, LONGITUDINAL, MODE_NAMES,
+                           SELECTED_CONTROLLER_NAMES, STATUS_NAMES)
 from ..core.longitudinal.trial import advance
 from ..core.longitudinal.workspace import EXC_3211, EXC_3211_START, EXC_DOUBLET, EXC_DOUBLET_START
 from ..model.faults import estimator_params, mode_of
@@ -163,6 +164,13 @@ def _timeseries(setup, sc, rec, k_sw, b0, b1) -> pd.DataFrame:
     return df
 
 
+def controller_names(sc: ScenarioConfig) -> tuple:
+    """The names of the controller codes the scenario's design flies: the
+    paper's three, or the four of a ``lock_turn_selected`` design."""
+    selected = sc.controller_of(runs_of(sc)[0]) == "lock_turn_selected"
+    return SELECTED_CONTROLLER_NAMES if selected else CONTROLLER_NAMES
+
+
 def _events(ts: pd.DataFrame, sc: ScenarioConfig, rec, setup) -> pd.DataFrame:
     rows = []
     dt = setup.plant.dt  # a signal applied during step k is logged at (k + 1) dt
@@ -186,11 +194,12 @@ def _events(ts: pd.DataFrame, sc: ScenarioConfig, rec, setup) -> pd.DataFrame:
             rows.append((ts.time_s.iloc[k] - dt, "excitation", name))
     ctrl = rec.controller[:, 0]
     every = setup.tim.reconf_every
+    names = controller_names(sc)
     prev = 0
     for p, c in enumerate(ctrl):
         if c != prev:
             rows.append(((p + 1) * every * dt, "controller_switch",
-                         f"{CONTROLLER_NAMES[prev]} -> {CONTROLLER_NAMES[c]}"))
+                         f"{names[prev]} -> {names[c]}"))
             prev = c
     bel = np.stack([ts[f"belief_{m}"].to_numpy() for m in MODE_NAMES], axis=1)
     top = np.argmax(bel, axis=1)

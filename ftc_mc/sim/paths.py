@@ -11,7 +11,8 @@ from __future__ import annotations
 from ..conventions import TEST_GLR
 from ..core.shared.paths import (DENSE_FILTER, EXTENDED_FILTER, GLR_TEST, LINEAR_PLANT,
                                  NOMINAL_CONTROL, NONLINEAR_PLANT, ONE_STEP_TEST, PAPER_FILTER,
-                                 RECONFIGURING, SIXDOF_EXTENDED_PLANT, SIXDOF_PLANT, Path)
+                                 RECONFIGURING, SELECT_FOUR, SIXDOF_EXTENDED_PLANT, SIXDOF_PLANT,
+                                 Path)
 from ..core.longitudinal.settings import Flight, Scheme
 
 
@@ -42,7 +43,13 @@ def path_of(scheme: Scheme, flight: Flight | None = None) -> Path:
 
         plant = SIXDOF_EXTENDED_PLANT if flight.plant.monitor.nonlinear == EXTENDED \
             else SIXDOF_PLANT
+    control = NOMINAL_CONTROL if scheme.reconfig.kind == 0 else RECONFIGURING
+    if scheme.reconfig.kind >= 2:
+        from ..core.sixdof.lockturn import SELECTED_TURN  # the 6-DOF path only
+
+        if scheme.reconfig.kind == SELECTED_TURN:
+            control = SELECT_FOUR
     return Path(plant=plant,
                 filter=filt,
                 test=GLR_TEST if scheme.detection.test == TEST_GLR else ONE_STEP_TEST,
-                control=NOMINAL_CONTROL if scheme.reconfig.kind == 0 else RECONFIGURING)
+                control=control)

@@ -37,7 +37,7 @@ from .estimator import (EstimatorSettings, belief_settings, detection, filter_mo
                         initial_covariance)
 from .truth import lateral_noise, sixdof_truth_plant, truth_plant
 
-CONTROLLER_KINDS = {"nominal": 0, "reconfiguring": 1, "lock_turn": 2}
+CONTROLLER_KINDS = {"nominal": 0, "reconfiguring": 1, "lock_turn": 2, "lock_turn_selected": 3}
 """``Reconfig.kind`` of each controller kind (``controller.kind``, a design's
 ``controller``)."""
 
@@ -89,6 +89,10 @@ class SimSetup:
     track : Track or None
         The glide path's cross-track error of the truth state (None: built from
         ``plant`` and ``truth`` when read, :attr:`flight`).
+    selection : tuple or None
+        ``(Reconfig, Belief)`` of a ``lock_turn_selected`` design
+        (:func:`ftc_mc.sim.selection.selection_settings`); None when no design
+        of the run flies one.
     """
 
     plant: LinearPlant
@@ -114,22 +118,30 @@ class SimSetup:
     lat_std: np.ndarray | None = None
     gust_lat_chol: np.ndarray | None = None
     track: Track | None = None
+    selection: tuple | None = None
 
     def scheme(self, name: str, detection: Detection | None = None) -> Scheme:
         """The kernels' :class:`Scheme` of the design ``name``: its filter, its
-        detection (or ``detection``), its excitation policy and its controller
-        kind (:meth:`reconfig_of`)."""
+        detection (or ``detection``), its excitation policy, its controller
+        kind (:meth:`reconfig_of`) and the belief its selection reads."""
         d: Design = self.designs[name]
+        rc = self.reconfig_of(name)
+        bs = self.selection[1] if rc.kind == CONTROLLER_KINDS["lock_turn_selected"] else self.bs
         return Scheme(filter=d.fm, detection=d.det if detection is None else detection,
-                      belief=self.bs, controller=self.ctl,
+                      belief=bs, controller=self.ctl,
                       excitation=self.exc._replace(**d.excitation),
-                      reconfig=self.reconfig_of(name), engine=self.eng)
+                      reconfig=rc, engine=self.eng)
 
     def reconfig_of(self, name: str) -> Reconfig:
         """The kernels' :class:`Reconfig` of the design ``name``: the config's,
-        with the design's own controller kind when it sets one."""
+        with the design's own controller kind when it sets one; a
+        ``lock_turn_selected`` design's is the 6-DOF selection's
+        (``selection``)."""
         kind = self.designs[name].controller
-        return self.rc if kind is None else self.rc._replace(kind=CONTROLLER_KINDS[kind])
+        code = self.rc.kind if kind is None else CONTROLLER_KINDS[kind]
+        if code == CONTROLLER_KINDS["lock_turn_selected"]:
+            return self.selection[0]
+        return self.rc if kind is None else self.rc._replace(kind=code)
 
     @property
     def flight(self) -> Flight:
@@ -240,7 +252,7 @@ def build_setup(cfg: Config | ScenarioConfig) -> SimSetup:
                    bank_max=math.radians(vc.bank_max_deg))
     pc = cfg.plant
     r_std = cfg.noise.measurement_scale * np.sqrt(fm.r_diag)
-    lat_std = gust_lat_chol = None
+    lat_std = gust_lat_chol = selection = None
     if pc.dof == 6:
         from .monitor import monitor_spec  # the 6-DOF family only on its path
 
@@ -251,6 +263,11 @@ def build_setup(cfg: Config | ScenarioConfig) -> SimSetup:
             paper=(K, eng, Q, R, c.discount) if c.coupling == "coupled" else None)
         lat_std = lateral_noise(r_std)
         gust_lat_chol = None if gust_lat is None else gust_lat.P0_chol
+        if cfg.selects_four(runs):
+            from .selection import selection_settings
+
+            selection = selection_settings(truth, ctl, eng, rc, bs,
+                                           cfg.steps(c.terminal_horizon_s))
     else:
         truth, gust = truth_plant(plant, pc.kind, pc.substeps, pc.turbulence, pc.altitude_m)
     return SimSetup(
@@ -265,4 +282,4 @@ def build_setup(cfg: Config | ScenarioConfig) -> SimSetup:
         beta=(cfg.estimator.beta_engine, cfg.estimator.beta_elevon),
         truth=truth, gust=gust, gust_chol=None if gust is None else gust.P0_chol,
         dof=pc.dof, lat_std=lat_std, gust_lat_chol=gust_lat_chol,
-        track=track_of(plant, truth, pc.dof))
+        track=track_of(plant, truth, pc.dof), selection=selection)

@@ -54,7 +54,8 @@ from ..shared.excitation import (doublet, doublet_length, running, saturate, sig
                                  signal_3211_length)
 from ..jit import kernel
 from ..shared.paths import (DENSE_FILTER, EXTENDED_FILTER, GLR_TEST, NOMINAL_CONTROL,
-                            ONE_STEP_TEST, PAPER_FILTER, RECONFIGURING, SIXDOF_EXTENDED_PLANT,
+                            ONE_STEP_TEST, PAPER_FILTER, RECONFIGURING, SELECT_FOUR,
+                            SIXDOF_EXTENDED_PLANT,
                             SIXDOF_PLANT, on_path)
 from .workspace import EXC_3211, EXC_3211_START, EXC_DOUBLET, EXC_DOUBLET_START
 
@@ -87,7 +88,8 @@ def reconfiguring_output(scheme, st, work):
             work.u[i, l] = Ul[i]
 
 
-@on_path("control", {NOMINAL_CONTROL: nominal_output, RECONFIGURING: reconfiguring_output})
+@on_path("control", {NOMINAL_CONTROL: nominal_output, RECONFIGURING: reconfiguring_output,
+                     SELECT_FOUR: reconfiguring_output})
 def controller_output(path, scheme, st, work):
     """The controller output of the path's scheme: :func:`nominal_output` or
     :func:`reconfiguring_output`."""
@@ -672,7 +674,10 @@ def reconfigure(path, scheme, timing, inp, st, kn, period, work, rec):
     """Stage 7, every reconfiguration period: belief, controller, detection.
 
     Per lane: the belief update (eqs. 13-14) with the fault-parameter estimate
-    and its marginal variances (eq. 12); on the reconfiguring controller's
+    and its marginal variances (eq. 12), unless the belief's boxes read other
+    parameters than the paper's five (a ``lock_turn_selected`` design: its
+    belief reads the side monitor's six, and its stage updated it at this
+    step, :func:`ftc_mc.core.sixdof.selection.sixdof_select`); on the reconfiguring controller's
     path the controller selection (eqs. 45-47, :func:`select`) on the
     estimate's first 14 states (a design's gust states are left out), for every
     lane at once (:func:`ftc_mc.core.longitudinal.control.select_controllers_lanes`, per
@@ -712,13 +717,20 @@ def reconfigure(path, scheme, timing, inp, st, kn, period, work, rec):
     bl = work.bl
     bh = work.bhat
     bv = work.bvar
+    updated = scheme.belief.lo.shape[1] != N_FAULT  # by the 6-DOF selection's stage
     for l in range(L):
         for m in range(N_MODES):
             bl[m] = st.belief[m, l]
         for j in range(N_FAULT):
             bh[j] = xa[N_X + j, l]
             bv[j] = P[N_X + j, N_X + j, l]
-        best = belief_update(bl, scheme.belief, bh, bv, work.bwork)
+        if updated:
+            best = 0
+            for m in range(N_MODES):
+                if bl[m] > bl[best]:
+                    best = m
+        else:
+            best = belief_update(bl, scheme.belief, bh, bv, work.bwork)
         for m in range(N_MODES):
             st.belief[m, l] = bl[m]
             rec.belief[period, m, l] = bl[m]

@@ -23,7 +23,7 @@ calls it and stage 7 by address (``core/linking.py``):
    6-DOF family's :func:`ftc_mc.core.sixdof.truth.sixdof_truth`), then
    :func:`ftc_mc.core.longitudinal.stages.record_cost` -- tracking and command costs,
    then :func:`side_monitor` -- on the 6-DOF plant its side monitor
-   (:func:`ftc_mc.core.sixdof.monitor.sixdof_monitor`), which records, and which a
+   (:func:`ftc_mc.core.sixdof.monitor_stage.sixdof_monitor`), which records, and which a
    ``lock_turn`` design's truth stage and its choice of the block to reset
    read (``core/sixdof/lockturn.py``);
 3. :func:`ftc_mc.core.longitudinal.stages.filter_update` -- the filter with ``u_k``, ``z_{k+1}``;
@@ -63,12 +63,12 @@ N_DIRECTIONS = N_U
 (``core/sixdof/layout.MONITOR_DIRECTIONS``)."""
 
 
-@on_path("plant", {SIXDOF_PLANT: "ftc_mc.core.sixdof.monitor:sixdof_monitor",
-                   SIXDOF_EXTENDED_PLANT: "ftc_mc.core.sixdof.monitor:sixdof_monitor_extended"},
+@on_path("plant", {SIXDOF_PLANT: "ftc_mc.core.sixdof.monitor_stage:sixdof_monitor",
+                   SIXDOF_EXTENDED_PLANT: "ftc_mc.core.sixdof.monitor_stage:sixdof_monitor_extended"},
          passes="marker")
 def side_monitor(path, scheme, flight, k, st, work, rec):
     """Stage 2b: the 6-DOF side monitor over step ``k -> k+1``
-    (:func:`ftc_mc.core.sixdof.monitor.sixdof_monitor`, imported only by a
+    (:func:`ftc_mc.core.sixdof.monitor_stage.sixdof_monitor`, imported only by a
     path that flies the 6-DOF plant); nothing on the longitudinal plants."""
 
 

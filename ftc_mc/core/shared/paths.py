@@ -29,8 +29,11 @@ The choices:
   airframe's equations);
 * ``test``: :data:`ONE_STEP_TEST` (eqs. 9-11) or :data:`GLR_TEST`
   (:mod:`ftc_mc.core.shared.glr`);
-* ``control``: :data:`NOMINAL_CONTROL` (c0 throughout) or
-  :data:`RECONFIGURING` (the selection of eqs. 45-47 every period).
+* ``control``: :data:`NOMINAL_CONTROL` (c0 throughout),
+  :data:`RECONFIGURING` (the selection of eqs. 45-47 every period) or
+  :data:`SELECT_FOUR` (6-DOF plant: the selection among the four 6-DOF
+  controllers, :mod:`ftc_mc.core.sixdof.selection`, which the 6-DOF truth and
+  monitor stages run: the paper's selection is not compiled).
 
 Everything else (turbulence, sensor faults, the settling rule, sensor-bias
 states) stays a run-time value: their code is small.  The path is computed
@@ -76,12 +79,13 @@ OneStepTest = _marker("OneStepTest")
 GlrTest = _marker("GlrTest")
 NominalControl = _marker("NominalControl")
 Reconfiguring = _marker("Reconfiguring")
+SelectFour = _marker("SelectFour")
 
 LINEAR_PLANT, NONLINEAR_PLANT, SIXDOF_PLANT = LinearPlant(), NonlinearPlant(), SixdofPlant()
 SIXDOF_EXTENDED_PLANT = SixdofExtendedPlant()
 PAPER_FILTER, DENSE_FILTER, EXTENDED_FILTER = PaperFilter(), DenseFilter(), ExtendedFilter()
 ONE_STEP_TEST, GLR_TEST = OneStepTest(), GlrTest()
-NOMINAL_CONTROL, RECONFIGURING = NominalControl(), Reconfiguring()
+NOMINAL_CONTROL, RECONFIGURING, SELECT_FOUR = NominalControl(), Reconfiguring(), SelectFour()
 
 NAMES = {LinearPlant: "linear plant", NonlinearPlant: "nonlinear plant",
          SixdofPlant: "6-DOF plant",
@@ -89,7 +93,8 @@ NAMES = {LinearPlant: "linear plant", NonlinearPlant: "nonlinear plant",
          PaperFilter: "paper filter", DenseFilter: "dense filter",
          ExtendedFilter: "extended filter", OneStepTest: "one-step test",
          GlrTest: "GLR test", NominalControl: "nominal controller",
-         Reconfiguring: "reconfiguring controller"}
+         Reconfiguring: "reconfiguring controller",
+         SelectFour: "selection among four controllers"}
 """What the compile notice calls each marker."""
 
 

@@ -149,6 +149,10 @@ from .plant import N_WORK, linear_output, linear_step, propagate
 LOCK_TURN = 2
 """``Reconfig.kind`` of a ``controller: lock_turn`` design (after 0 nominal and
 1 reconfiguring, which it runs until the monitor names an elevon)."""
+SELECTED_TURN = 3
+"""``Reconfig.kind`` of a ``controller: lock_turn_selected`` design: the
+selection of eqs. 45-47 chooses among c0, c1 and the lock-turn controllers of
+either side (:mod:`ftc_mc.core.sixdof.selection`)."""
 
 DECISION_BLOCK = (NO_RESET,) + LONGITUDINAL.actuator_block
 """The longitudinal filter's block of each monitor decision code (0: none, then
@@ -220,12 +224,7 @@ def lock_turn_law(tab, pl, s, p, mx, z, lat, l, lo_dev, hi_dev, u):
     u : ndarray, shape (3, L)
         Commands less ``u0``; column ``l`` is written.
     """
-    n = tab.x.shape[1]
-    f = (p - tab.lo[s]) / tab.step
-    f = min(float(n - 1), max(0.0, f))
-    i = min(int(f), max(n - 2, 0))
-    w = f - i
-    j1 = min(i + 1, n - 1)
+    i, j1, w = bracket(tab, s, p)
     if tab.steady[s, i] == 0.0 and tab.steady[s, j1] == 0.0:  # no steady flight
         if tab.ro_on == 0 or not rocking_law(tab, pl, s, p, mx, z, lat, l, lo_dev, hi_dev,
                                              u):
@@ -235,6 +234,39 @@ def lock_turn_law(tab, pl, s, p, mx, z, lat, l, lo_dev, hi_dev, u):
     elif tab.gd_on == 0 or not guarded_law(tab, pl, s, i, j1, w, p, mx, z, lat, l, lo_dev,
                                            hi_dev, u):
         turn_law(tab, s, i, j1, w, mx, z, lat, l, lo_dev, hi_dev, u)
+    a = tab.locked[s]
+    u[a, l] = min(hi_dev[a], max(lo_dev[a], tab.hold[a]))
+
+
+@kernel(inline="always")
+def bracket(tab, s, p):
+    """``(i, j1, w)``: the designs of side ``s`` around the lock position ``p``
+    [rad] (clamped to the grid's ends) and the weight on ``j1``."""
+    n = tab.x.shape[1]
+    f = (p - tab.lo[s]) / tab.step
+    f = min(float(n - 1), max(0.0, f))
+    i = min(int(f), max(n - 2, 0))
+    w = f - i
+    j1 = min(i + 1, n - 1)
+    return i, j1, w
+
+
+@kernel(inline="always")
+def base_law(tab, pl, s, p, xs, lo_dev, hi_dev, u, l):
+    """Column ``l`` of ``u`` (commands less ``u0``): the lock-turn law of side
+    ``s`` at the lock position ``p`` on the flown absolute 6-DOF state ``xs``,
+    without the rocking law and the guard (their own rollouts): the scheduled
+    LQR (:func:`turn_deviation`) where a design bracketing ``p`` has a steady
+    flight, else the trim commands held; the locked elevon at its trim
+    command (:func:`lock_turn_law`)."""
+    i, j1, w = bracket(tab, s, p)
+    steady = tab.steady[s, i] != 0.0 or tab.steady[s, j1] != 0.0
+    for c in range(2):
+        a = tab.cmd[s, c]
+        if steady:
+            u[a, l] = turn_deviation(tab, pl, s, i, j1, w, xs, lo_dev, hi_dev, c)
+        else:
+            u[a, l] = min(hi_dev[a], max(lo_dev[a], tab.hold[a]))
     a = tab.locked[s]
     u[a, l] = min(hi_dev[a], max(lo_dev[a], tab.hold[a]))
 
@@ -375,15 +407,23 @@ def turn_command(tab, pl, s, i, j1, w, xs, lo_dev, hi_dev, cmd):
     of designs ``i`` and ``j1`` of side ``s`` (weight ``w`` on ``j1``) at the
     6-DOF state ``xs`` (absolute), each fed-back state read from ``xs``;
     written into ``cmd`` (:func:`turn_law`'s law on a flown state)."""
-    mon = pl.monitor
-    nf = tab.x.shape[2]
     for c in range(2):
         a = tab.cmd[s, c]
-        v = law_base(tab, s, i, j1, w, c)
-        for r in range(nf):
-            q = mon.states[tab.rows[s, r]]
-            v -= law_term(tab, s, i, j1, w, c, r, xs[q] - pl.x0[q])
-        cmd[a] = mon.u0[a] + min(hi_dev[a], max(lo_dev[a], v))
+        cmd[a] = pl.monitor.u0[a] + turn_deviation(tab, pl, s, i, j1, w, xs, lo_dev, hi_dev, c)
+
+
+@kernel(inline="always")
+def turn_deviation(tab, pl, s, i, j1, w, xs, lo_dev, hi_dev, c):
+    """Command ``c`` (0 throttle, 1 healthy elevon) of :func:`turn_command`,
+    less ``u0`` and clipped to the limits."""
+    mon = pl.monitor
+    nf = tab.x.shape[2]
+    a = tab.cmd[s, c]
+    v = law_base(tab, s, i, j1, w, c)
+    for r in range(nf):
+        q = mon.states[tab.rows[s, r]]
+        v -= law_term(tab, s, i, j1, w, c, r, xs[q] - pl.x0[q])
+    return min(hi_dev[a], max(lo_dev[a], v))
 
 
 @kernel(inline="always")
@@ -494,7 +534,8 @@ def side_blocks(plant, scheme, st, block):
     plant : SixdofPlant or SixdofExtendedPlant
         The path's plant marker (the dispatcher's calling convention).
     scheme : Scheme
-        ``reconfig.kind`` (:data:`LOCK_TURN`: the monitor decides the block).
+        ``reconfig.kind`` (:data:`LOCK_TURN` or :data:`SELECTED_TURN`: the
+        monitor decides the block).
     st : LaneState
         ``mside`` (the elevon the lane flies the law about, if > 0) and
         ``mlast`` (the monitor's latest decision, 0 none).
@@ -502,7 +543,7 @@ def side_blocks(plant, scheme, st, block):
         Table 1's block per lane (``NO_RESET``, ``RESET_THRUST`` or
         ``RESET_ELEVONS``), rewritten in place.
     """
-    if scheme.reconfig.kind != LOCK_TURN:
+    if scheme.reconfig.kind < LOCK_TURN:
         return
     for l in range(block.shape[0]):
         named = st.mside[l] if st.mside[l] > 0 else st.mlast[l]

@@ -607,9 +607,12 @@ def monitor_start(mon, k, st):
 
 
 @kernel(inline="always")
-def monitor_decide(mon, flight, k, st, work, rec, num, den):
+def monitor_decide(mon, flight, k, st, work, rec, num, den, names):
     """After the update: the projection of the fault parameters, the windowed
-    GLR of each direction, the decisions with their resets, and the record."""
+    GLR of each direction, the decisions with their resets, and the record;
+    with ``names`` (every design but a ``lock_turn_selected`` one, whose
+    selection sets them) the first elevon named is kept in ``st.mside`` and
+    the step in ``st.mturn``."""
     x = st.mx
     P = st.mP
     n = x.shape[0]
@@ -651,7 +654,7 @@ def monitor_decide(mon, flight, k, st, work, rec, num, den):
                 P[j, pidx, l] = 0.0
             P[pidx, pidx, l] = mon.reset_var[pidx - ns]
         st.mlast[l] = b
-        if b > 1 and st.mside[l] == 0:  # the first elevon named (lockturn.py)
+        if names and b > 1 and st.mside[l] == 0:  # the first elevon named (lockturn.py)
             st.mside[l] = b
             st.mturn[l] = kn
         if st.alive[l]:
@@ -670,53 +673,3 @@ def monitor_decide(mon, flight, k, st, work, rec, num, den):
                 rec.mon_b[i, l] = x[ns + i, l]
             for a in range(nu):
                 rec.mon_b[2 * nu + a, l] = position(mon, x, ns, nu, a, l, work.u)
-
-
-@kernel(internal=True)
-def sixdof_monitor(plant, scheme, flight, k, st, work, rec):
-    """Advance the side monitor of every lane over step ``k -> k+1``.
-
-    Parameters
-    ----------
-    plant : SixdofPlant
-        The path's plant marker (the dispatcher's calling convention).
-    scheme : Scheme
-        Unused (the stage's calling convention).
-    flight : Flight
-        ``plant.monitor`` (:class:`SideMonitor`), ``timing.k_fault``.
-    k : int
-        Step.
-    st : LaneState
-        ``mx`` (n, L), ``mP`` (n, n, L) (set at step 0: zero and ``P0``),
-        the GLR window ``mbuf`` and ``mcount``, the first elevon named
-        ``mside`` and its position estimate ``mpos``, the latest decision
-        ``mlast``, updated in place; ``lat``
-        the lateral loop's measurements of ``k + 1``.
-    work : TrialWork
-        ``u`` the commands sent over the step, ``z`` the 12 longitudinal
-        measurements of ``k + 1``.
-    rec : TrialRecord
-        ``side_k``, ``side_block``, ``side_pre``, ``side_n`` (on live lanes), ``mon_b``
-        (module docstring).
-    """
-    mon = flight.plant.monitor
-    if mon.on == 0:
-        return
-    if mon.nonlinear == EXTENDED:
-        raise ValueError("an extended side monitor flies sixdof_monitor_extended")
-    num, den = monitor_start(mon, k, st)
-    trim_filter(mon, flight.plant, st.mx, st.mP, work.u, work.z, st.lat, num, den)
-    monitor_decide(mon, flight, k, st, work, rec, num, den)
-
-
-@kernel(internal=True)
-def sixdof_monitor_extended(plant, scheme, flight, k, st, work, rec):
-    """:func:`sixdof_monitor` with the extended filter (:func:`extended_filter`),
-    on the ``SIXDOF_EXTENDED_PLANT`` path (``core/shared/paths.py``): the
-    other 6-DOF path never compiles it."""
-    mon = flight.plant.monitor
-    if mon.on == 0:
-        return
-    num, den = monitor_start(mon, k, st)
-    extended_filter(mon, flight.plant, st.mx, st.mP, work.u, work.z, st.lat, num, den)
-    monitor_decide(mon, flight, k, st, work, rec, num, den)

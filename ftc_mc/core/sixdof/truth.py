@@ -71,24 +71,18 @@ from collections import namedtuple
 
 import numpy as np
 
-from ...conventions import (C_ENGINE, C_NOMINAL, I_B0_THRUST, I_B1_THRUST, LONGITUDINAL,
+from ...conventions import (I_B0_THRUST, I_B1_THRUST, LONGITUDINAL,
                             N_U, N_X, N_Z)
 from ..jit import kernel
 from ..longitudinal.plant import actuator_effect, gust_lanes, schedule_entry, sensor_fault
-from ..shared.interp import engine_controller
 from .layout import (N_OUTPUT, N_STATE, N_WIND, OUTPUT, SIXDOF_LINEAR, SIXDOF_NONLINEAR,
                      STATE, U_LEFT, U_RIGHT, W_P, W_Q, W_R, W_U, W_V, W_W, X_PHI, X_PSI,
                      Y_ALPHA, Y_VA, sixdof_name)
 from .lockturn import LOCK_TURN, hands_back, lock_turn_law, turn_probe
+from .loop import (LAT_LEFT, LAT_RIGHT, LATERAL_LOOP, N_LAT, N_LAT_MEASURED,  # noqa: F401
+                   loop_command)
 from .plant import N_WORK, linear_output, linear_step, outputs, propagate
 
-LATERAL_LOOP = ("phi", "v", "p", "r", "psi", "left", "right")
-"""Rows of ``LaneState.lat``: the lateral loop's measured states, then its
-model of the commanded elevons (the order of
-:data:`ftc_mc.design.lateral.LATERAL_STATES`)."""
-N_LAT = len(LATERAL_LOOP)
-N_LAT_MEASURED = 5
-LAT_LEFT, LAT_RIGHT = LATERAL_LOOP.index("left"), LATERAL_LOOP.index("right")
 N_LAT_GUST_STATE = 4
 N_LAT_GUST_NOISE = 4
 """Lateral Dryden model (:func:`ftc_mc.model.turbulence.dryden_lateral_model`)."""
@@ -121,12 +115,6 @@ SixDofTruth = namedtuple("SixDofTruth", [
 ])
 """The 6-DOF truth plant a trial flies (module docstring); the kernels'
 ``Flight.plant`` on the ``SIXDOF_PLANT`` path."""
-
-_ELEVON_SIGN = np.zeros(N_U)
-_ELEVON_SIGN[U_LEFT] = 1.0
-_ELEVON_SIGN[U_RIGHT] = -1.0
-"""Share of the aileron ``da`` in each command (PyFly's mixing)."""
-
 
 def index_maps():
     """``(lon_state, lon_out, lat_out)`` of :class:`SixDofTruth`: where the
@@ -217,7 +205,8 @@ def sixdof_truth(plant, scheme, flight, inp, k, st, work, rec):
     u = work.u
     lag = pl.a_act
     turn = pl.monitor.turn
-    turning = scheme.reconfig.kind == LOCK_TURN and turn.x.shape[1] > 0
+    turning = scheme.reconfig.kind >= LOCK_TURN and turn.x.shape[1] > 0
+    handing = scheme.reconfig.kind == LOCK_TURN  # a selection switches back itself
     b1_row = pl.monitor.A.shape[0] + pl.monitor.B.shape[1]  # the monitor's b1 of actuator 0
     xl = np.empty(N_X + N_LAT)
     du = np.empty(N_U)
@@ -227,7 +216,7 @@ def sixdof_truth(plant, scheme, flight, inp, k, st, work, rec):
             named = st.mside[l] - 1  # the named elevon's command (block code - 1)
             t = k - st.mturn[l]
             b1 = st.mx[b1_row + named, l]
-            if hands_back(turn, t, b1, st.mP[b1_row + named, b1_row + named, l]):
+            if handing and hands_back(turn, t, b1, st.mP[b1_row + named, b1_row + named, l]):
                 st.mside[l] = -st.mside[l]  # the paper's loop from this step on
                 flies_turn = False
         if flies_turn:
@@ -238,29 +227,13 @@ def sixdof_truth(plant, scheme, flight, inp, k, st, work, rec):
                           ctl.lo_dev, ctl.hi_dev, u)
             v = u[named, l] + turn_probe(turn, t)
             u[named, l] = min(ctl.hi_dev[named], max(ctl.lo_dev[named], v))
-        elif pl.coupled != 0 and st.cur[l] <= C_ENGINE:
+        else:
             for j in range(N_X):
                 xl[j] = st.xa[j, l]
             for j in range(N_LAT):
                 xl[N_X + j] = st.lat[j, l]
-            if st.cur[l] == C_NOMINAL:
-                for i in range(N_U):
-                    acc = 0.0
-                    for j in range(N_X + N_LAT):
-                        acc -= pl.G0[i, j] * xl[j]
-                    du[i] = acc
-            else:
-                engine_controller(pl.G1, st.xa[I_B0_THRUST, l], st.xa[I_B1_THRUST, l], xl, du)
-            for i in range(N_U):
-                ui = u[i, l] + pl.u_ff[i] + du[i]
-                u[i, l] = min(ctl.hi_dev[i], max(ctl.lo_dev[i], ui))
-        else:
-            da = 0.0
-            for j in range(N_LAT):
-                da -= pl.K_lat[j] * st.lat[j, l]
-            for i in range(N_U):
-                ui = u[i, l] + pl.u_ff[i] + _ELEVON_SIGN[i] * da
-                u[i, l] = min(ctl.hi_dev[i], max(ctl.lo_dev[i], ui))
+            loop_command(pl, ctl.lo_dev, ctl.hi_dev, st.cur[l], st.xa[I_B0_THRUST, l],
+                         st.xa[I_B1_THRUST, l], xl, du, u, l)
         st.lat[LAT_LEFT, l] = (lag * st.lat[LAT_LEFT, l]
                                + (1.0 - lag) * (u[U_LEFT, l] - pl.u_ff[U_LEFT]))
         st.lat[LAT_RIGHT, l] = (lag * st.lat[LAT_RIGHT, l]

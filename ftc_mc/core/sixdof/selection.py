@@ -1,0 +1,281 @@
+"""The selection among the four 6-DOF controllers (eqs. 45-47; issue 26, item 4).
+
+A design with ``controller: lock_turn_selected`` keeps the paper's structure
+on the flying wing: a mode belief, and every reconfiguration period a
+rolling-horizon choice among controllers, now four:
+
+* ``c0``: the paper's nominal controller with the lateral autopilot (or the
+  coupled 6-DOF c0, ``controller.coupling``), :func:`~ftc_mc.core.sixdof.loop.loop_command`;
+* ``c1``: the paper's engine-fault controller (Theorem 4.1's tables) with the
+  lateral autopilot (or the coupled c1);
+* ``c2``, ``c3``: the lock-turn controller of the left and of the right elevon
+  (:mod:`ftc_mc.core.sixdof.lockturn`): the throttle and the healthy elevon
+  fly pitch and roll together.
+
+**Belief** (eqs. 12-14).  The four modes ``m0`` to ``m3`` are read from the
+side monitor's estimate of the six fault parameters (``b0`` and ``b1`` of the
+throttle, the left and the right elevon), which roll makes separable: the
+paper's mode boxes, per actuator (``ftc_mc/sim/selection.py``), and its
+``T_M``, updated at the end of each reconfiguration period by the monitor's
+stage (:func:`sixdof_select`; :mod:`ftc_mc.core.sixdof.monitor_stage`), where
+the paper's is updated by :func:`ftc_mc.core.longitudinal.stages.reconfigure`
+(which then only records it).
+
+**Objective** (eq. 47), per lane and action ``a``::
+
+    I^H(a) + sum_m b(m) (J^N(m, a) + P(c, a))
+
+* ``I^H(a)`` (eq. 45): the discounted cost of ``a`` over the horizon ``H``
+  (``controller.horizon_s``), predicted by :func:`action_cost` on the side
+  monitor's linear 6-DOF model from its estimate, with its estimated faults
+  (eq. 2 per actuator), each law reading the predicted state;
+* ``J^N(m, a)`` (eq. 46): the regret table of ``a`` in mode ``m``, computed
+  off line by the same :func:`action_cost` (``ftc_mc/sim/selection.py``);
+* ``P(c, a)``: the switching penalty from the controller in use ``c``;
+* ``b(m)``: the belief updated at this period.  The paper weighs ``J^N`` by
+  the belief predicted under each action, which differs between actions only
+  through the predicted covariance; the prediction here carries no
+  covariance, so every action is weighed by the same belief.
+
+The lane then flies the action chosen (``LaneState.cur``, 0 to 3; for ``c2``
+and ``c3`` also ``LaneState.mside``, the block code of the elevon, and
+``mturn``, the step the law took over), until the next period.  Unlike a
+``lock_turn`` design, the monitor's decision does not switch the law in, and
+a later period may switch back or to the other side.
+
+**What the prediction flies.**  The lock-turn law without its rollouts
+(:func:`~ftc_mc.core.sixdof.lockturn.base_law`: the scheduled LQR where a
+steady flight brackets the lock estimate, else the trim commands held), on
+the lock position the estimate gives under the law's command to the locked
+elevon; the paper's controllers without their excitation, saturated as the
+commands stage saturates them.  The lateral loop's elevon model advances as
+in the truth stage.  The stage cost (eq. 45) weighs the 6-DOF states by
+``Reconfig.q_lqr`` (15: the paper's ``Q_lqr`` on the states of the same
+names, and ``controller.selection_bank_weight`` on the bank) and the
+commands less the 6-DOF trim's by ``r_lqr``.
+
+Plain-NumPy twin: ``tests/naive_sixdof.py::action_cost_ref``,
+``select_four_ref``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ...conventions import (C_ENGINE, I_B0_ELEVONS, I_B0_THRUST, I_B1_LEFT, I_B1_RIGHT,
+                            I_B1_THRUST, N_AUG, N_MODES, N_U, N_X)
+from ..jit import kernel
+from ..longitudinal.control import controller_command
+from ..shared.belief import belief_update
+from ..shared.excitation import saturate
+from .layout import N_STATE, STATE, U_LEFT, U_RIGHT
+from .lockturn import base_law
+from .loop import LAT_LEFT, LAT_RIGHT, LATERAL_LOOP, N_LAT, N_LAT_MEASURED, loop_command
+from .monitor import position
+
+N_SELECTED = 4
+"""The four controllers the selection chooses among: c0, c1, c2 (left elevon),
+c3 (right elevon)."""
+C_LEFT_TURN = 2
+"""The first lock-turn controller: ``c2`` flies side 0 (left), ``c3`` side 1;
+a lane flying ``c_a`` holds the block code ``a`` in ``LaneState.mside`` (the
+elevon's command index plus one)."""
+
+LAT_STATE = np.array([STATE[n] for n in LATERAL_LOOP[:N_LAT_MEASURED]], dtype=np.int64)
+"""The 6-DOF state of each measured row of the lateral loop."""
+
+
+@kernel(internal=True)
+def action_cost(pl, ctl, eng, rc, a, xm, mlr, bhat, btrue, n_steps):
+    """Discounted cost (eq. 45) of controller ``a`` flown ``n_steps`` periods on
+    the side monitor's linear 6-DOF model (module docstring).
+
+    Parameters
+    ----------
+    pl : SixDofTruth
+        ``monitor`` (its ``A``, ``B``, ``states``, ``u0``, ``u_ff``, ``turn``),
+        ``lon_state``, ``u_ff``, ``a_act`` and the lateral gains.
+    ctl : Controller
+        The paper's nominal gain ``K`` and the command limits ``lo_dev``, ``hi_dev``.
+    eng : EngineTables
+        c1's tables.
+    rc : Reconfig
+        ``alpha``, ``q_lqr`` (15,) on the 6-DOF states, ``r_lqr`` (3,).
+    a : int
+        Controller: 0 to 3 (:data:`N_SELECTED`).
+    xm : ndarray, shape (ns,)
+        Start: the monitor's states (deviations from the 6-DOF trim; gust states last).
+    mlr : ndarray, shape (2,)
+        Start: the lateral loop's model of the left and right elevon commands.
+    bhat : ndarray, shape (6,)
+        The fault parameters the laws read (``b0``, then ``b1``, of the
+        throttle, the left and the right elevon; the monitor's order).
+    btrue : ndarray, shape (6,)
+        The fault parameters the model flies (eq. 2 per actuator).
+    n_steps : int
+
+    Returns
+    -------
+    float
+        ``sum_{k=1..n} alpha^k (x_k' Q x_k + (u_{k-1} - u_ff)' R (u_{k-1} - u_ff))``,
+        ``x_k`` the 6-DOF state; ``inf`` when it is not finite.
+    """
+    mon = pl.monitor
+    tab = mon.turn
+    ns = mon.A.shape[0]
+    nu = mon.B.shape[1]
+    x = xm.copy()
+    xn = np.empty(ns)
+    x6 = np.zeros(N_STATE)
+    xs = np.empty(N_STATE)
+    xa = np.zeros(N_AUG)
+    xl = np.empty(N_X + N_LAT)
+    du = np.empty(N_U)
+    up = np.empty(N_U)
+    u = np.empty((N_U, 1))
+    xa[I_B0_THRUST] = bhat[0]
+    xa[I_B0_ELEVONS] = bhat[1] + bhat[2]
+    xa[I_B1_THRUST] = bhat[nu]
+    xa[I_B1_LEFT] = bhat[nu + 1]
+    xa[I_B1_RIGHT] = bhat[nu + 2]
+    m_l = mlr[0]
+    m_r = mlr[1]
+    lag = pl.a_act
+    s = a - C_LEFT_TURN
+    p = 0.0
+    if s >= 0:  # the lock position the estimate gives under the law's command
+        j = tab.locked[s]
+        p = bhat[j] + (1.0 - bhat[nu + j]) * (tab.hold[j] + mon.u0[j])
+    cost = 0.0
+    disc = 1.0
+    for _ in range(n_steps):
+        for i in range(N_STATE):
+            x6[i] = 0.0
+        for i in range(mon.states.shape[0]):
+            x6[mon.states[i]] = x[i]
+        if s < 0:
+            for i in range(N_X):
+                xa[i] = x6[pl.lon_state[i]]
+            controller_command(a, xa, ctl.K, eng, mon.u0, up)
+            for i in range(N_U):
+                u[i, 0] = saturate(up[i], 0.0, 0.0, ctl.lo_dev[i], ctl.hi_dev[i])
+            for i in range(N_X):
+                xl[i] = xa[i]
+            for i in range(N_LAT_MEASURED):
+                xl[N_X + i] = x6[LAT_STATE[i]]
+            xl[N_X + LAT_LEFT] = m_l
+            xl[N_X + LAT_RIGHT] = m_r
+            loop_command(pl, ctl.lo_dev, ctl.hi_dev, a, xa[I_B0_THRUST], xa[I_B1_THRUST], xl,
+                         du, u, 0)
+        else:
+            for i in range(N_STATE):
+                xs[i] = pl.x0[i] + x6[i]
+            base_law(tab, pl, s, p, xs, ctl.lo_dev, ctl.hi_dev, u, 0)
+        m_l = lag * m_l + (1.0 - lag) * (u[U_LEFT, 0] - pl.u_ff[U_LEFT])
+        m_r = lag * m_r + (1.0 - lag) * (u[U_RIGHT, 0] - pl.u_ff[U_RIGHT])
+        for i in range(ns):
+            acc = 0.0
+            for j in range(ns):
+                acc += mon.A[i, j] * x[j]
+            for c in range(nu):
+                e = (u[c, 0] - mon.u_ff[c]) + btrue[c] - (u[c, 0] + mon.u0[c]) * btrue[nu + c]
+                acc += mon.B[i, c] * e
+            xn[i] = acc
+        for i in range(ns):
+            x[i] = xn[i]
+        disc *= rc.alpha
+        stage = 0.0
+        for c in range(nu):
+            d = u[c, 0] - mon.u_ff[c]
+            stage += rc.r_lqr[c] * d * d
+        for i in range(mon.states.shape[0]):
+            stage += rc.q_lqr[mon.states[i]] * x[i] * x[i]
+        cost += disc * stage
+    if not math.isfinite(cost):
+        return math.inf
+    return cost
+
+
+@kernel(internal=True)
+def select_four(pl, scheme, k, st, work):
+    """Eq. 47 among the four controllers, on every live lane at step ``k``
+    (module docstring); ``st.cur``, ``st.mside``, ``st.mturn`` and
+    ``st.mpos`` updated.
+
+    Parameters
+    ----------
+    pl : SixDofTruth
+    scheme : Scheme
+        ``reconfig`` (``horizon``, ``JN`` (4, 4), ``penalty`` (4, 4)),
+        ``controller``, ``engine``.
+    k : int
+        Step (a reconfiguration period's end).
+    st : LaneState
+        Reads ``mx``, ``lat``, ``belief``, ``alive``.
+    work : TrialWork
+        ``u``: the commands of the step (:func:`~ftc_mc.core.sixdof.monitor.position`).
+    """
+    mon = pl.monitor
+    rc = scheme.reconfig
+    ns = mon.A.shape[0]
+    nu = mon.B.shape[1]
+    xm = np.empty(ns)
+    mlr = np.empty(2)
+    bh = np.empty(2 * nu)
+    for l in range(st.mx.shape[1]):
+        if not st.alive[l]:
+            continue
+        for i in range(ns):
+            xm[i] = st.mx[i, l]
+        for i in range(2 * nu):
+            bh[i] = st.mx[ns + i, l]
+        mlr[0] = st.lat[LAT_LEFT, l]
+        mlr[1] = st.lat[LAT_RIGHT, l]
+        cur = st.cur[l]
+        best = cur
+        best_obj = math.inf
+        for a in range(N_SELECTED):
+            obj = action_cost(pl, scheme.controller, scheme.engine, rc, a, xm, mlr, bh, bh,
+                              rc.horizon)
+            for m in range(N_MODES):
+                obj += st.belief[m, l] * (rc.JN[m, a] + rc.penalty[cur, a])
+            if obj < best_obj:
+                best_obj = obj
+                best = a
+        st.cur[l] = best
+        if best <= C_ENGINE:
+            st.mside[l] = 0
+        elif st.mside[l] != best:
+            st.mside[l] = best
+            st.mturn[l] = k
+            st.mpos[l] = position(mon, st.mx, ns, nu, best - 1, l, work.u)
+
+
+@kernel(internal=True)
+def sixdof_select(pl, scheme, kn, st, work):
+    """At the end of a reconfiguration period (step ``kn``), every lane's
+    belief (eqs. 13-14: ``scheme.belief``'s ``T_M`` and its boxes on the side
+    monitor's six fault parameters, with their marginal variances; eq. 12)
+    and then the selection (:func:`select_four`).  ``st.belief`` is updated
+    on every lane, as the paper's is
+    (:func:`ftc_mc.core.longitudinal.stages.reconfigure`, which then records
+    it)."""
+    mon = pl.monitor
+    ns = mon.A.shape[0]
+    npar = 2 * mon.B.shape[1]
+    bl = np.empty(N_MODES)
+    bw = np.empty(2 * N_MODES)
+    bh = np.empty(npar)
+    bv = np.empty(npar)
+    for l in range(st.mx.shape[1]):
+        for m in range(N_MODES):
+            bl[m] = st.belief[m, l]
+        for i in range(npar):
+            bh[i] = st.mx[ns + i, l]
+            bv[i] = st.mP[ns + i, ns + i, l]
+        belief_update(bl, scheme.belief, bh, bv, bw)
+        for m in range(N_MODES):
+            st.belief[m, l] = bl[m]
+    select_four(pl, scheme, kn, st, work)
