@@ -14,7 +14,8 @@ that compiles the trial kernel when it is not cached (1.5-3 min).
 With ``--campaign N`` it also times issue 26's speed target: the reconfiguring
 6-DOF campaign, ``configs/sixdof_tables.yaml``'s twelve rows with the design
 ``sixdof`` alone (the paper's filter and loop, the side monitor, the lock-turn
-law), ``N`` trials per row, ``--jobs 2``, on the linear 6-DOF plant (the
+law; ``--design sixdof_selected``: the selection among the four 6-DOF
+controllers instead), ``N`` trials per row, ``--jobs 2``, on the linear 6-DOF plant (the
 issue's setting) and on the nonlinear one, each after a small warm-up run of
 the same path (its compile and the lock-turn designs are not timed): trial
 steps per second of the whole ``api.run_campaign`` call (setup, trials, summary).
@@ -22,7 +23,7 @@ steps per second of the whole ``api.run_campaign`` call (setup, trials, summary)
 Usage::
 
     .venv/bin/python scripts/bench_sixdof.py [--lanes 128] [--steps 500] [--repeat 5] [--trial]
-        [--campaign 500]
+        [--campaign 500] [--design sixdof_selected]
 
 The last line is ``longitudinal_plant_steps_per_s=<a> sixdof_plant_steps_per_s=<b>
 ratio=<b/a>`` (and ``longitudinal_trial_steps_per_s=<c> sixdof_vs_trial=<b/c>``
@@ -106,6 +107,9 @@ def main():
                     help="also time the longitudinal nonlinear plant's full trial")
     ap.add_argument("--campaign", type=int, default=0, metavar="N",
                     help="also time the reconfiguring 6-DOF campaign, N trials per row")
+    ap.add_argument("--design", default="sixdof",
+                    help="the campaign's design (sixdof_tables.yaml's designs section; "
+                         "sixdof_selected: the selection among four controllers)")
     args = ap.parse_args()
     af = PRESETS["x8-pyfly"].airframe
     rng = np.random.default_rng(24)
@@ -145,27 +149,27 @@ def main():
                  f"sixdof_vs_trial={r_six / r_trial:.3f}")
     if args.campaign:
         for kind in ("linear", "nonlinear"):
-            rate, wall = campaign_steps_per_s(kind, args.campaign)
-            print(f"reconfiguring 6-DOF campaign (sixdof_tables.yaml, design sixdof, "
+            rate, wall = campaign_steps_per_s(kind, args.campaign, args.design)
+            print(f"reconfiguring 6-DOF campaign (sixdof_tables.yaml, design {args.design}, "
                   f"{kind} plant, {args.campaign} trials x 12 rows, --jobs 2): "
                   f"{wall:.1f} s, {rate:.4g} trial steps/s")
             line += f" campaign_{kind}_trial_steps_per_s={rate:.4g}"
     print(line)
 
 
-def campaign_steps_per_s(kind, trials):
+def campaign_steps_per_s(kind, trials, design="sixdof"):
     """Trial steps per second of ``configs/sixdof_tables.yaml`` with the design
-    ``sixdof`` on the ``kind`` 6-DOF plant, ``trials`` per row, two workers,
+    ``design`` on the ``kind`` 6-DOF plant, ``trials`` per row, two workers,
     after a warm-up run of 2 trials per row; and the wall time [s]."""
     from ftc_mc import api
 
     config = str(Path(__file__).resolve().parents[1] / "configs" / "sixdof_tables.yaml")
-    common = dict(design=["sixdof"], plant=kind, jobs=2, progress=False)
+    common = dict(design=[design], plant=kind, jobs=2, progress=False)
     api.run_campaign(config, trials=2, **common)
     t = time.perf_counter()
     res = api.run_campaign(config, trials=trials, **common)
     wall = time.perf_counter() - t
-    cfg = api.campaign_config(config, trials=trials, design=["sixdof"], plant=kind)
+    cfg = api.campaign_config(config, trials=trials, design=[design], plant=kind)
     steps = len(res.trials) * int(round(cfg.timing.duration_s / cfg.model.dt_s))
     return steps / wall, wall
 

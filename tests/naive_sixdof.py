@@ -657,33 +657,33 @@ def side_blocks_ref(kind, mside, mlast, block):
 
 
 
-def action_cost_ref(pl, ctl, tables, rc, a, xm, mlr, bhat, btrue, n_steps):
+def action_cost_ref(pl, ctl, tables, rc, a, x6, mlr, bhat, btrue, n_steps):
     """Eq. (45) for one of the four 6-DOF controllers
     (``ftc_mc/core/sixdof/selection.py``), written from that module's
-    docstring with whole vectors: the side monitor's linear model ``A``, ``B``
-    flown ``n_steps`` periods from ``xm`` with the faults ``btrue`` (eq. 2 per
-    actuator, ``[b0 (3), b1 (3)]``); c0 and c1 the paper's laws on the
-    longitudinal states of the same names and the faults ``bhat`` (the elevons'
-    ``b0`` summed), clipped, plus ``u_ff`` and the lateral loop's aileron (or
-    the coupled law's terms), clipped again; c2 and c3 :func:`lock_turn_law_ref`
-    at the lock position ``b0 + (1 - b1)(hold + u0)`` of the locked elevon, on
-    the fed-back states read by name; the lateral loop's elevon model
-    advanced; cost ``sum alpha^k (x' Q x + (u - u_ff)' R (u - u_ff))`` on the
-    predicted 6-DOF states.  ``inf`` when not finite."""
+    docstring with whole vectors: the plant's model (:func:`rollout_step_ref`)
+    flown ``n_steps`` periods from the absolute state ``x6`` with the faults
+    ``btrue`` (eq. 2 per actuator, ``[b0 (3), b1 (3)]``); c0 and c1 the
+    paper's laws on the longitudinal states of the same names and the faults
+    ``bhat`` (the elevons' ``b0`` summed), clipped, plus ``u_ff`` and the
+    lateral loop's aileron (or the coupled law's terms), clipped again; c2 and
+    c3 :func:`lock_turn_law_ref` at the lock position ``b0 + (1 - b1)(hold +
+    u0)`` of the locked elevon, on the fed-back states read by name; the
+    lateral loop's elevon model advanced; cost ``sum alpha^k (x' Q x + (u -
+    u_ff)' R (u - u_ff))`` on the flown 6-DOF states less the trim.  ``inf``
+    when not finite."""
     from ftc_mc.conventions import LONGITUDINAL
     from ftc_mc.design.lock_turn import SIDES, turn_states
     from naive import B0_E, B0_T, B1_L, B1_R, B1_T, C0, C1, controller_command_ref, engine_gain_ref
 
     mon = pl.monitor
     tab = mon.turn
-    n = len(mon.states)
     lon = [LAYOUT.states.index(LONGITUDINAL_AS_SIXDOF.get(m, m)) for m in LONGITUDINAL.states]
     lat = [LAYOUT.states.index(m) for m in LATERAL_MEASURED]
     left, right = LAYOUT.commands.index("left"), LAYOUT.commands.index("right")
     X = np.zeros(14)
     X[B0_T], X[B0_E], X[B1_T], X[B1_L], X[B1_R] = (bhat[0], bhat[1] + bhat[2], bhat[3],
                                                    bhat[4], bhat[5])
-    x = np.array(xm, dtype=float)
+    xs = np.array(x6, dtype=float)
     m = np.array(mlr, dtype=float)
     if a >= 2:
         s = a - 2
@@ -691,31 +691,31 @@ def action_cost_ref(pl, ctl, tables, rc, a, xm, mlr, bhat, btrue, n_steps):
         p = bhat[j] + (1.0 - bhat[3 + j]) * (tab.hold[j] + mon.u0[j])
         fed = [LAYOUT.states.index(name) for name in turn_states(SIDES[s])]
     cost, disc = 0.0, 1.0
-    for _ in range(n_steps):
-        x6 = np.zeros(len(LAYOUT.states))
-        x6[mon.states] = x[:n]
-        if a < 2:
-            X[:9] = x6[lon]
-            U = np.clip(controller_command_ref(a, X, ctl.K, tables, mon.u0), ctl.lo_dev,
-                        ctl.hi_dev)
-            state = np.concatenate([X[:9], x6[lat], m])
-            if pl.coupled and a == C0:
-                extra = -pl.G0 @ state
-            elif pl.coupled and a == C1:
-                G, g = engine_gain_ref(pl.G1, X[B0_T], X[B1_T])
-                extra = -G @ state - g
+    with np.errstate(all="ignore"):
+        for _ in range(n_steps):
+            dev = xs - pl.x0
+            if a < 2:
+                X[:9] = dev[lon]
+                U = np.clip(controller_command_ref(a, X, ctl.K, tables, mon.u0), ctl.lo_dev,
+                            ctl.hi_dev)
+                state = np.concatenate([X[:9], dev[lat], m])
+                if pl.coupled and a == C0:
+                    extra = -pl.G0 @ state
+                elif pl.coupled and a == C1:
+                    G, g = engine_gain_ref(pl.G1, X[B0_T], X[B1_T])
+                    extra = -G @ state - g
+                else:
+                    da = -pl.K_lat @ state[9:]
+                    extra = np.zeros(3)
+                    extra[left], extra[right] = da, -da
+                u = np.clip(U + pl.u_ff + extra, ctl.lo_dev, ctl.hi_dev)
             else:
-                da = -pl.K_lat @ state[9:]
-                extra = np.zeros(3)
-                extra[left], extra[right] = da, -da
-            u = np.clip(U + pl.u_ff + extra, ctl.lo_dev, ctl.hi_dev)
-        else:
-            u = lock_turn_law_ref(tab, s, p, x6[fed], ctl.lo_dev, ctl.hi_dev)
-        m = pl.a_act * m + (1.0 - pl.a_act) * (u[[left, right]] - pl.u_ff[[left, right]])
-        e = (u - mon.u_ff) + btrue[:3] - (u + mon.u0) * btrue[3:]
-        x = mon.A @ x + mon.B @ e
-        disc *= rc.alpha
-        cost += disc * (rc.r_lqr @ (u - mon.u_ff) ** 2 + rc.q_lqr[mon.states] @ x[:n] ** 2)
+                u = lock_turn_law_ref(tab, s, p, dev[fed], ctl.lo_dev, ctl.hi_dev)
+            m = pl.a_act * m + (1.0 - pl.a_act) * (u[[left, right]] - pl.u_ff[[left, right]])
+            cmd = btrue[:3] + (1.0 - btrue[3:]) * (u + mon.u0)
+            xs, _ = rollout_step_ref(tab, pl, xs, cmd)
+            disc *= rc.alpha
+            cost += disc * (rc.r_lqr @ (u - mon.u_ff) ** 2 + rc.q_lqr @ (xs - pl.x0) ** 2)
     return cost if np.isfinite(cost) else np.inf
 
 
@@ -744,8 +744,10 @@ def sixdof_select_ref(pl, scheme, kn, st, u, horizon_cost=action_cost_ref):
             continue
         cur = int(st.cur[l])
         mlr = st.lat[[5, 6], l]
-        obj = [horizon_cost(pl, scheme.controller, scheme.engine, rc, a, st.mx[:ns, l], mlr,
-                            bh, bh, rc.horizon) + b @ (rc.JN[:, a] + rc.penalty[cur, a])
+        x6 = pl.x0.copy()  # the monitor's estimate on its rows, the trim elsewhere
+        x6[mon.states] += st.mx[:len(mon.states), l]
+        obj = [horizon_cost(pl, scheme.controller, scheme.engine, rc, a, x6, mlr, bh, bh,
+                            rc.horizon) + b @ (rc.JN[:, a] + rc.penalty[cur, a])
                for a in range(4)]
         best = int(np.argmin(obj))
         out["cur"][l] = best

@@ -78,11 +78,12 @@ ROLLOUT_MAX_SUBSTEP_S = 0.05
 -38.5 1/s, gives h lambda = 1.9 there, inside RK4's stability bound of 2.8."""
 
 
-def _check_rollout(cfg) -> None:
+def _check_rollout(cfg, runs) -> None:
     """The rocking law's RK4 sub-step must be at most :data:`ROLLOUT_MAX_SUBSTEP_S`
-    (when ``monitor.turn_beyond`` is ``rollout`` or ``guarded``)."""
+    (when ``monitor.turn_beyond`` is ``rollout`` or ``guarded``, or a design of
+    ``runs`` flies ``lock_turn_selected``, whose predictions fly the same way)."""
     m = cfg.monitor
-    if m.turn_beyond == "hold":
+    if m.turn_beyond == "hold" and not cfg.selects_four(runs):
         return
     h = cfg.model.dt_s / m.rollout_substeps
     if h > ROLLOUT_MAX_SUBSTEP_S * (1 + 1e-9):
@@ -850,7 +851,7 @@ class Config(_Sampled):
                             ("timing.reconfiguration_period_s",
                              t.reconfiguration_period_s),
                             *_shared_periods(self)])
-        _check_rollout(self)
+        _check_rollout(self, self.campaign.runs())
         if self.controller.horizon_s > t.duration_s:
             raise ValueError("controller.horizon_s: must not exceed timing.duration_s "
                              f"({t.duration_s:g} s), got {self.controller.horizon_s:g}")
@@ -1028,6 +1029,6 @@ class ScenarioConfig(_Sampled):
                                  f"scenario.duration_s ({sc.duration_s:g} s), got "
                                  f"{sf.time_s:g}")
         _check_periods(dt, _shared_periods(self))
-        _check_rollout(self)
+        _check_rollout(self, (sc.design or sc.signature,))
         _check_length("scenario.duration_s", sc.duration_s, dt)
         return self

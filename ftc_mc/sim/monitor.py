@@ -52,7 +52,10 @@ NO_ROLLOUT = dict(ro_on=0, ro_steps=1, ro_sub=1, ro_first=np.ones(1, dtype=np.in
                   ro_u=np.zeros((2, 1, 2, 2)), ro_env=np.zeros(5), gd_on=0, gd_pairs=0,
                   gd_holds=np.ones(1, dtype=np.int64))
 """The ``LockTurnTable`` fields of no rocking law and no rollout guard
-(``monitor.turn_beyond: hold``; the same types as the law's, one signature)."""
+(``monitor.turn_beyond: hold``; the same types as the law's, one signature);
+a monitor's table takes the envelope and the sub-steps of its flights
+(``ro_env``, ``ro_sub``: the 6-DOF selection's predictions fly the airframe's
+equations so) from the config all the same."""
 
 MEASURED = LONGITUDINAL.outputs + MONITOR_LATERAL
 """The monitor's measured outputs in its order (``CAS`` and ``Va`` both the
@@ -104,6 +107,13 @@ class MonitorSpec:
         the nonlinear plant with gust states; ``nonlinear`` is then True too).
     state_noise_scale : float
         Multiplies the process noise variance ``q_x`` of the 6-DOF states.
+    turn_env : tuple
+        The validity envelope the lock-turn table's predictions fly in
+        (airspeed [m/s], angle of attack and bank [deg], :func:`rocking_table`'s
+        ``env``).
+    turn_sub : int
+        Their RK4 sub-steps per period (``monitor.rollout_substeps``): the
+        rocking law's, the guard's and the 6-DOF selection's.
     turn_rollout : dict or None
         The rocking law (``monitor.turn_beyond: rollout`` or ``guarded``):
         ``steps`` (its horizon), ``switches`` (the candidates' switch times)
@@ -140,6 +150,8 @@ class MonitorSpec:
     substeps: int = 5
     extended: bool = False
     state_noise_scale: float = 1.0
+    turn_env: tuple = ()
+    turn_sub: int = 2
     turn_rollout: dict | None = None
     turn_wide: tuple | None = None
 
@@ -193,6 +205,7 @@ def monitor_spec(cfg, fm, det, lock_turn: bool = False) -> MonitorSpec | None:
                   (mc.prediction == "auto" and cfg.plant.kind == "nonlinear"
                    and mc.design_turbulence != "none")),
         state_noise_scale=float(mc.state_noise_scale),
+        turn_env=env, turn_sub=int(mc.rollout_substeps),
         turn_rollout=None if mc.turn_beyond == "hold" else dict(
             steps=cfg.steps(mc.rollout_horizon_s),
             switches=tuple(cfg.steps(t) for t in mc.rollout_switch_s),
@@ -423,7 +436,8 @@ def side_monitor(six, u_ff: np.ndarray, u_lower, u_upper, lon_out: np.ndarray,
     u_upper = np.asarray(u_upper, dtype=float)
     u0 = six.u0 - u_ff
     ro = spec.turn_rollout
-    rollout = None if ro is None else rocking_table(
+    rollout = dict(NO_ROLLOUT, ro_env=np.asarray(spec.turn_env, dtype=np.float64),
+                   ro_sub=int(spec.turn_sub)) if ro is None else rocking_table(
         u_lower - u0, u_upper - u0, ro["steps"], ro["switches"], ro["sub"], ro["env"],
         ro["levels"], ro.get("holds", ()))
     wide = None

@@ -18,8 +18,11 @@ keeps the paper's belief and selection, read on the 6-DOF model:
   paper's (:mod:`ftc_mc.design.terminal`: the mean discounted cost of ``a``
   over ``controller.terminal_horizon_s`` from trim, with the fault and the
   state known, over representative faults of mode ``m``; as regrets), flown
-  by :func:`ftc_mc.core.sixdof.selection.action_cost` on the side monitor's
-  linear 6-DOF model.  The elevon locks are :data:`SIXDOF_ELEVON_OFFSETS_DEG`
+  by :func:`ftc_mc.core.sixdof.selection.action_cost` on the plant's model
+  (the linear 6-DOF model, or the airframe's equations: the model the
+  lock-turn table is designed on).  A flight whose state the equations no
+  longer hold finite (the aircraft departed) costs as much as the most
+  expensive finite flight of the table.  The elevon locks are :data:`SIXDOF_ELEVON_OFFSETS_DEG`
   from the 6-DOF trim, where a controller can fly on
   (``docs/airframes.md``, "Which locks can be flown steadily"); the engine's
   locks and every loss are the paper's.
@@ -69,6 +72,22 @@ def sixdof_q_lqr(q_lqr: np.ndarray) -> np.ndarray:
     return q
 
 
+def _flight_costs(truth, ctl, eng, rc: Reconfig, n_steps: int) -> list:
+    """Per mode and action, the costs of the action's flights over the mode's
+    representative faults from the 6-DOF trim, state and faults known
+    (module docstring)."""
+    mon = truth.monitor
+    trim = mon.u0 + mon.u_ff
+    elevon = [tuple(trim[COMMAND[side]] + math.radians(d) for d in SIXDOF_ELEVON_OFFSETS_DEG)
+              for side in ("left", "right")]
+    faults = representative_faults((ENGINE_LOCKS, elevon[0], elevon[1]))
+    mlr = np.zeros(2)
+    costs = [[[action_cost(truth, ctl, eng, rc, a, truth.x0, mlr, b, b, n_steps)
+               for b in (np.concatenate(f) for f in mode_faults)]
+              for a in range(N_SELECTED)] for mode_faults in faults]
+    return costs
+
+
 def sixdof_terminal_costs(truth, ctl, eng, rc: Reconfig, n_steps: int) -> np.ndarray:
     """``J^N`` regrets as a (4, 4) array: modes (nominal, engine, left, right)
     by controllers (c0, c1, left and right lock-turn); module docstring.
@@ -76,7 +95,8 @@ def sixdof_terminal_costs(truth, ctl, eng, rc: Reconfig, n_steps: int) -> np.nda
     Parameters
     ----------
     truth : SixDofTruth
-        Its side monitor's model and lock-turn table, the lateral loop.
+        The plant's model, its trim, the lateral loop, and its side monitor's
+        lock-turn table.
     ctl : Controller
     eng : EngineTables
     rc : Reconfig
@@ -84,29 +104,18 @@ def sixdof_terminal_costs(truth, ctl, eng, rc: Reconfig, n_steps: int) -> np.nda
     n_steps : int
         Steps of the simulated rest of the mission.
     """
-    mon = truth.monitor
-    trim = mon.u0 + mon.u_ff
-    elevon = [tuple(trim[COMMAND[side]] + math.radians(d) for d in SIXDOF_ELEVON_OFFSETS_DEG)
-              for side in ("left", "right")]
-    faults = representative_faults((ENGINE_LOCKS, elevon[0], elevon[1]))
-    xm = np.zeros(mon.A.shape[0])
-    mlr = np.zeros(2)
-    JN = np.zeros((len(faults), N_SELECTED))
-    for m, mode_faults in enumerate(faults):
-        for a in range(N_SELECTED):
-            costs = []
-            for b0, b1 in mode_faults:
-                b = np.concatenate([b0, b1])
-                costs.append(action_cost(truth, ctl, eng, rc, a, xm, mlr, b, b, n_steps))
-            JN[m, a] = float(np.mean(costs))
+    costs = _flight_costs(truth, ctl, eng, rc, n_steps)
+    worst = max(c for mode in costs for a in mode for c in a if math.isfinite(c))
+    JN = np.array([[np.mean([c if math.isfinite(c) else worst for c in a]) for a in mode]
+                   for mode in costs])
     return JN - JN.min(axis=1, keepdims=True)
 
 
 def selection_settings(truth, ctl, eng, rc: Reconfig, paper: Belief, n_steps: int):
     """``(Reconfig, Belief)`` of a ``lock_turn_selected`` design: ``rc`` with
-    its kind, the 6-DOF weights, the (4, 4) terminal costs and the (4, 4)
-    switching penalty (``rc``'s off-diagonal value), and the six-parameter
-    belief (module docstring)."""
+    its kind, the 6-DOF weights, the (4, 4) terminal costs and the
+    (4, 4) switching penalty (``rc``'s off-diagonal value); and the
+    six-parameter belief (module docstring)."""
     pen = float(rc.penalty[0, 1])
     six = rc._replace(kind=SELECTED_TURN, q_lqr=sixdof_q_lqr(rc.q_lqr),
                       penalty=pen * (1.0 - np.eye(N_SELECTED)))

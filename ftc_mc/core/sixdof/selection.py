@@ -26,9 +26,16 @@ the paper's is updated by :func:`ftc_mc.core.longitudinal.stages.reconfigure`
     I^H(a) + sum_m b(m) (J^N(m, a) + P(c, a))
 
 * ``I^H(a)`` (eq. 45): the discounted cost of ``a`` over the horizon ``H``
-  (``controller.horizon_s``), predicted by :func:`action_cost` on the side
-  monitor's linear 6-DOF model from its estimate, with its estimated faults
-  (eq. 2 per actuator), each law reading the predicted state;
+  (``controller.horizon_s``), predicted by :func:`action_cost` from the side
+  monitor's estimate (on its rows; the trim elsewhere), with its estimated
+  faults (eq. 2 per actuator), each law reading the predicted state, on the
+  plant's model as the lock-turn law's rollouts fly it
+  (:func:`~ftc_mc.core.sixdof.lockturn.rollout_step`: the linear 6-DOF model
+  on the linear plant, the airframe's equations with ``ro_sub`` RK4
+  sub-steps on the nonlinear one; still air), which is also the model the
+  lock-turn table is designed on (``monitor.turn_model: auto``; flown on the
+  monitor's linear model instead, the table of the equations diverged and
+  the selection never chose it);
 * ``J^N(m, a)`` (eq. 46): the regret table of ``a`` in mode ``m``, computed
   off line by the same :func:`action_cost` (``ftc_mc/sim/selection.py``);
 * ``P(c, a)``: the switching penalty from the controller in use ``c``;
@@ -70,10 +77,11 @@ from ..jit import kernel
 from ..longitudinal.control import controller_command
 from ..shared.belief import belief_update
 from ..shared.excitation import saturate
-from .layout import N_STATE, STATE, U_LEFT, U_RIGHT
-from .lockturn import base_law
+from .layout import N_STATE, N_WIND, STATE, U_LEFT, U_RIGHT
+from .lockturn import base_law, rollout_step
 from .loop import LAT_LEFT, LAT_RIGHT, LATERAL_LOOP, N_LAT, N_LAT_MEASURED, loop_command
-from .monitor import position
+from .monitor import on_trim, position
+from .plant import N_WORK
 
 N_SELECTED = 4
 """The four controllers the selection chooses among: c0, c1, c2 (left elevon),
@@ -88,15 +96,17 @@ LAT_STATE = np.array([STATE[n] for n in LATERAL_LOOP[:N_LAT_MEASURED]], dtype=np
 
 
 @kernel(internal=True)
-def action_cost(pl, ctl, eng, rc, a, xm, mlr, bhat, btrue, n_steps):
+def action_cost(pl, ctl, eng, rc, a, x6, mlr, bhat, btrue, n_steps):
     """Discounted cost (eq. 45) of controller ``a`` flown ``n_steps`` periods on
-    the side monitor's linear 6-DOF model (module docstring).
+    the plant's model (module docstring).
 
     Parameters
     ----------
     pl : SixDofTruth
-        ``monitor`` (its ``A``, ``B``, ``states``, ``u0``, ``u_ff``, ``turn``),
-        ``lon_state``, ``u_ff``, ``a_act`` and the lateral gains.
+        The plant's model (:func:`~ftc_mc.core.sixdof.lockturn.rollout_step`),
+        its trim ``x0``, ``lon_state``, ``u_ff``, ``a_act``, the lateral gains
+        and ``monitor`` (``u0``, ``u_ff``, and ``turn``: the lock-turn table
+        and the sub-steps ``ro_sub`` of the airframe's equations).
     ctl : Controller
         The paper's nominal gain ``K`` and the command limits ``lo_dev``, ``hi_dev``.
     eng : EngineTables
@@ -105,8 +115,8 @@ def action_cost(pl, ctl, eng, rc, a, xm, mlr, bhat, btrue, n_steps):
         ``alpha``, ``q_lqr`` (15,) on the 6-DOF states, ``r_lqr`` (3,).
     a : int
         Controller: 0 to 3 (:data:`N_SELECTED`).
-    xm : ndarray, shape (ns,)
-        Start: the monitor's states (deviations from the 6-DOF trim; gust states last).
+    x6 : ndarray, shape (15,)
+        Start: the absolute 6-DOF state.
     mlr : ndarray, shape (2,)
         Start: the lateral loop's model of the left and right elevon commands.
     bhat : ndarray, shape (6,)
@@ -120,16 +130,16 @@ def action_cost(pl, ctl, eng, rc, a, xm, mlr, bhat, btrue, n_steps):
     -------
     float
         ``sum_{k=1..n} alpha^k (x_k' Q x_k + (u_{k-1} - u_ff)' R (u_{k-1} - u_ff))``,
-        ``x_k`` the 6-DOF state; ``inf`` when it is not finite.
+        ``x_k`` the 6-DOF state less the trim; ``inf`` when it is not finite.
     """
     mon = pl.monitor
     tab = mon.turn
-    ns = mon.A.shape[0]
     nu = mon.B.shape[1]
-    x = xm.copy()
-    xn = np.empty(ns)
-    x6 = np.zeros(N_STATE)
-    xs = np.empty(N_STATE)
+    xs = x6.copy()
+    dev = np.empty(N_STATE)
+    cmd = np.empty(N_U)
+    wd = np.zeros(N_WIND)
+    rk = np.empty((N_WORK, N_STATE))
     xa = np.zeros(N_AUG)
     xl = np.empty(N_X + N_LAT)
     du = np.empty(N_U)
@@ -152,46 +162,36 @@ def action_cost(pl, ctl, eng, rc, a, xm, mlr, bhat, btrue, n_steps):
     disc = 1.0
     for _ in range(n_steps):
         for i in range(N_STATE):
-            x6[i] = 0.0
-        for i in range(mon.states.shape[0]):
-            x6[mon.states[i]] = x[i]
+            dev[i] = xs[i] - pl.x0[i]
         if s < 0:
             for i in range(N_X):
-                xa[i] = x6[pl.lon_state[i]]
+                xa[i] = dev[pl.lon_state[i]]
             controller_command(a, xa, ctl.K, eng, mon.u0, up)
             for i in range(N_U):
                 u[i, 0] = saturate(up[i], 0.0, 0.0, ctl.lo_dev[i], ctl.hi_dev[i])
             for i in range(N_X):
                 xl[i] = xa[i]
             for i in range(N_LAT_MEASURED):
-                xl[N_X + i] = x6[LAT_STATE[i]]
+                xl[N_X + i] = dev[LAT_STATE[i]]
             xl[N_X + LAT_LEFT] = m_l
             xl[N_X + LAT_RIGHT] = m_r
             loop_command(pl, ctl.lo_dev, ctl.hi_dev, a, xa[I_B0_THRUST], xa[I_B1_THRUST], xl,
                          du, u, 0)
         else:
-            for i in range(N_STATE):
-                xs[i] = pl.x0[i] + x6[i]
             base_law(tab, pl, s, p, xs, ctl.lo_dev, ctl.hi_dev, u, 0)
         m_l = lag * m_l + (1.0 - lag) * (u[U_LEFT, 0] - pl.u_ff[U_LEFT])
         m_r = lag * m_r + (1.0 - lag) * (u[U_RIGHT, 0] - pl.u_ff[U_RIGHT])
-        for i in range(ns):
-            acc = 0.0
-            for j in range(ns):
-                acc += mon.A[i, j] * x[j]
-            for c in range(nu):
-                e = (u[c, 0] - mon.u_ff[c]) + btrue[c] - (u[c, 0] + mon.u0[c]) * btrue[nu + c]
-                acc += mon.B[i, c] * e
-            xn[i] = acc
-        for i in range(ns):
-            x[i] = xn[i]
+        for c in range(nu):  # eq. 2: the absolute command the actuator follows
+            cmd[c] = btrue[c] + (1.0 - btrue[nu + c]) * (u[c, 0] + mon.u0[c])
+        rollout_step(tab, pl, xs, cmd, wd, rk)  # its envelope check is not used here
         disc *= rc.alpha
         stage = 0.0
         for c in range(nu):
             d = u[c, 0] - mon.u_ff[c]
             stage += rc.r_lqr[c] * d * d
-        for i in range(mon.states.shape[0]):
-            stage += rc.q_lqr[mon.states[i]] * x[i] * x[i]
+        for i in range(N_STATE):
+            d = xs[i] - pl.x0[i]
+            stage += rc.q_lqr[i] * d * d
         cost += disc * stage
     if not math.isfinite(cost):
         return math.inf
@@ -221,14 +221,13 @@ def select_four(pl, scheme, k, st, work):
     rc = scheme.reconfig
     ns = mon.A.shape[0]
     nu = mon.B.shape[1]
-    xm = np.empty(ns)
+    x6 = np.empty(N_STATE)
     mlr = np.empty(2)
     bh = np.empty(2 * nu)
     for l in range(st.mx.shape[1]):
         if not st.alive[l]:
             continue
-        for i in range(ns):
-            xm[i] = st.mx[i, l]
+        on_trim(mon, pl, st.mx[:, l], x6)
         for i in range(2 * nu):
             bh[i] = st.mx[ns + i, l]
         mlr[0] = st.lat[LAT_LEFT, l]
@@ -237,7 +236,7 @@ def select_four(pl, scheme, k, st, work):
         best = cur
         best_obj = math.inf
         for a in range(N_SELECTED):
-            obj = action_cost(pl, scheme.controller, scheme.engine, rc, a, xm, mlr, bh, bh,
+            obj = action_cost(pl, scheme.controller, scheme.engine, rc, a, x6, mlr, bh, bh,
                               rc.horizon)
             for m in range(N_MODES):
                 obj += st.belief[m, l] * (rc.JN[m, a] + rc.penalty[cur, a])
