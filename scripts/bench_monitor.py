@@ -5,7 +5,7 @@ model, nominal, so that no reset or decision fires:
 
 a. the paper's filter, ``ftc_mc.core.longitudinal.batch.filter_step_lanes``
    (14 states, 12 outputs, Table 1), as ``scripts/bench_core.py`` measures it;
-b. the side monitor, ``ftc_mc.core.sixdof.monitor_stage.sixdof_monitor`` (20 states,
+b. the side monitor, ``ftc_mc.core.sixdof.monitor.sixdof_monitor`` (20 states,
    17 outputs: predict, 17 sequential updates carrying three direction
    signatures, projection, three windowed GLR statistics), called from Python
    once per step on all lanes (the call's own cost is included).
@@ -51,9 +51,8 @@ import bench_core  # noqa: E402
 from ftc_mc import api  # noqa: E402
 from ftc_mc.core.longitudinal.trial import new_state  # noqa: E402
 from ftc_mc.core.longitudinal.workspace import new_trial_work  # noqa: E402
-from ftc_mc.core.sixdof.monitor import EXTENDED  # noqa: E402
-from ftc_mc.core.sixdof.monitor_stage import (sixdof_monitor,  # noqa: E402
-                                              sixdof_monitor_extended)
+from ftc_mc.core.sixdof.monitor import (EXTENDED, sixdof_monitor,  # noqa: E402
+                                        sixdof_monitor_extended)
 from ftc_mc.core.sixdof.truth import N_LAT  # noqa: E402
 from ftc_mc.sim.lanes import new_record  # noqa: E402
 from ftc_mc.sim.paths import path_of  # noqa: E402

@@ -749,7 +749,9 @@ def sixdof_select_ref(pl, scheme, kn, st, u, horizon_cost=action_cost_ref):
         obj = [horizon_cost(pl, scheme.controller, scheme.engine, rc, a, x6, mlr, bh, bh,
                             rc.horizon) + b @ (rc.JN[:, a] + rc.penalty[cur, a])
                for a in range(4)]
-        best = int(np.argmin(obj))
+        obj = np.array(obj)
+        obj[~np.isfinite(obj)] = np.inf  # never chosen; none finite: the one in use stays
+        best = int(np.argmin(obj)) if np.isfinite(obj).any() else cur
         out["cur"][l] = best
         if best < 2:
             out["mside"][l] = 0

@@ -20,7 +20,8 @@ from ftc_mc.config import load_config, with_overrides
 from ftc_mc.core.jit import kernel
 from ftc_mc.core.shared.paths import (DENSE_FILTER, EXTENDED_FILTER, GLR_TEST, LINEAR_PLANT,
                                       NOMINAL_CONTROL, NONLINEAR_PLANT, ONE_STEP_TEST,
-                                      PAPER_FILTER, RECONFIGURING, SIXDOF_EXTENDED_PLANT,
+                                      PAPER_FILTER, RECONFIGURING, SELECT_FOUR,
+                                      SIXDOF_EXTENDED_PLANT,
                                       SIXDOF_PLANT, describe, on_path, takes)
 from ftc_mc.core.shared.paths import Path as CPath
 from ftc_mc.sim.paths import path_of
@@ -104,6 +105,11 @@ def test_markers_are_distinct_values_and_types():
                                             RECONFIGURING),
                                   "sixdof_robust": (SIXDOF_EXTENDED_PLANT, EXTENDED_FILTER,
                                                     GLR_TEST, RECONFIGURING)}),
+    # the selection among four 6-DOF controllers is a controller path of its own
+    ("sixdof_survival.yaml", {}, {"sixdof": (SIXDOF_PLANT, PAPER_FILTER, ONE_STEP_TEST,
+                                             RECONFIGURING),
+                                  "sixdof_selected": (SIXDOF_PLANT, PAPER_FILTER, ONE_STEP_TEST,
+                                                      SELECT_FOUR)}),
 ])
 def test_path_of_the_shipped_designs(config, overrides, want):
     cfg = load_config(CONFIGS / config)

@@ -15,8 +15,7 @@ from ftc_mc.core.longitudinal.trial import new_state
 from ftc_mc.core.longitudinal.workspace import new_trial_work
 from ftc_mc.core.sixdof.layout import (MONITOR_DIRECTIONS, MONITOR_GUST_STATES, MONITOR_PARAMS,
                                        MONITOR_STATES)
-from ftc_mc.core.sixdof.monitor import EXTENDED
-from ftc_mc.core.sixdof.monitor_stage import sixdof_monitor, sixdof_monitor_extended
+from ftc_mc.core.sixdof.monitor import EXTENDED, sixdof_monitor, sixdof_monitor_extended
 from ftc_mc.core.sixdof.truth import N_LAT
 from ftc_mc.sim.lanes import new_record
 from ftc_mc.sim.paths import path_of

@@ -102,7 +102,7 @@ def test_action_cost_matches_its_twin(setups, which):
 def lanes(su, rng, L=8):
     """A lane state and work of ``L`` lanes with random monitor estimates
     (covariances positive definite), beliefs, controllers in use and elevon
-    models; two lanes no longer alive."""
+    models; lane 5 no longer alive."""
     mon = su.truth.monitor
     n_m = mon.P0.shape[0]
     st = new_state(L, 14, 1, 15, 7, 4, n_m, mon.window)
@@ -210,3 +210,24 @@ def test_selected_design_flies_on(tmp_path):
     assert (sel["status"] == "ok").all(), sel["status"].value_counts()
     assert (paper["status"] == "ok").mean() < 1.0
     assert (sel["detected"] == 1).all(), sel[["transition", "detected", "detection_s"]]
+
+
+def test_only_a_selecting_design_imports_the_selection(tmp_path):
+    """A run of the ``lock_turn`` design alone (6-DOF plant) never imports the
+    selection's kernels: its compile path does not reach them (issue 23: a
+    run compiles only what it flies)."""
+    import json
+    import subprocess
+    import sys
+
+    cfg = selected_config(signature="none", designs=["six"], trials=2)
+    cfg["designs"] = {"six": {"controller": "lock_turn"}}
+    code = (
+        "import json, sys\n"
+        "from ftc_mc import api\n"
+        f"api.run_campaign(json.loads({json.dumps(json.dumps(cfg))}), jobs=1, progress=False,"
+        f" out={str(tmp_path / 'run')!r})\n"
+        "print('selection' if 'ftc_mc.core.sixdof.selection' in sys.modules else 'none')\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True).stdout
+    assert out.strip().endswith("none"), out

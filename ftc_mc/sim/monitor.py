@@ -168,8 +168,9 @@ def monitor_spec(cfg, fm, det, lock_turn: bool = False) -> MonitorSpec | None:
         The paper's detection (its ``reset_var``: ``[b0_T, b0_elevons, b1_T,
         b1_L, b1_R]``).
     lock_turn : bool
-        A design flies ``controller: lock_turn``: the spec carries the lock-turn
-        table's offsets (``monitor.turn_offsets_deg``, ``turn_step_deg``).
+        A design flies ``controller: lock_turn`` or ``lock_turn_selected``: the
+        spec carries the lock-turn table's offsets (``monitor.turn_offsets_deg``,
+        ``turn_step_deg``).
     """
     from .truth import lateral_noise
 

@@ -9,7 +9,9 @@ keeps the paper's belief and selection, read on the 6-DOF model:
   the nominal mode each ``b1`` in ``[0, beta]`` and each ``b0`` within
   ``+-b0_nominal`` (the elevon's for both elevons); in mode ``m1``, ``m2``,
   ``m3`` the throttle's, the left or the right elevon's ``b1`` in
-  ``[beta, 1]`` and its ``b0`` over its command range; the paper's ``T_M``.
+  ``[beta, 1]`` and its ``b0`` over the paper's box (the throttle's command
+  range, or the elevon one the paper takes for both elevons); the paper's
+  ``T_M``.
   The paper's longitudinal filter carries the two elevons' ``b0`` as one sum;
   the monitor has one per elevon, which roll tells apart.
 * **Weights** (:func:`sixdof_q_lqr`): the paper's ``Q_lqr`` on the 6-DOF

@@ -314,10 +314,13 @@ LaneState = namedtuple("LaneState", [
     "mP",       # (n_m, n_m, L) its covariance
     "mbuf",     # (W_m, 3, L) its GLR window of each direction's projection (ring)
     "mcount",   # (L,) int64 projections in that window
-    "mside",    # (L,) int64 the first elevon it named: 0 none, else its block code (2, 3)
+    "mside",    # (L,) int64 the first elevon it named (a lock_turn_selected design: the
+                #        elevon whose lock-turn law the selection chose): 0 none, else its
+                #        block code (2, 3)
     "mpos",     # (L,) that elevon's estimated absolute position [rad] (core/sixdof/lockturn.py)
     "mturn",    # (L,) int64 the step from which the lock-turn law may fly (the monitor's
-                #        first elevon decision, k + 1), or -1; ``mside`` < 0 once handed back
+                #        first elevon decision, k + 1, or the selection's step), or -1;
+                #        ``mside`` < 0 once handed back
     "mlast",    # (L,) int64 its latest decision: 0 none, else its block code (1-3)
     # the extended filter's Jacobians about the lane's estimate (FilterModel.relin > 0;
     # the trim matrices otherwise, never read)

@@ -23,7 +23,7 @@ calls it and stage 7 by address (``core/linking.py``):
    6-DOF family's :func:`ftc_mc.core.sixdof.truth.sixdof_truth`), then
    :func:`ftc_mc.core.longitudinal.stages.record_cost` -- tracking and command costs,
    then :func:`side_monitor` -- on the 6-DOF plant its side monitor
-   (:func:`ftc_mc.core.sixdof.monitor_stage.sixdof_monitor`), which records, and which a
+   (:func:`ftc_mc.core.sixdof.monitor.sixdof_monitor`), which records, and which a
    ``lock_turn`` design's truth stage and its choice of the block to reset
    read (``core/sixdof/lockturn.py``);
 3. :func:`ftc_mc.core.longitudinal.stages.filter_update` -- the filter with ``u_k``, ``z_{k+1}``;
@@ -32,7 +32,9 @@ calls it and stage 7 by address (``core/linking.py``):
    and the design's excitation policy;
 6. :func:`ftc_mc.core.longitudinal.stages.record_step` -- history;
 7. :func:`ftc_mc.core.longitudinal.stages.reconfigure` -- belief and controller, every
-   ``reconf_every`` steps.
+   ``reconf_every`` steps (on the path of a ``lock_turn_selected`` design,
+   after :func:`six_dof_selection`: its belief and its choice among the
+   four 6-DOF controllers).
 """
 
 from __future__ import annotations
@@ -46,7 +48,7 @@ from ..shared.dryden import N_GUST_STATE
 from .gustfilter import N_WIND
 from ..jit import kernel
 from .plant import truth
-from ..shared.paths import SIXDOF_EXTENDED_PLANT, SIXDOF_PLANT, on_path
+from ..shared.paths import SELECT_FOUR, SIXDOF_EXTENDED_PLANT, SIXDOF_PLANT, on_path
 from .settings import LaneState
 from .stages import (check_validity, commands, filter_update, handle_resets,  # noqa: F401
                      is_psd, reconfigure, record_cost, record_end, record_step)
@@ -63,13 +65,22 @@ N_DIRECTIONS = N_U
 (``core/sixdof/layout.MONITOR_DIRECTIONS``)."""
 
 
-@on_path("plant", {SIXDOF_PLANT: "ftc_mc.core.sixdof.monitor_stage:sixdof_monitor",
-                   SIXDOF_EXTENDED_PLANT: "ftc_mc.core.sixdof.monitor_stage:sixdof_monitor_extended"},
+@on_path("plant", {SIXDOF_PLANT: "ftc_mc.core.sixdof.monitor:sixdof_monitor",
+                   SIXDOF_EXTENDED_PLANT: "ftc_mc.core.sixdof.monitor:sixdof_monitor_extended"},
          passes="marker")
 def side_monitor(path, scheme, flight, k, st, work, rec):
     """Stage 2b: the 6-DOF side monitor over step ``k -> k+1``
-    (:func:`ftc_mc.core.sixdof.monitor_stage.sixdof_monitor`, imported only by a
+    (:func:`ftc_mc.core.sixdof.monitor.sixdof_monitor`, imported only by a
     path that flies the 6-DOF plant); nothing on the longitudinal plants."""
+
+
+@on_path("control", {SELECT_FOUR: "ftc_mc.core.sixdof.selection:sixdof_select"})
+def six_dof_selection(path, plant, scheme, kn, st, work):
+    """At a reconfiguration period's end, before :func:`reconfigure`: on the
+    path of a ``lock_turn_selected`` design (6-DOF plant), its belief and its
+    selection among the four 6-DOF controllers
+    (:func:`ftc_mc.core.sixdof.selection.sixdof_select`, imported only by
+    that path); nothing on the others."""
 
 
 @kernel
@@ -118,6 +129,7 @@ def advance(path, scheme, flight, inp, rec, st, k0, k1):
         trial_steps(path, scheme, flight, inp, k, k_end, st, work, rec)
         k = k_end
         if k % every == 0:
+            six_dof_selection(path, flight.plant, scheme, k, st, work)
             reconfigure(path, scheme, flight.timing, inp, st, k, period, work, rec)
             period += 1
     record_end(st, rec)

@@ -141,18 +141,12 @@ import numpy as np
 from ...conventions import LONGITUDINAL, NO_RESET
 from ..jit import kernel
 from ..shared.excitation import signal_3211, signal_3211_length
+from .kinds import LOCK_TURN, SELECTED_TURN  # noqa: F401 -- the kinds, by their module
 from .layout import (N_COMMAND, N_STATE, N_WIND, SIXDOF_LINEAR, X_PHI, X_U, X_V, X_W,
                      Y_ALPHA, Y_VA)
 from .monitor import on_trim
 from .plant import N_WORK, linear_output, linear_step, propagate
 
-LOCK_TURN = 2
-"""``Reconfig.kind`` of a ``controller: lock_turn`` design (after 0 nominal and
-1 reconfiguring, which it runs until the monitor names an elevon)."""
-SELECTED_TURN = 3
-"""``Reconfig.kind`` of a ``controller: lock_turn_selected`` design: the
-selection of eqs. 45-47 chooses among c0, c1 and the lock-turn controllers of
-either side (:mod:`ftc_mc.core.sixdof.selection`)."""
 
 DECISION_BLOCK = (NO_RESET,) + LONGITUDINAL.actuator_block
 """The longitudinal filter's block of each monitor decision code (0: none, then
@@ -525,9 +519,10 @@ def law_term(tab, s, i, j1, w, c, r, xr):
 
 @kernel(internal=True)
 def side_blocks(plant, scheme, st, block):
-    """Table 1's decisions of a ``lock_turn`` design, each moved to the block of
-    the actuator the design acts on (module docstring, "Which block the
-    paper's filter resets"); other designs' are left alone.
+    """Table 1's decisions of a ``lock_turn`` or ``lock_turn_selected``
+    design, each moved to the block of the actuator the design acts on
+    (module docstring, "Which block the paper's filter resets"); other
+    designs' are left alone.
 
     Parameters
     ----------

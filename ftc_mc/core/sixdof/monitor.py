@@ -10,6 +10,9 @@ decisions and estimates, so that a campaign measures how well roll tells left
 from right, and how soon; it keeps the first elevon it names and that
 elevon's position estimate (``LaneState.mside``, ``mpos``), on which a
 ``controller: lock_turn`` design flies on (:mod:`ftc_mc.core.sixdof.lockturn`).
+In a ``controller: lock_turn_selected`` design it names none there: the
+selection chooses the side (:mod:`ftc_mc.core.sixdof.selection`), and reads
+the belief from the monitor's estimate.
 
 **Filter** (the paper's eqs. 4-11 on the 6-DOF model, per actuator).  The
 estimate is ``X = [x (14), b0 (3), b1 (3)]``: the 6-DOF states but the
@@ -93,6 +96,7 @@ import numpy as np
 
 from ..jit import kernel
 from ..shared.glr import glr_lanes, glr_restart
+from .kinds import SELECTED_TURN
 from .layout import N_OUTPUT, N_STATE, N_WIND
 from .plant import N_WORK, outputs, propagate
 
@@ -673,3 +677,56 @@ def monitor_decide(mon, flight, k, st, work, rec, num, den, names):
                 rec.mon_b[i, l] = x[ns + i, l]
             for a in range(nu):
                 rec.mon_b[2 * nu + a, l] = position(mon, x, ns, nu, a, l, work.u)
+
+
+@kernel(internal=True)
+def sixdof_monitor(plant, scheme, flight, k, st, work, rec):
+    """Advance the side monitor of every lane over step ``k -> k+1``.
+
+    Parameters
+    ----------
+    plant : SixdofPlant
+        The path's plant marker (the dispatcher's calling convention).
+    scheme : Scheme
+        ``reconfig.kind`` (a ``lock_turn`` or ``lock_turn_selected`` design);
+        for the selection, ``belief``, ``reconfig``, ``controller``, ``engine``.
+    flight : Flight
+        ``plant.monitor`` (:class:`SideMonitor`), ``timing.k_fault``.
+    k : int
+        Step.
+    st : LaneState
+        ``mx`` (n, L), ``mP`` (n, n, L) (set at step 0: zero and ``P0``),
+        the GLR window ``mbuf`` and ``mcount``, the first elevon named
+        ``mside`` and its position estimate ``mpos``, the latest decision
+        ``mlast``, updated in place; ``lat``
+        the lateral loop's measurements of ``k + 1``.
+    work : TrialWork
+        ``u`` the commands sent over the step, ``z`` the 12 longitudinal
+        measurements of ``k + 1``.
+    rec : TrialRecord
+        ``side_k``, ``side_block``, ``side_pre``, ``side_n`` (on live lanes), ``mon_b``
+        (module docstring).
+    """
+    mon = flight.plant.monitor
+    if mon.on == 0:
+        return
+    if mon.nonlinear == EXTENDED:
+        raise ValueError("an extended side monitor flies sixdof_monitor_extended")
+    num, den = monitor_start(mon, k, st)
+    trim_filter(mon, flight.plant, st.mx, st.mP, work.u, work.z, st.lat, num, den)
+    monitor_decide(mon, flight, k, st, work, rec, num, den,
+                   scheme.reconfig.kind != SELECTED_TURN)
+
+
+@kernel(internal=True)
+def sixdof_monitor_extended(plant, scheme, flight, k, st, work, rec):
+    """:func:`sixdof_monitor` with the extended filter (:func:`extended_filter`),
+    on the ``SIXDOF_EXTENDED_PLANT`` path (``core/shared/paths.py``): the
+    other 6-DOF path never compiles it."""
+    mon = flight.plant.monitor
+    if mon.on == 0:
+        return
+    num, den = monitor_start(mon, k, st)
+    extended_filter(mon, flight.plant, st.mx, st.mP, work.u, work.z, st.lat, num, den)
+    monitor_decide(mon, flight, k, st, work, rec, num, den,
+                   scheme.reconfig.kind != SELECTED_TURN)

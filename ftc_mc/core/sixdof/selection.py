@@ -16,10 +16,11 @@ rolling-horizon choice among controllers, now four:
 side monitor's estimate of the six fault parameters (``b0`` and ``b1`` of the
 throttle, the left and the right elevon), which roll makes separable: the
 paper's mode boxes, per actuator (``ftc_mc/sim/selection.py``), and its
-``T_M``, updated at the end of each reconfiguration period by the monitor's
-stage (:func:`sixdof_select`; :mod:`ftc_mc.core.sixdof.monitor_stage`), where
-the paper's is updated by :func:`ftc_mc.core.longitudinal.stages.reconfigure`
-(which then only records it).
+``T_M``, updated at the end of each reconfiguration period by
+:func:`sixdof_select`, which ``advance`` calls on this design's compile path
+only (:func:`ftc_mc.core.longitudinal.trial.six_dof_selection`), before
+:func:`ftc_mc.core.longitudinal.stages.reconfigure` (which then only
+records it; the paper's 3-controller selection is not compiled there).
 
 **Objective** (eq. 47), per lane and action ``a``::
 
@@ -58,11 +59,13 @@ elevon; the paper's controllers without their excitation, saturated as the
 commands stage saturates them.  The lateral loop's elevon model advances as
 in the truth stage.  The stage cost (eq. 45) weighs the 6-DOF states by
 ``Reconfig.q_lqr`` (15: the paper's ``Q_lqr`` on the states of the same
-names, and ``controller.selection_bank_weight`` on the bank) and the
-commands less the 6-DOF trim's by ``r_lqr``.
+names, along-track and height; zero on the others) and the commands less the
+6-DOF trim's by ``r_lqr``.  A probe (``monitor.turn_probe_rad``) rides on the
+named elevon as in a ``lock_turn`` design, but no lane hands back on it: the
+selection itself may switch back.
 
-Plain-NumPy twin: ``tests/naive_sixdof.py::action_cost_ref``,
-``select_four_ref``.
+Plain-NumPy twins: ``tests/naive_sixdof.py::action_cost_ref``,
+``sixdof_select_ref``.
 """
 
 from __future__ import annotations
@@ -97,8 +100,8 @@ LAT_STATE = np.array([STATE[n] for n in LATERAL_LOOP[:N_LAT_MEASURED]], dtype=np
 
 @kernel(internal=True)
 def action_cost(pl, ctl, eng, rc, a, x6, mlr, bhat, btrue, n_steps):
-    """Discounted cost (eq. 45) of controller ``a`` flown ``n_steps`` periods on
-    the plant's model (module docstring).
+    """Discounted cost (eq. 45) of controller ``a`` flown ``n_steps`` control
+    periods (steps) on the plant's model (module docstring).
 
     Parameters
     ----------

@@ -17,7 +17,9 @@ One step ``k -> k+1`` on every lane, with the longitudinal commands ``u_k``
    monitor has named an elevon flies the lock-turn law of
    :mod:`ftc_mc.core.sixdof.lockturn` instead: ``u`` is replaced, no
    ``da``, and the named elevon's command carries the law's probe; a lane
-   the probe hands back flies this loop again from that step.)
+   the probe hands back flies this loop again from that step.  A
+   ``controller: lock_turn_selected`` design's lane flies the law of the
+   side its selection chose, and none hands back on the probe.)
    ``da = -K_lat lat_k``, ``lat_k`` the loop's measured state
    (``LaneState.lat``: bank, side velocity, roll and yaw rates and heading
    measured at ``k``, and its model of the commanded elevon positions).  The
