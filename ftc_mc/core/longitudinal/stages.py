@@ -47,7 +47,7 @@ from .batch import filter_correct_lanes, filter_predict_lanes, innovations_lanes
 from .signature import signature_lanes
 from ..shared.glr import glr_lanes, glr_restart
 from .gustfilter import gust_correct_lanes, gust_predict_lanes
-from ..shared.belief import belief_update
+from ..shared.belief import belief_update_lane
 from .control import (U_LEFT, U_RIGHT, U_THRUST, controller_command, feedback_lanes,
                       select_controllers_lanes)
 from ..shared.excitation import (doublet, doublet_length, running, saturate, signal_3211,
@@ -717,22 +717,13 @@ def reconfigure(path, scheme, timing, inp, st, kn, period, work, rec):
     bl = work.bl
     bh = work.bhat
     bv = work.bvar
-    updated = scheme.belief.lo.shape[1] != N_FAULT  # by the 6-DOF selection's stage
+    # boxes on other parameters than the paper's five: the 6-DOF selection's
+    # belief, updated before this stage (trial.six_dof_selection)
+    update = scheme.belief.lo.shape[1] == N_FAULT
     for l in range(L):
+        best = belief_update_lane(st.belief, l, scheme.belief, xa, P, N_X, update, bl, bh, bv,
+                                  work.bwork)
         for m in range(N_MODES):
-            bl[m] = st.belief[m, l]
-        for j in range(N_FAULT):
-            bh[j] = xa[N_X + j, l]
-            bv[j] = P[N_X + j, N_X + j, l]
-        if updated:
-            best = 0
-            for m in range(N_MODES):
-                if bl[m] > bl[best]:
-                    best = m
-        else:
-            best = belief_update(bl, scheme.belief, bh, bv, work.bwork)
-        for m in range(N_MODES):
-            st.belief[m, l] = bl[m]
             rec.belief[period, m, l] = bl[m]
         for j in range(N_FAULT):
             rec.bhat[period, j, l] = bh[j]

@@ -117,9 +117,38 @@ def belief_update(belief, bs, bhat, var, work):
         e = math.exp(work[nm + i] - top)
         work[nm + i] = e
         total += e
-    best = 0
     for i in range(nm):
         belief[i] = work[nm + i] / total
+    return most_probable(belief)
+
+
+@kernel(inline="always")
+def most_probable(belief):
+    """Index of the most probable mode of ``belief`` (the first on a tie)."""
+    best = 0
+    for i in range(belief.shape[0]):
         if belief[i] > belief[best]:
             best = i
+    return best
+
+
+@kernel(inline="always")
+def belief_update_lane(beliefs, l, bs, x, P, first, update, bl, bhat, var, work):
+    """Lane ``l``'s belief (column ``l`` of ``beliefs``, (4, L)) updated in
+    place by :func:`belief_update` from the fault-parameter estimate on rows
+    ``first`` to ``first + n`` of ``x`` (n, L) (``n = bhat.shape[0]``) and
+    their marginal variances, the diagonal of ``P`` (n, n, L); with
+    ``update`` False left as it is.  ``bl``, ``bhat``, ``var`` hold the
+    belief, the estimate and the variances after; ``work`` as
+    :func:`belief_update`'s.  Returns the most probable mode."""
+    for m in range(bl.shape[0]):
+        bl[m] = beliefs[m, l]
+    for j in range(bhat.shape[0]):
+        bhat[j] = x[first + j, l]
+        var[j] = P[first + j, first + j, l]
+    if not update:
+        return most_probable(bl)
+    best = belief_update(bl, bs, bhat, var, work)
+    for m in range(bl.shape[0]):
+        beliefs[m, l] = bl[m]
     return best

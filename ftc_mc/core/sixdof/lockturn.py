@@ -224,12 +224,12 @@ def lock_turn_law(tab, pl, s, p, mx, z, lat, l, lo_dev, hi_dev, u):
                                              u):
             for c in range(2):  # hold the trim commands
                 a = tab.cmd[s, c]
-                u[a, l] = min(hi_dev[a], max(lo_dev[a], tab.hold[a]))
+                u[a, l] = held(tab, a, lo_dev, hi_dev)
     elif tab.gd_on == 0 or not guarded_law(tab, pl, s, i, j1, w, p, mx, z, lat, l, lo_dev,
                                            hi_dev, u):
         turn_law(tab, s, i, j1, w, mx, z, lat, l, lo_dev, hi_dev, u)
     a = tab.locked[s]
-    u[a, l] = min(hi_dev[a], max(lo_dev[a], tab.hold[a]))
+    u[a, l] = held(tab, a, lo_dev, hi_dev)
 
 
 @kernel(inline="always")
@@ -260,9 +260,16 @@ def base_law(tab, pl, s, p, xs, lo_dev, hi_dev, u, l):
         if steady:
             u[a, l] = turn_deviation(tab, pl, s, i, j1, w, xs, lo_dev, hi_dev, c)
         else:
-            u[a, l] = min(hi_dev[a], max(lo_dev[a], tab.hold[a]))
+            u[a, l] = held(tab, a, lo_dev, hi_dev)
     a = tab.locked[s]
-    u[a, l] = min(hi_dev[a], max(lo_dev[a], tab.hold[a]))
+    u[a, l] = held(tab, a, lo_dev, hi_dev)
+
+
+@kernel(inline="always")
+def held(tab, a, lo_dev, hi_dev):
+    """Command ``a``'s 6-DOF trim command less ``u0`` (``tab.hold``), clipped
+    to the limits: what the law holds where it holds the trim."""
+    return min(hi_dev[a], max(lo_dev[a], tab.hold[a]))
 
 
 @kernel(internal=True)

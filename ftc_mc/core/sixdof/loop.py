@@ -34,6 +34,14 @@ ELEVON_SIGN[U_RIGHT] = -1.0
 
 
 @kernel(inline="always")
+def elevon_model(lag, m, u, u_ff):
+    """The lateral loop's model of one commanded elevon after a step:
+    ``a m + (1 - a) (u - u_ff)``, ``a = exp(-dt / tau_elevon)`` (``lag``),
+    ``u`` the command sent less ``u0``."""
+    return lag * m + (1.0 - lag) * (u - u_ff)
+
+
+@kernel(inline="always")
 def loop_command(pl, lo_dev, hi_dev, cur, b0_t, b1_t, xl, du, u, l):
     """Column ``l`` of ``u``, the paper's command (less the longitudinal trim
     ``u0``, saturated), made the command the paper's loop sends on the 6-DOF

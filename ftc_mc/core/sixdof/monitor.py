@@ -144,7 +144,14 @@ units: m, rad, m/s, rad/s; commands; wind in m/s and rad/s)."""
 def position(mon, x, ns, nu, a, l, u):
     """Lane ``l``'s estimated absolute position of actuator ``a``,
     ``b0 + (1 - b1)(u + u0)``: what eq. (2) makes of the command sent."""
-    return x[ns + a, l] + (1.0 - x[ns + nu + a, l]) * (u[a, l] + mon.u0[a])
+    return follows(x[ns + a, l], x[ns + nu + a, l], u[a, l] + mon.u0[a])
+
+
+@kernel(inline="always")
+def follows(b0, b1, command):
+    """The absolute position an actuator with the faults ``b0``, ``b1`` takes
+    under the absolute ``command``: ``b0 + (1 - b1) command`` (eq. 2)."""
+    return b0 + (1.0 - b1) * command
 
 
 @kernel(inline="always")

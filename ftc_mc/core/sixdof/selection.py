@@ -78,12 +78,13 @@ from ...conventions import (C_ENGINE, I_B0_ELEVONS, I_B0_THRUST, I_B1_LEFT, I_B1
                             I_B1_THRUST, N_AUG, N_MODES, N_U, N_X)
 from ..jit import kernel
 from ..longitudinal.control import controller_command
-from ..shared.belief import belief_update
+from ..shared.belief import belief_update_lane
 from ..shared.excitation import saturate
 from .layout import N_STATE, N_WIND, STATE, U_LEFT, U_RIGHT
 from .lockturn import base_law, rollout_step
-from .loop import LAT_LEFT, LAT_RIGHT, LATERAL_LOOP, N_LAT, N_LAT_MEASURED, loop_command
-from .monitor import on_trim, position
+from .loop import (LAT_LEFT, LAT_RIGHT, LATERAL_LOOP, N_LAT, N_LAT_MEASURED, elevon_model,
+                   loop_command)
+from .monitor import follows, on_trim, position
 from .plant import N_WORK
 
 N_SELECTED = 4
@@ -160,12 +161,12 @@ def action_cost(pl, ctl, eng, rc, a, x6, mlr, bhat, btrue, n_steps):
     p = 0.0
     if s >= 0:  # the lock position the estimate gives under the law's command
         j = tab.locked[s]
-        p = bhat[j] + (1.0 - bhat[nu + j]) * (tab.hold[j] + mon.u0[j])
+        p = follows(bhat[j], bhat[nu + j], tab.hold[j] + mon.u0[j])
+    for i in range(N_STATE):
+        dev[i] = xs[i] - pl.x0[i]
     cost = 0.0
     disc = 1.0
     for _ in range(n_steps):
-        for i in range(N_STATE):
-            dev[i] = xs[i] - pl.x0[i]
         if s < 0:
             for i in range(N_X):
                 xa[i] = dev[pl.lon_state[i]]
@@ -182,10 +183,10 @@ def action_cost(pl, ctl, eng, rc, a, x6, mlr, bhat, btrue, n_steps):
                          du, u, 0)
         else:
             base_law(tab, pl, s, p, xs, ctl.lo_dev, ctl.hi_dev, u, 0)
-        m_l = lag * m_l + (1.0 - lag) * (u[U_LEFT, 0] - pl.u_ff[U_LEFT])
-        m_r = lag * m_r + (1.0 - lag) * (u[U_RIGHT, 0] - pl.u_ff[U_RIGHT])
-        for c in range(nu):  # eq. 2: the absolute command the actuator follows
-            cmd[c] = btrue[c] + (1.0 - btrue[nu + c]) * (u[c, 0] + mon.u0[c])
+        m_l = elevon_model(lag, m_l, u[U_LEFT, 0], pl.u_ff[U_LEFT])
+        m_r = elevon_model(lag, m_r, u[U_RIGHT, 0], pl.u_ff[U_RIGHT])
+        for c in range(nu):  # eq. 2: the absolute position the actuator takes
+            cmd[c] = follows(btrue[c], btrue[nu + c], u[c, 0] + mon.u0[c])
         rollout_step(tab, pl, xs, cmd, wd, rk)  # its envelope check is not used here
         disc *= rc.alpha
         stage = 0.0
@@ -193,8 +194,8 @@ def action_cost(pl, ctl, eng, rc, a, x6, mlr, bhat, btrue, n_steps):
             d = u[c, 0] - mon.u_ff[c]
             stage += rc.r_lqr[c] * d * d
         for i in range(N_STATE):
-            d = xs[i] - pl.x0[i]
-            stage += rc.q_lqr[i] * d * d
+            dev[i] = xs[i] - pl.x0[i]
+            stage += rc.q_lqr[i] * dev[i] * dev[i]
         cost += disc * stage
     if not math.isfinite(cost):
         return math.inf
@@ -272,12 +273,5 @@ def sixdof_select(pl, scheme, kn, st, work):
     bh = np.empty(npar)
     bv = np.empty(npar)
     for l in range(st.mx.shape[1]):
-        for m in range(N_MODES):
-            bl[m] = st.belief[m, l]
-        for i in range(npar):
-            bh[i] = st.mx[ns + i, l]
-            bv[i] = st.mP[ns + i, ns + i, l]
-        belief_update(bl, scheme.belief, bh, bv, bw)
-        for m in range(N_MODES):
-            st.belief[m, l] = bl[m]
+        belief_update_lane(st.belief, l, scheme.belief, st.mx, st.mP, ns, True, bl, bh, bv, bw)
     select_four(pl, scheme, kn, st, work)

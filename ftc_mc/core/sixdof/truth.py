@@ -82,7 +82,7 @@ from .layout import (N_OUTPUT, N_STATE, N_WIND, OUTPUT, SIXDOF_LINEAR, SIXDOF_NO
                      Y_ALPHA, Y_VA, sixdof_name)
 from .lockturn import LOCK_TURN, hands_back, lock_turn_law, turn_probe
 from .loop import (LAT_LEFT, LAT_RIGHT, LATERAL_LOOP, N_LAT, N_LAT_MEASURED,  # noqa: F401
-                   loop_command)
+                   elevon_model, loop_command)
 from .plant import N_WORK, linear_output, linear_step, outputs, propagate
 
 N_LAT_GUST_STATE = 4
@@ -236,10 +236,10 @@ def sixdof_truth(plant, scheme, flight, inp, k, st, work, rec):
                 xl[N_X + j] = st.lat[j, l]
             loop_command(pl, ctl.lo_dev, ctl.hi_dev, st.cur[l], st.xa[I_B0_THRUST, l],
                          st.xa[I_B1_THRUST, l], xl, du, u, l)
-        st.lat[LAT_LEFT, l] = (lag * st.lat[LAT_LEFT, l]
-                               + (1.0 - lag) * (u[U_LEFT, l] - pl.u_ff[U_LEFT]))
-        st.lat[LAT_RIGHT, l] = (lag * st.lat[LAT_RIGHT, l]
-                                + (1.0 - lag) * (u[U_RIGHT, l] - pl.u_ff[U_RIGHT]))
+        st.lat[LAT_LEFT, l] = elevon_model(lag, st.lat[LAT_LEFT, l], u[U_LEFT, l],
+                                           pl.u_ff[U_LEFT])
+        st.lat[LAT_RIGHT, l] = elevon_model(lag, st.lat[LAT_RIGHT, l], u[U_RIGHT, l],
+                                            pl.u_ff[U_RIGHT])
     ev = schedule_entry(inp.k_switch, k)
     actuator_effect(u0, inp.b0[ev], inp.b1[ev], u, work.e)
     wlat = np.zeros((3, L))
