@@ -1,6 +1,6 @@
 """The fixed small campaigns and scenarios pinned by ``tests/test_golden.py``.
 
-``python scripts/make_golden.py`` writes what they produce today to
+``python scripts/maintenance/make_golden.py`` writes what they produce today to
 ``tests/golden/``; the test reruns them and asks for the same data bit for bit.
 A refactor or speed-up must leave these files alone.  A change of behaviour
 regenerates them in its own commit, and its issue note says what moved and why.

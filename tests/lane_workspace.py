@@ -1,6 +1,6 @@
 """Work arrays of the lane-interleaved filter kernels (:mod:`ftc_mc.core.longitudinal.batch`).
 
-The benchmark (``scripts/bench_core.py``) and the tests of the lane filter
+The benchmark (``scripts/benchmarks/bench_core.py``) and the tests of the lane filter
 use them; the trial loop has its own (``core/longitudinal/workspace.py``).
 
 Alignment matters: the kernels load and store 64-byte vectors along the lane

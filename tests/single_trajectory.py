@@ -6,7 +6,7 @@ kernels on one trajectory, in the same operations and order, so they live
 with the tests that compare them (``tests/test_batch.py``,
 ``tests/test_stages.py``), the oracles (``tests/test_filter_oracles.py``,
 ``tests/test_core_vs_naive.py``, ``tests/test_soak.py``) and
-``scripts/bench_core.py``.  They are Numba kernels like the package's, and
+``scripts/benchmarks/bench_core.py``.  They are Numba kernels like the package's, and
 structure-exploiting; the plain-NumPy twins are in ``tests/naive.py``.
 
 The augmented filter (paper eqs. 5-11): Augmented state ``X = [x (9), b0 (2), b1 (3)]`` (indices in

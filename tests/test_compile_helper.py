@@ -287,7 +287,7 @@ def test_the_shipped_plan_matches_the_default_path(trial_kernel):
     first variant) is a signature that path's ``advance`` calls: typing
     ``advance`` for the path (loaded from the cache, so typed again here)
     loads or compiles exactly those.  A stale plan fails here
-    (``scripts/make_compile_plan.py`` writes it again)."""
+    (``scripts/maintenance/make_compile_plan.py`` writes it again)."""
     from ftc_mc.campaign.chunk import chunk_spec
     from ftc_mc.config import load_config
     from ftc_mc.core.longitudinal.trial import advance

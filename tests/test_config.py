@@ -18,7 +18,7 @@ def test_shipped_configs_are_current():
     for fname, text in campaign_configs().items():
         path = ROOT / "configs" / fname
         assert path.read_text(encoding="utf-8") == text, (
-            f"configs/{fname} is stale: run python scripts/make_configs.py")
+            f"configs/{fname} is stale: run python scripts/maintenance/make_configs.py")
         if fname == "paper_scenario.yaml":
             assert load_scenario(path).scenario.duration_s == 100.0
         else:

@@ -1,6 +1,6 @@
 """Golden results: a fixed small campaign and the scenario, identical to the bit.
 
-The files in ``tests/golden/`` were written by ``scripts/make_golden.py`` (see
+The files in ``tests/golden/`` were written by ``scripts/maintenance/make_golden.py`` (see
 ``tests/golden_cases.py`` for what runs).  A refactor or speed-up keeps every
 value, dtype and column order; only a deliberate change of behaviour regenerates
 them, in its own commit.

@@ -268,7 +268,7 @@ def test_direction_projections_are_standard_normal_without_fault(setup, request)
     mon = setup.truth.monitor._replace(threshold=np.inf, startup=0)
     n_steps, transient = 150, 20
     if mon.nonlinear and mon.A.shape[0] > len(MONITOR_STATES):
-        # Known limits (docs/airframes.md, scripts/study_monitor_consistency.py):
+        # Known limits (docs/airframes.md, scripts/studies/study_monitor_consistency.py):
         # at the excursions of moderate gusts (bank RMS about 10 deg) the trim
         # Jacobians misstate the covariance (mean square here about 8 over the
         # three directions, 16 on the throttle's); the extended filter's, taken

@@ -163,7 +163,7 @@ def auto_jobs(cfg: Config, n_variants: int, backend: str = "threads") -> int:
 
     A trial step of the reconfiguring loop costs about six of the nominal one
     (the controller selection predicts three controllers over the horizon); one
-    on the nonlinear plant about four (``scripts/bench_truth.py``).
+    on the nonlinear plant about four (``scripts/benchmarks/bench_truth.py``).
     """
     c = cfg.campaign
     weight = 6 if any(cfg.controller_of(d) == "reconfiguring" for d in c.runs()) else 1

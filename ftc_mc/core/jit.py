@@ -22,7 +22,7 @@ sources and on those folders' files (:class:`CloneFolderLocator`), so a new
 clone loads the test kernels too.  ``NUMBA_CACHE_DIR`` in the environment takes
 precedence over ``$FTC_MC_CACHE_DIR/numba`` (``$NUMBA_CACHE_DIR/<digest>``; the
 benchmarks point it at an empty folder), and ``FTC_MC_NUMBA_CACHE=0`` turns caching off.  ``fastmath`` stays
-off: it was no faster here (``scripts/bench_core.py``) and breaks bit-for-bit
+off: it was no faster here (``scripts/benchmarks/bench_core.py``) and breaks bit-for-bit
 agreement with the NumPy references.
 """
 
@@ -182,14 +182,16 @@ def source_digest(core: Path | None = None) -> str:
 
 
 def clone_sources(root: Path) -> list[Path]:
-    """The ``.py`` files directly inside a source tree's ``root`` and inside
-    each of its folders whose name does not start with a dot (``tests/``,
-    ``scripts/``), not read recursively; the package (``ftc_mc/``) is left
-    out, its kernels being :func:`kernel_sources`.  Sorted by path."""
+    """The ``.py`` files directly inside a source tree's ``root`` and at any
+    depth inside each of its folders whose name does not start with a dot
+    (``tests/``, ``scripts/benchmarks/``), but for folders whose name starts
+    with a dot; the package (``ftc_mc/``) is left out, its kernels being
+    :func:`kernel_sources`.  Sorted by path."""
     files = list(root.glob("*.py"))
     for folder in root.iterdir():
         if folder.is_dir() and not folder.name.startswith(".") and folder != CORE.parent:
-            files += folder.glob("*.py")
+            files += (f for f in folder.rglob("*.py")
+                      if not any(part.startswith(".") for part in f.relative_to(root).parts))
     return sorted(files, key=lambda p: p.relative_to(root).as_posix())
 
 
@@ -291,8 +293,8 @@ class PythonTwinLocator(ContentCacheLocator):
 
 class CloneFolderLocator(ContentCacheLocator):
     """Numba cache locator for the kernels of a source tree's own folders:
-    functions defined in a file of ``tests/`` or ``scripts/`` beside
-    ``ftc_mc/`` in a tree with ``pyproject.toml`` (a clone, not an install).
+    functions defined in a file of ``tests/`` or ``scripts/`` (at any depth)
+    beside ``ftc_mc/`` in a tree with ``pyproject.toml`` (a clone, not an install).
 
     Numba's own locator keys such a kernel on its file's absolute path and its
     file's stamp alone: a new clone compiles every test kernel again (15 s of
@@ -310,7 +312,7 @@ class CloneFolderLocator(ContentCacheLocator):
         self._clone = clone_digest(self._root)
         self._stamp = full_source_digest(core) + self._clone
         self._cache_path = str(cache_root() / self._stamp[:16] / "clone" / self._clone[:16]
-                               / py_file.parent.name)
+                               / py_file.parent.relative_to(self._root))
 
     def sources_unchanged(self) -> bool:
         """Whether the kernel sources and the tree's own files still have the
@@ -321,8 +323,11 @@ class CloneFolderLocator(ContentCacheLocator):
     def from_function(cls, py_func, py_file):
         path = _resolved(py_file)
         root = CORE.parent.parent
-        if (path is None or path.parent.parent != root or path.parent == CORE.parent
-                or path.parent.name.startswith(".") or not (root / "pyproject.toml").is_file()):
+        if path is None or not path.is_relative_to(root) or path.parent == root:
+            return None
+        parts = path.relative_to(root).parts
+        if (parts[0] == CORE.parent.name or any(p.startswith(".") for p in parts[:-1])
+                or not (root / "pyproject.toml").is_file()):
             return None
         return cls._writable(py_func, path)
 

@@ -163,7 +163,7 @@ def envelope_box(airspeed, alpha_deg, bank_deg, margin: float = 0.5,
     Where the design box (:class:`DesignBox`) holds no steady flight of a lock,
     the envelope may still hold one: on ``x8-pyfly`` the steady turns closest
     to the nominal glide of locks from about -29 to -10 deg of trim lie at
-    12.5-16.5 m/s and 58-60 deg of bank (``scripts/study_recoverable.py``,
+    12.5-16.5 m/s and 58-60 deg of bank (``scripts/studies/study_recoverable.py``,
     docs/airframes.md); with 10 deg of room below the bank bound, those of
     -15 to -11 deg at 12.5-14.7 m/s and 50 deg.  The air-path
     angle may then lie from -45 to +30 deg; the throttle, elevon and

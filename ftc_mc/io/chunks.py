@@ -15,7 +15,7 @@ result data.
 
 Resuming looks at the folder once (:meth:`ChunkStore.finished`: one directory
 listing, whatever the number of chunks), so a run of 15 000 chunks resumes in
-time proportional to the chunks still to run (``scripts/bench_resume.py``).
+time proportional to the chunks still to run (``scripts/benchmarks/bench_resume.py``).
 """
 
 from __future__ import annotations

@@ -201,7 +201,7 @@ def bisect_band(steady, start: float, limits, tol: float):
     (float, float) or None
         The lowest and highest locks found to hold; None when ``start`` does
         not.  Bisection assumes one interval: a lock beyond a failing one is
-        not tried (``scripts/study_trimmable.py`` checks a grid).
+        not tried (``scripts/studies/study_trimmable.py`` checks a grid).
     """
     if not tol > 0.0:
         raise ValueError(f"bisect_band: tol must be > 0, got {tol!r}")

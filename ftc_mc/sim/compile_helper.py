@@ -16,7 +16,7 @@ stays in this process (measured: ``docs/performance.md``, lessons 11, 14 and
 17).
 
 The helper must know each stage's Numba signature before ``advance`` is typed.
-The *compile plan* (:data:`PLAN_FILE`, written by ``scripts/make_compile_plan.py``)
+The *compile plan* (:data:`PLAN_FILE`, written by ``scripts/maintenance/make_compile_plan.py``)
 holds, per path of the shipped configs, the stages ``advance`` compiles, in the
 order it compiles them, with their argument types and the seconds each took.
 A plan that no longer matches the kernels costs only the work of compiling

@@ -1,7 +1,7 @@
 """One compile of each path of the trial kernel at a time per kernel cache.
 
 A cold compile of a path of :func:`ftc_mc.core.longitudinal.trial.advance`
-(``core/shared/paths.py``) takes tens of seconds (``scripts/bench_campaign.py``,
+(``core/shared/paths.py``) takes tens of seconds (``scripts/benchmarks/bench_campaign.py``,
 ``docs/performance.md`` lesson 11).  Processes that start together on an empty
 cache (two runs launched at once, Dask or test workers on one machine) would
 each compile it, on cores they then share.  :func:`compiled_once` makes the
@@ -52,9 +52,9 @@ EXPECTED_COMPILE = {LinearPlant: "30 s", NonlinearPlant: "30 s",
 """What the compile notice says a path's cold compile takes, by its plant marker
 (``core/shared/paths.py``), on 2 cores with the compile helper
 (:mod:`ftc_mc.sim.compile_helper`), each path on an empty cache
-(``scripts/bench_compile.py``, stop 44, once the stages were called by
+(``scripts/benchmarks/bench_compile.py``, stop 44, once the stages were called by
 address: ``docs/performance.md`` lesson 17): the default (linear) path 22.8 s
-(``scripts/bench_campaign.py``'s ``compile_s``, setup included: 24.0-25.8 s),
+(``scripts/benchmarks/bench_campaign.py``'s ``compile_s``, setup included: 24.0-25.8 s),
 the paper's design on the nonlinear plant 21.8 s, ``robust`` 28.8 s, the
 paper's design on the 6-DOF plant 32.8 s; at stop 45 the same 33.6 and
 36.1 s, and the paper's design on the 6-DOF plant with the extended side

@@ -6,7 +6,7 @@ Each kernel here is the lane-wise twin of a single-trajectory kernel of
 the lane index *last* (``xa[n, L]``, ``P[n, n, L]``, ``u[3, L]``, ``z[12, L]``;
 ``n = 14`` for the paper's filter, taken from the arrays' shapes)
 so that the innermost loops run over lanes and compile to 512-bit vector code
-(2.3x the best per-trajectory layout when measured; ``scripts/bench_core.py``).
+(2.3x the best per-trajectory layout when measured; ``scripts/benchmarks/bench_core.py``).
 ``L`` is a run-time shape.
 
 Every lane is computed with the same floating-point operations, in the same
@@ -32,7 +32,7 @@ differs is only the order in which *independent* results are produced:
 * a reset re-predicts from ``P_{k|k}``, which stays in ``P`` (the prediction
   goes to a work array), only for the lanes that reset when they are few.
 
-Measured on the paper's problem, one core (``scripts/bench_core.py``): about
+Measured on the paper's problem, one core (``scripts/benchmarks/bench_core.py``): about
 1.6-1.7 M filter steps/s at 64-192 lanes, about 4x ``step.filter_step``.  The
 lane rows should start on 64-byte boundaries (``tests/lane_workspace.py::lane_zeros``,
 ``L`` a multiple of 8): NumPy's default placement cost 20 % here.
@@ -350,7 +350,7 @@ def innovations_lanes(xa, P, z, fm, innov):
 
     Apart from :func:`residuals_lanes` because the paper's one-step test does
     not need them: written in the same lane loop, they cost 8-15 % of
-    :func:`filter_step_lanes` (``scripts/bench_core.py``, 64-128 lanes).
+    :func:`filter_step_lanes` (``scripts/benchmarks/bench_core.py``, 64-128 lanes).
 
     Parameters
     ----------

@@ -23,7 +23,7 @@ two beyond the grid's end) has a steady flight of its own in the design box
 one, with Theorem 4.1's bias), no linear law about a steady flight applies.
 There the throttle and the healthy elevon either hold the 6-DOF trim commands
 (``LockTurnTable.hold``; ``monitor.turn_beyond: hold``): the oracle study
-(``scripts/study_lock_turn.py``) found that holding them keeps such locks in
+(``scripts/studies/study_lock_turn.py``) found that holding them keeps such locks in
 the envelope longer than the biased designs (+3 deg from trim: 12.7 s against
 6.8 s); or they fly the **rocking law** (``turn_beyond: rollout``,
 :func:`rocking_law`).
@@ -43,7 +43,7 @@ to limit: with 5, 10 held pairs and, per switch time, the 90 ordered pairs of
 two different ones).  The envelope's excess after each period is the
 largest of ``Va_min - Va``, ``Va - Va_max`` [m/s], ``alpha_min - alpha``,
 ``alpha - alpha_max``, ``|phi| - phi_max`` [deg] (``ro_env``; one m/s counts
-as one degree, as ``scripts/study_recoverable.py`` counts it).  The
+as one degree, as ``scripts/studies/study_recoverable.py`` counts it).  The
 candidate that stays inside
 longest wins; among those that stay equally long, the one whose largest
 excess before leaving is least (the widest margin); the first in the table

@@ -58,7 +58,7 @@ and the directions are the Jacobians at each lane's estimate, taken anew at
 every step by forward differences.  In moderate turbulence the trim's do not
 hold at the excursions the gusts cause (bank RMS about 10 deg): on its own
 model's data the nonlinear prediction's throttle projection has about 20
-times its variance (``scripts/study_monitor_consistency.py``).
+times its variance (``scripts/studies/study_monitor_consistency.py``).
 
 **Directions.**  A fault of actuator ``j`` starting during step ``k`` moves
 the prediction by ``B_j delta`` (``b0``; a loss moves it along the same

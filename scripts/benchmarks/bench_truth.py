@@ -11,7 +11,7 @@ controller (the Tables 2-3 estimation campaign) or the reconfiguring loop.
 
 Usage::
 
-    .venv/bin/python scripts/bench_truth.py [--lanes 128] [--repeat 3]
+    .venv/bin/python scripts/benchmarks/bench_truth.py [--lanes 128] [--repeat 3]
 
 Then the detection designs of issue 13 (``DESIGNS``) on the nonlinear plant in
 moderate turbulence, each run alone on the same chunk: the paper's filter
@@ -43,7 +43,7 @@ from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 
 from ftc_mc.campaign.chunk import chunk_spec, run_chunk  # noqa: E402
 from ftc_mc.config import Config  # noqa: E402

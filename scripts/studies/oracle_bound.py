@@ -2,7 +2,7 @@
 
 Issue 26 asks that, for elevon locks outside the trimmable set, the
 reconfiguring loop at least double the nominal controller's median time to
-leave the envelope.  ``scripts/study_recoverable.py --json F`` finds, per lock
+leave the envelope.  ``scripts/studies/study_recoverable.py --json F`` finds, per lock
 offset, the longest stay any command history it searched keeps the aircraft
 inside (an oracle: side and lock known from the lock's first instant).  This
 script puts that beside a run's trials:
@@ -25,7 +25,7 @@ The oracle's searches are local (SLSQP) and its stays interpolated, so its
 median is evidence of what a controller can reach, not a proof.  Its rows
 must cover the run's offsets; the script says how far they reach.
 
-    python scripts/oracle_bound.py STUDY.json RUN_DIR [--side left]
+    python scripts/studies/oracle_bound.py STUDY.json RUN_DIR [--side left]
 """
 
 from __future__ import annotations
@@ -63,7 +63,7 @@ def oracle_stays(rows: list, side: str):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("study", help="scripts/study_recoverable.py --json output")
+    ap.add_argument("study", help="scripts/studies/study_recoverable.py --json output")
     ap.add_argument("run", help="a run's folder (trials.parquet)")
     ap.add_argument("--side", choices=("left", "right"), default="left")
     a = ap.parse_args(argv)

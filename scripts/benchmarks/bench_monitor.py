@@ -4,7 +4,7 @@ One process, one thread.  Both filters run on lanes of data from their own
 model, nominal, so that no reset or decision fires:
 
 a. the paper's filter, ``ftc_mc.core.longitudinal.batch.filter_step_lanes``
-   (14 states, 12 outputs, Table 1), as ``scripts/bench_core.py`` measures it;
+   (14 states, 12 outputs, Table 1), as ``scripts/benchmarks/bench_core.py`` measures it;
 b. the side monitor, ``ftc_mc.core.sixdof.monitor.sixdof_monitor`` (20 states,
    17 outputs: predict, 17 sequential updates carrying three direction
    signatures, projection, three windowed GLR statistics), called from Python
@@ -14,7 +14,7 @@ One *filter step* is one lane advanced by one 0.1 s period.  The best of
 three repeats after a warm-up call (which compiles or loads the kernels).
 Usage::
 
-    .venv/bin/python scripts/bench_monitor.py [--lanes 128] [--steps 400]
+    .venv/bin/python scripts/benchmarks/bench_monitor.py [--lanes 128] [--steps 400]
         [--prediction linear|nonlinear|extended]
 
 ``--prediction nonlinear`` times the monitor that predicts with the airframe's
@@ -42,9 +42,8 @@ from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
-sys.path.insert(0, str(ROOT / "scripts"))
 sys.path.insert(0, str(ROOT / "tests"))
 
 import bench_core  # noqa: E402

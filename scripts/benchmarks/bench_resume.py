@@ -9,7 +9,7 @@ on the store, which lists the folder once), for several ``k``; then times the
 final assembly of the result files from all chunks (which reads every chunk
 once per design, so it grows with the run, not with ``k``).
 
-Usage: ``python scripts/bench_resume.py [--trials 15360] [--missing 0,160,1600]``.
+Usage: ``python scripts/benchmarks/bench_resume.py [--trials 15360] [--missing 0,160,1600]``.
 Last line: ``chunks=<n> resume_s=<k>:<s>,... per_missing_chunk_ms=<m> assemble_s=<a>``.
 """
 

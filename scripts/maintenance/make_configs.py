@@ -1,6 +1,6 @@
 """Regenerate configs/*.yaml from the pydantic defaults (docs come from the models).
 
-Run ``python scripts/make_configs.py`` after changing a default or a field's
+Run ``python scripts/maintenance/make_configs.py`` after changing a default or a field's
 docstring; ``tests/test_config.py`` fails while the files are out of date.
 """
 
@@ -9,7 +9,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
 
 from ftc_mc.campaign.transitions import TRANSITION_TABLE  # noqa: E402

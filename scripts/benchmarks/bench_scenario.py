@@ -21,7 +21,7 @@ Targets (issue): kernel under 0.05 s; offline design under 30 s cold, 1 s cached
 The last line is
 ``scenario_kernel_s=<x> scenario_total_s=<y> design_cold_s=<z> design_cached_s=<w>``
 with ``scenario_total_s`` the median of ``run_scenario(sc, setup=prebuilt)``.
-Usage: ``python scripts/bench_scenario.py [--repeat N] [--config PATH]``.
+Usage: ``python scripts/benchmarks/bench_scenario.py [--repeat N] [--config PATH]``.
 """
 
 from __future__ import annotations
@@ -36,7 +36,7 @@ import tempfile
 import time
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 PAPER_MATLAB_S = 7.0
 
 DESIGN = """

@@ -12,11 +12,11 @@ design of a config (``campaign.chunk.warm_up``), and reports:
 
 Each path is measured on its own empty cache, so the kernels it shares with the
 default path (the setup's, the paper filter's) count in every row; the cost one
-path adds to another already cached is ``scripts/bench_campaign.py``'s
+path adds to another already cached is ``scripts/benchmarks/bench_campaign.py``'s
 ``compile_robust_s``.
 
 The last line is ``compile_default_cpu_s=<x> compile_default_wall_s=<y>``.
-Usage: ``python scripts/bench_compile.py [--only NAME ...]``.
+Usage: ``python scripts/benchmarks/bench_compile.py [--only NAME ...]``.
 """
 
 from __future__ import annotations
@@ -29,7 +29,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 PATHS = {
     # name: (config, design, overrides)

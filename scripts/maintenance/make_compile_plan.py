@@ -16,7 +16,7 @@ Run it after a change of what ``advance`` calls or of its stages' signatures
 or after a Numba upgrade (a plan from another Numba version is not used).
 It takes a cold compile per path: about 20-30 minutes for all of them on 2 cores.
 
-Usage: ``python scripts/make_compile_plan.py [--only KEY ...]`` (``--only``
+Usage: ``python scripts/maintenance/make_compile_plan.py [--only KEY ...]`` (``--only``
 records the paths named, words as in the compile notice, and keeps the others).
 """
 
@@ -31,7 +31,7 @@ import tempfile
 import time
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
 
 import ftc_mc  # noqa: E402,F401 -- before numpy (threads)

@@ -37,7 +37,7 @@ largest magnitude (``nan``: the filter diverged).
 
 Usage::
 
-    .venv/bin/python scripts/study_monitor_consistency.py [--lanes 7] [--steps 50]
+    .venv/bin/python scripts/studies/study_monitor_consistency.py [--lanes 7] [--steps 50]
         [--seeds 2] [--skip 20] [--gust-scale 1] [--state-noise-scale 1]
 
 The figures in docs/airframes.md: ``--steps 35 --skip 15 --seeds 4``, with

@@ -12,7 +12,7 @@ b. linear: ``x <- A x + B u`` on the 9-state discrete model (explicit loops).
 
 Compile (or cache-load) time is excluded (warm-up call).  Usage::
 
-    .venv/bin/python scripts/bench_nonlinear.py
+    .venv/bin/python scripts/benchmarks/bench_nonlinear.py
 
 The last line is ``nonlinear_steps_per_s=<x> linear_steps_per_s=<y> ratio=<y/x>``.
 """
@@ -31,7 +31,7 @@ from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 
 from ftc_mc.core.shared.dryden import gust_step  # noqa: E402
 from ftc_mc.core.jit import kernel  # noqa: E402

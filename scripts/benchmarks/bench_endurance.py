@@ -8,7 +8,7 @@ flight hours per minute of wall time, and per minute of CPU time (on a
 machine shared with other work the wall time says less).  Target (issue 25): at least 100 flight
 hours per minute on 2 cores.
 
-Usage: ``python scripts/bench_endurance.py [--hours H] [--jobs N] [--design NAME]``.
+Usage: ``python scripts/benchmarks/bench_endurance.py [--hours H] [--jobs N] [--design NAME]``.
 Last line: ``endurance_hours_per_min=<x>``.
 """
 
@@ -19,7 +19,7 @@ import os
 import time
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def main():

@@ -21,7 +21,7 @@ compile_s=<z> compile_robust_s=<c>``: trial steps per second with --jobs 2 for
 the nominal controller (the estimation campaign of Tables 2-3, ``x``, with its
 wall time ``y``) and for the reconfiguring loop (``r``), the cold compile time
 of the default path (``z``) and the compile the robust config adds (``c``).
-Usage: ``python scripts/bench_campaign.py [--trials N]``.
+Usage: ``python scripts/benchmarks/bench_campaign.py [--trials N]``.
 """
 
 from __future__ import annotations
@@ -34,7 +34,7 @@ import tempfile
 import time
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 WARM = ("from ftc_mc.config import load_config; "
         "from ftc_mc.campaign.chunk import chunk_spec, warm_up; "
         "c = load_config('configs/{}'); "

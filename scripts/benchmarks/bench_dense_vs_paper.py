@@ -10,7 +10,7 @@ general filter with no gust or bias states.  Prints each path's best trial-step
 rate and whether the records agree (reset counts, statuses, final estimates).
 
 The last line is ``paper_steps_per_s=<x> dense_steps_per_s=<y> ratio=<x/y>
-identical=<bool>``.  Usage: ``python scripts/bench_dense_vs_paper.py [nominal|reconfiguring]``.
+identical=<bool>``.  Usage: ``python scripts/benchmarks/bench_dense_vs_paper.py [nominal|reconfiguring]``.
 """
 
 from __future__ import annotations
@@ -34,7 +34,7 @@ from ftc_mc.sim.inputs import design_inputs  # noqa: E402
 from ftc_mc.sim.lanes import new_record, start_lanes  # noqa: E402
 from ftc_mc.sim.paths import path_of  # noqa: E402
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 L = 256
 
 

@@ -25,7 +25,7 @@ survived 60 s, the time it left and by which bound, the height lost [m]
 
 Usage::
 
-    PYTHONPATH=. python scripts/study_lock_turn.py [--airframe x8-pyfly]
+    PYTHONPATH=. python scripts/studies/study_lock_turn.py [--airframe x8-pyfly]
         [--offsets -30,-20,...] [--turbulence [--seeds N]]  # moderate turbulence,
                                             # N records: nominal and lock-turn (1 s)
         [--json out.json]

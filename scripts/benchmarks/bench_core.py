@@ -17,7 +17,7 @@ d. ``ftc_mc.core.longitudinal.batch.filter_step_lanes`` at several lane counts
 
 Compile (or cache-load) time of the first call is reported apart.  Usage::
 
-    .venv/bin/python scripts/bench_core.py
+    .venv/bin/python scripts/benchmarks/bench_core.py
 
 The last line is ``numba_vs_numpy=<x> numba_vs_filterpy=<y> batch_steps_per_s=<z>``
 (``x``, ``y``: single-trajectory Numba steps/s over NumPy's and filterpy's;
@@ -39,7 +39,7 @@ from pathlib import Path  # noqa: E402
 import numba  # noqa: E402
 import numpy as np  # noqa: E402
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "tests"))
 

@@ -17,7 +17,7 @@ grid and whether it is one interval; for the linear model also the set's
 exact ends (``ftc_mc.model.trimmable.linear_trimmable_set``: the set is one
 interval, whose ends two linear programmes find).
 
-    python scripts/study_trimmable.py [--airframe x8-pyfly,x8-gryte2018]
+    python scripts/studies/study_trimmable.py [--airframe x8-pyfly,x8-gryte2018]
         [--models linear,nonlinear] [--offsets=-12:12:0.25]
 """
 

@@ -3,7 +3,7 @@
 Run only when behaviour changes on purpose, in a commit of its own whose message
 and issue note say what moved and why::
 
-    .venv/bin/python scripts/make_golden.py
+    .venv/bin/python scripts/maintenance/make_golden.py
 """
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "tests"))
 
 import ftc_mc  # noqa: E402,F401  -- first: it pins OpenBLAS's kernels before numpy loads (blas.py)
 from golden_cases import GOLDEN, all_frames  # noqa: E402

@@ -6,7 +6,7 @@ wind held), from the trim of ``x8-pyfly`` with small random commands and wind,
 each plant's own ``propagate`` kernel called from one compiled loop (the way the
 trial kernel calls the longitudinal one per lane).  Median of ``--repeat``
 after a warm-up call.  With ``--trial`` it also times the longitudinal
-nonlinear plant's full trial (``scripts/bench_truth.py``'s measure: filter,
+nonlinear plant's full trial (``scripts/benchmarks/bench_truth.py``'s measure: filter,
 controllers and classification included), the reference of issue 24's target
 (6-DOF plant at least 0.5x the longitudinal nonlinear plant's trial steps/s);
 that compiles the trial kernel when it is not cached (1.5-3 min).
@@ -22,7 +22,7 @@ steps per second of the whole ``api.run_campaign`` call (setup, trials, summary)
 
 Usage::
 
-    .venv/bin/python scripts/bench_sixdof.py [--lanes 128] [--steps 500] [--repeat 5] [--trial]
+    .venv/bin/python scripts/benchmarks/bench_sixdof.py [--lanes 128] [--steps 500] [--repeat 5] [--trial]
         [--campaign 500] [--design sixdof_selected]
 
 The last line is ``longitudinal_plant_steps_per_s=<a> sixdof_plant_steps_per_s=<b>
@@ -49,7 +49,7 @@ from pathlib import Path  # noqa: E402
 import numba  # noqa: E402
 import numpy as np  # noqa: E402
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 
 from ftc_mc.core.longitudinal import nonlinear as lon  # noqa: E402
 from ftc_mc.core.sixdof import plant as six  # noqa: E402
@@ -163,7 +163,7 @@ def campaign_steps_per_s(kind, trials, design="sixdof"):
     after a warm-up run of 2 trials per row; and the wall time [s]."""
     from ftc_mc import api
 
-    config = str(Path(__file__).resolve().parents[1] / "configs" / "sixdof_tables.yaml")
+    config = str(Path(__file__).resolve().parents[2] / "configs" / "sixdof_tables.yaml")
     common = dict(design=[design], plant=kind, jobs=2, progress=False)
     api.run_campaign(config, trials=2, **common)
     t = time.perf_counter()

@@ -15,7 +15,7 @@ under the paper's reset (and ``S``), and the engine's b1 estimate 2 s after the
 recovery at 70 s (the end of its one doublet) against the reset's scale, with
 the shrinkage a Gaussian prior of the reset's variance gives (text).
 
-Usage: ``python scripts/figure_recoveries.py [CONFIG] [--plant P] [--turbulence T]
+Usage: ``python scripts/studies/figure_recoveries.py [CONFIG] [--plant P] [--turbulence T]
 [--reset-scale S] [--seeds N] [-o docs/figures/recoveries.png]``.
 """
 
@@ -26,7 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 SCALES = (1.0, 2.0, 4.0, 9.0, 25.0, 52.08)
 """Reset scales of the seeds figure's last panel (52.08 = 25^2/12: a uniform

@@ -11,9 +11,9 @@ and the last line of stderr.
 
 Usage::
 
-    python scripts/bench_memory.py --trials 20000
-    python scripts/bench_memory.py --trials 160000 --report --out results/bench160k
-    python scripts/bench_memory.py --trials 2000000 --signal SIGINT --after 12
+    python scripts/benchmarks/bench_memory.py --trials 20000
+    python scripts/benchmarks/bench_memory.py --trials 160000 --report --out results/bench160k
+    python scripts/benchmarks/bench_memory.py --trials 2000000 --signal SIGINT --after 12
 
 Before it, the run's CPU time (user + system: on a shared machine the wall time
 depends on the load, the CPU time much less).  Last line:
@@ -32,7 +32,7 @@ import tempfile
 import time
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 FTC_MC = [sys.executable, "-m", "ftc_mc"]
 
 

@@ -40,7 +40,7 @@ Per side and lock offset from trim, four questions:
    subject to ``excess_k <= -0.3`` (SLSQP, from the five structured starts
    of question 1 in turn, until one flies).  Then the 60 s are flown, the LQR after the transient, and
    the flight counts only if it stays inside the envelope at every sample
-   (``scripts/study_lock_turn.fly``, as the oracle study flies its runs).
+   (``scripts/studies/study_lock_turn.fly``, as the oracle study flies its runs).
 
 3. **Later exits.**  For a lock question 2 did not fly and question 1 did
    not lose, question 1 again over ``--long-horizon`` seconds (20 s), with
@@ -52,7 +52,7 @@ Per side and lock offset from trim, four questions:
    least excess from the eight starts is not positive, nodes every 0.1 s up
    to 3 s and every 1 s beyond; beside it, the time the nominal 6-DOF LQR
    (the paper's longitudinal law and the wings-level lateral law,
-   ``scripts/study_lock_turn.py``) leaves.  Their ratio bounds what issue
+   ``scripts/studies/study_lock_turn.py``) leaves.  Their ratio bounds what issue
    26's "the reconfiguring loop at least doubles the time to leave" can reach
    for that lock.
 
@@ -75,7 +75,7 @@ question 1 found no 3 s history where question 4's bisection found one of
 4.0 s, so a verdict is evidence, not proof.  Prints one line per lock as it
 ends and, last, the bands per side.
 
-    python scripts/study_recoverable.py [--airframe x8-pyfly]
+    python scripts/studies/study_recoverable.py [--airframe x8-pyfly]
         [--offsets=-30:5:1,6,7,8,10,12,15,20,25] [--sides left,right]
         [--delay 0] [--plant nonlinear] [--jobs 2] [--json out.json]
 """
@@ -238,7 +238,7 @@ def transient(prob, design, z0):
 
 
 class Replay:
-    """Question 2's flight as ``scripts/study_lock_turn.fly`` flies a
+    """Question 2's flight as ``scripts/studies/study_lock_turn.fly`` flies a
     controller: the transient's commands ``cmds`` (n, 3), then ``design``'s
     law."""
 

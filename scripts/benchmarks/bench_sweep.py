@@ -6,7 +6,7 @@ same 20 points as separate campaigns (``run_campaign`` per point) in the same
 process.  Prints both wall times, their ratio and the trial steps the sharing
 saved.  The nominal controller is used by default (``--controller``).
 
-Usage: ``python scripts/bench_sweep.py [--trials N] [--points SPEC]``.
+Usage: ``python scripts/benchmarks/bench_sweep.py [--trials N] [--points SPEC]``.
 Last line: ``sweep_wall_s=<x> separate_wall_s=<y> ratio=<y/x> steps_saved=<f>``.
 """
 
@@ -16,7 +16,7 @@ import argparse
 import time
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def main():
