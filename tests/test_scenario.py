@@ -38,7 +38,7 @@ FIGURES = ("fig06_trajectory.png", "fig07_thrust_b.png", "fig08_elevon_b.png",
            "fig09_residuals.png", "fig10_belief.png", "fig11_controller.png",
            "fig12_commands.png")
 
-# Columns of timeseries.parquet, grouped as documented in README.md
+# Columns of timeseries.parquet, grouped as documented in docs/reference/outputs.md
 # ("true and estimated states, fault parameters, residuals, belief, selected
 # controller, commands and excitation at every 0.1 s step") and in
 # ftc_mc.scenario._timeseries.

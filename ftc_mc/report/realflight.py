@@ -50,7 +50,8 @@ def real_flight_lines(trials: pd.DataFrame) -> list:
              "FDDBenchmark's names: average detection delay (ADD, to the first reset of any "
              "block in the judging window, missed trials excluded) and correct diagnosis "
              "rate (CDR, the first reset after the fault names the correct block). "
-             "Definitions: README, *Metrics comparable with real-flight studies*.", "",
+             "Definitions: docs/guides/compare-designs.md, *Metrics comparable with "
+             "real-flight studies*.", "",
              f"For context only: on {k['flights']} real flights of a {k['aircraft']} "
              f"({k['faults']}) Keipour, Mousaei and Scherer (ICRA 2019) report precision "
              f"and recall {100 * k['precision']:.2f} %, mean detection delay "
