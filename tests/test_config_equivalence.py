@@ -31,3 +31,15 @@ def test_shipped_config_resolves_as_recorded(name):
     assert type(cfg) is model
     assert cfg.model_dump(mode="json") == want["config"]
     assert cfg == model.model_validate(want["config"])
+
+
+def test_a_design_shipped_under_one_name_is_the_same_everywhere():
+    """Several configs ship the same designs (robust, sixdof, ...) in their own
+    file: a name means one design in every shipped config."""
+    seen = {}
+    for name in SHIPPED:
+        cfg = load_any(ROOT / "configs" / f"{name}.yaml")
+        for key, design in cfg.designs.items():
+            first = seen.setdefault(key, (name, design))
+            assert design == first[1], f"designs.{key} differs in {name}.yaml and {first[0]}.yaml"
+    assert {"robust", "sixdof", "sixdof_selected"} <= set(seen)

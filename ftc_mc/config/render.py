@@ -1,4 +1,4 @@
-"""A complete, commented YAML file of a configuration (``scripts/maintenance/make_configs.py``)."""
+"""A complete, commented YAML file of a configuration (`ftc-mc config show`)."""
 
 from __future__ import annotations
 
