@@ -5,7 +5,7 @@ YAML loading with one-line errors, and commented YAML rendering.
   ``ftc-mc sweep``) and :class:`ScenarioConfig` (``ftc-mc scenario``);
 * :mod:`~ftc_mc.config.load`: :func:`load_config`, :func:`load_scenario`, :func:`load_any`,
   :func:`parse_config`, :func:`with_overrides`;
-* :mod:`~ftc_mc.config.render`: :func:`render_yaml`.
+* :mod:`~ftc_mc.config.render`: :func:`render_yaml` (``ftc-mc config show``).
 """
 
 from .load import load_any, load_config, load_scenario, parse_config, with_overrides

@@ -6,6 +6,11 @@ out-of-range numbers and periods that are not whole sampling periods are
 refused with a message that names the field (``section.field: problem``).
 What is built from a validated config (:mod:`ftc_mc.sim.setup`) trusts it.
 Reading YAML and formatting errors: :mod:`ftc_mc.config.load`.
+
+Each field's docstring is its description: one line (``ftc-mc config show``
+prints it beside the value, ``docs/reference/config.md`` is generated from it
+by ``scripts/maintenance/make_config_reference.py``); what needs more points to
+a notes section of that page.
 """
 
 from __future__ import annotations
