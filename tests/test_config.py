@@ -112,3 +112,33 @@ def test_non_utf8(tmp_path):
 def test_parse_roundtrip():
     cfg = Config()
     assert parse_config(yaml.safe_load(yaml.safe_dump(cfg.model_dump(mode="json")))) == cfg
+
+
+AT_DEFAULT_ON_PURPOSE = {("elevon_lock", "campaign", "transitions"),
+                         ("paper_scenario", "scenario", "schedule")}
+"""Fields a shipped config sets to their default, to say what it runs (a file
+must hold at least one section)."""
+
+
+def test_shipped_configs_set_only_what_they_change():
+    from ftc_mc.config import load_any
+    from ftc_mc.config.schema import DesignConfig
+    from ftc_mc.io.yamlfile import read_yaml
+
+    design_default = DesignConfig().model_dump(mode="json")
+    for path in sorted((ROOT / "configs").glob("*.yaml")):
+        cfg = load_any(path)
+        defaults = type(cfg)().model_dump(mode="json")
+        resolved = cfg.model_dump(mode="json")
+        for section, fields in read_yaml(path).items():
+            if section == "designs":
+                for name, design in fields.items():
+                    for field in design:
+                        assert resolved["designs"][name][field] != design_default[field], (
+                            f"{path.name}: designs.{name}.{field} is at its default")
+                continue
+            for field in fields:
+                if (path.stem, section, field) in AT_DEFAULT_ON_PURPOSE:
+                    continue
+                assert resolved[section][field] != defaults[section][field], (
+                    f"{path.name}: {section}.{field} is at its default")
