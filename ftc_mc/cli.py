@@ -547,6 +547,39 @@ def report(dirs, output, allow_mixed):
     click.echo(f"wrote {out}")
 
 
+@cli.group("config")
+def config_group():
+    """Read configuration files (reference: docs/reference/config.md)."""
+
+
+@config_group.command("show")
+@click.argument("path", required=False, metavar="[CONFIG]", type=click.Path())
+@click.option("--scenario", is_flag=True,
+              help="Read CONFIG as a scenario config (ftc-mc scenario), or with no CONFIG "
+              "show a scenario config's defaults [default: a CONFIG with a scenario "
+              "section is one].")
+@user_errors
+def config_show(path, scenario):
+    """Print the resolved CONFIG as commented YAML: every section and field, its
+    value and a one-line description; a value that is not the default says the
+    default.  With no CONFIG, the defaults of a campaign config (ftc-mc run,
+    sweep).  The output is itself a valid config.
+    """
+    from .config import Config, ScenarioConfig, load_any, load_scenario
+    from .config.render import render_yaml
+
+    if path is None:
+        cfg = ScenarioConfig() if scenario else Config()
+        what = "the defaults of a " + ("scenario config (ftc-mc scenario)" if scenario
+                                        else "campaign config (ftc-mc run, ftc-mc sweep)")
+    else:
+        cfg = load_scenario(path) if scenario else load_any(path)
+        what = f"{path}, " + ("a scenario config (ftc-mc scenario)"
+                              if isinstance(cfg, ScenarioConfig)
+                              else "a campaign config (ftc-mc run, ftc-mc sweep)")
+    click.echo(render_yaml(cfg, f"ftc-mc config show: {what}"))
+
+
 def main():
     """Console-script entry point (SIGTERM exits cleanly, releasing locks)."""
     import signal

@@ -1,14 +1,14 @@
 """Hostile and malformed configs for ``ftc-mc run``, ``sweep`` and ``scenario``.
 
-Starting from the shipped configs/elevon_lock.yaml and configs/paper_scenario.yaml,
-hypothesis mutates the parsed YAML (wrong types, missing and unknown keys, NaN and
-inf, huge and negative numbers, sections replaced by lists or scalars, anchors and
-alias bombs, Python tags) and the raw bytes (non-UTF-8, truncation, stray YAML
-syntax).  Every case that is not a valid config must be refused the way the CLI
-promises: exit code 2, exactly one line on stderr naming the field or the file
-problem, no traceback, and nothing created or changed on disk (neither in --out
-nor under results/ in the working directory).  A mutated config that happens to be
-valid is never run (no real campaign starts here).
+Starting from what the shipped configs/elevon_lock.yaml and
+configs/paper_scenario.yaml resolve to (every field listed), hypothesis mutates the
+parsed YAML (wrong types, missing and unknown keys, NaN and inf, huge and negative
+numbers, sections replaced by lists or scalars, anchors and alias bombs, Python tags)
+and the raw bytes (non-UTF-8, truncation, stray YAML syntax). Every case that is not a
+valid config must be refused the way the CLI promises: exit code 2, exactly one line
+on stderr naming the field or the file problem, no traceback, and nothing created or
+changed on disk (neither in --out nor under results/ in the working directory). A
+mutated config that happens to be valid is never run (no real campaign starts here).
 
 The generators include huge and tiny magnitudes (up to 1e308, subnormals) and
 explicitly tagged scalars that PyYAML cannot construct (``!!int abc``...), which
@@ -34,7 +34,7 @@ from hypothesis import HealthCheck, currently_in_test_context, event, given, set
 from hypothesis import strategies as st
 
 from ftc_mc.cli import cli
-from ftc_mc.config import Config, ScenarioConfig, parse_config
+from ftc_mc.config import Config, ScenarioConfig, load_any, parse_config
 from ftc_mc.errors import UserError
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -43,7 +43,8 @@ SHIPPED = {"run": ROOT / "configs" / "elevon_lock.yaml",
            "sweep": ROOT / "configs" / "sweep.yaml"}
 EXTRA_ARGS = {"sweep": ["--thresholds", "10"]}
 """Options a command needs besides its config."""
-BASES = {cmd: yaml.safe_load(p.read_text(encoding="utf-8")) for cmd, p in SHIPPED.items()}
+BASES = {cmd: load_any(p).model_dump(mode="json") for cmd, p in SHIPPED.items()}
+"""What the shipped configs resolve to, every field listed: the mutations' start."""
 SECTIONS = {"run": set(Config.model_fields), "scenario": set(ScenarioConfig.model_fields),
             "sweep": set(Config.model_fields)}
 FULL = True  # every generator, including the inputs that once hit bugs

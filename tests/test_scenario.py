@@ -62,7 +62,8 @@ THRUST, ELEVONS = 1, 2  # reset_block values
 
 
 def _paper_dict():
-    return yaml.safe_load(PAPER.read_text())
+    """What configs/paper_scenario.yaml resolves to, every section and field listed."""
+    return load_scenario(PAPER).model_dump(mode="json")
 
 
 def _config(schedule, duration_s, seed=2026, airframe=None, **controller):

@@ -118,3 +118,11 @@ def with_overrides(cfg, **sections):
 def load_scenario(path) -> ScenarioConfig:
     """Read and validate a scenario YAML file (see :func:`load_config`)."""
     return validate_model(ScenarioConfig, read_yaml(path), str(path))
+
+
+def load_any(path):
+    """Read and validate a campaign or a scenario file: a :class:`ScenarioConfig`
+    when its top level has a ``scenario`` section, else a :class:`Config`."""
+    data = read_yaml(path)
+    model = ScenarioConfig if isinstance(data, dict) and "scenario" in data else Config
+    return validate_model(model, data, str(path))

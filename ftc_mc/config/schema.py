@@ -6,6 +6,11 @@ out-of-range numbers and periods that are not whole sampling periods are
 refused with a message that names the field (``section.field: problem``).
 What is built from a validated config (:mod:`ftc_mc.sim.setup`) trusts it.
 Reading YAML and formatting errors: :mod:`ftc_mc.config.load`.
+
+Each field's docstring is its description: one line (``ftc-mc config show``
+prints it beside the value, ``docs/reference/config.md`` is generated from it
+by ``scripts/maintenance/make_config_reference.py``); what needs more points to
+a notes section of that page.
 """
 
 from __future__ import annotations
@@ -236,11 +241,7 @@ class PlantConfig(_Strict):
     altitude_m: Annotated[float, NoBool, Field(ge=3.048, le=304.8, allow_inf_nan=False)] = 100.0
     """Altitude for the Dryden scale lengths [m] (low-altitude model: 10-1000 ft)."""
     dof: Literal[3, 6] = 3
-    """Degrees of freedom of the truth plant: 3, the longitudinal plane (the
-    paper's); 6, the flying wing with its lateral-directional motion, left and
-    right elevons as separate actuators and a lateral autopilot beside the
-    paper's loop (``ftc_mc/core/sixdof/truth.py``).  The filter and the
-    controllers keep the longitudinal model either way."""
+    """3: the longitudinal plane (the paper's); 6: the flying wing, two elevons, a lateral autopilot (docs/reference/config.md#the-6-dof-plant)."""
 
 
 class EstimatorConfig(_Strict):
@@ -268,7 +269,7 @@ class ControllerConfig(_Strict):
     """Controllers and their selection (sections 4.1-4.2, 5.1)."""
 
     kind: ControllerKind = "reconfiguring"
-    """``nominal``: c0 only; ``reconfiguring``: c0/c1/c2 chosen by eqs. 45-47; ``lock_turn`` (6-DOF plant, side monitor on): reconfiguring until the side monitor names an elevon, then the lock-turn controller of that side, scheduled on the monitor's lock estimate; the monitor also decides which block Table 1's resets open (``ftc_mc/core/sixdof/lockturn.py``); ``lock_turn_selected`` (6-DOF plant, side monitor on): eqs. 45-47 choose every period among c0, c1 and the lock-turn controllers of the left (c2) and the right (c3) elevon, on a belief read from the side monitor's fault estimates (``ftc_mc/core/sixdof/selection.py``); the monitor decides the blocks as for lock_turn."""
+    """nominal: c0 only; reconfiguring: c0/c1/c2 chosen by eqs. 45-47; lock_turn, lock_turn_selected: 6-DOF (docs/reference/config.md#controllers)."""
     discount: Annotated[float, NoBool, Field(gt=0, lt=1, allow_inf_nan=False)] = 0.999
     """Discount factor alpha (< 1: a locked engine needs it, section 4.1.2)."""
     r_lqr: Pos = 0.1
@@ -278,10 +279,9 @@ class ControllerConfig(_Strict):
     switch_penalty: NonNeg = 0.1
     """Penalty P(c, a) of changing controller (eq. 46; paper 0.1)."""
     terminal_horizon_s: Pos = 100.0
-    """Simulated rest of the mission for the terminal costs J^N (eq. 46) [s]
-    (100 s: the paper's mission, and about 1/(1 - alpha) steps)."""
+    """Simulated rest of the mission for the terminal costs J^N (eq. 46) [s] (100: the paper's mission)."""
     coupling: Literal["separate", "coupled"] = "separate"
-    """How c0 and c1 fly the 6-DOF plant (plant.dof 6 only): ``separate``, the paper's longitudinal laws with the wings-level lateral LQR beside them; ``coupled``, c0 as one discounted LQR on the 6-DOF linear model with the sum of their weights, and c1 as Theorem 4.1's tables on that model (``ftc_mc/design/lateral.py``). On ``x8-pyfly`` the coupled laws also roll with the propeller's torque, and c1 then relies on the thrust's estimated effectiveness for it: measured in docs/airframes.md, where a locked engine that the paper's filter reads as a bias costs heading. c2 and the lock-turn law keep their own."""
+    """6-DOF c0 and c1: separate (the paper's laws and a lateral LQR) or coupled (6-DOF LQRs) (docs/reference/config.md#controllers)."""
 
 
 class ExcitationConfig(_Strict):
@@ -311,12 +311,12 @@ class NoiseConfig(_Strict):
 
 
 class DrawsConfig(_Strict):
-    """Per-trial draws (docs/paper-map.md)."""
+    """Per-trial draws (docs/reference/paper-map.md)."""
 
     engine_lock_range: tuple[Finite, Finite] | None = None
     """Absolute throttle lock position range; null = the command range [0, 1]."""
     elevon_lock_range_rad: tuple[Finite, Finite] | None = None
-    """Absolute elevon lock position range [rad], of the left (elevon_*) and the right (right_elevon_*) rows; null = the command range."""
+    """Absolute elevon lock position range [rad] of the left and right rows; null = the command range."""
     loss_b1_range: tuple[Annotated[float, NoBool, Field(ge=0, le=1)],
                          Annotated[float, NoBool, Field(ge=0, le=1)]] = (0.0, 1.0)
     """Uniform range of the effectiveness loss b1."""
@@ -375,9 +375,7 @@ class ValidityConfig(_Strict):
     psd_check_period_s: Pos = 1.0
     """Period of the full Cholesky check of the filter covariance [s]."""
     bank_max_deg: Annotated[float, NoBool, Field(gt=0, le=90, allow_inf_nan=False)] = 60.0
-    """Largest bank angle [deg] (6-DOF plant): beyond it the longitudinal filter's
-    model no longer describes the flight (its load factor and pitch channels
-    mix with the turn), and a small flying wing's autopilot would not fly it."""
+    """Largest bank angle [deg] (6-DOF plant): beyond it the longitudinal filter's model no longer holds."""
 
     @model_validator(mode="after")
     def _ordered(self):
@@ -390,83 +388,57 @@ class MonitorConfig(_Strict):
     """The 6-DOF side monitor: which actuator failed, from roll and pitch (6-DOF plant only)."""
 
     enabled: bool = True
-    """Fly the side monitor beside every design on the 6-DOF plant
-    (``ftc_mc/core/sixdof/monitor.py``): an augmented filter of the 6-DOF
-    model with a fault of each actuator and a windowed GLR per
-    actuator; it records its decisions, and acts only in a design with
-    ``controller: lock_turn``.  Ignored on the longitudinal plants."""
+    """Fly the side monitor beside every design on the 6-DOF plant (docs/reference/config.md#the-side-monitor)."""
     design_turbulence: Literal[TURBULENCE_LEVELS] = "none"
-    """Dryden level the monitor's filter models (``none``: no gust states; else
-    the 8 states of the longitudinal and lateral Dryden models at that level,
-    as a ``gust_aware`` design adds the longitudinal ones)."""
+    """Dryden level the monitor's filter models (none: no gust states; else 8 gust states at that level)."""
     prediction: Literal["auto", "linear", "nonlinear", "extended"] = "auto"
-    """What predicts the monitor's states and measurements: ``linear``, the
-    6-DOF linear model at trim; ``nonlinear``, the airframe's equations (the
-    covariance, gains and directions with the trim's Jacobians), which keep the
-    propeller's torque and the moments off the trim airspeed that the linear
-    model reads as a differential elevon; ``extended``, the airframe's
-    equations with the gust states' wind flown through them, and the
-    Jacobians taken about each lane's estimate at every step (in turbulence,
-    where the trim's do not hold; several times slower); ``auto``, ``linear``
-    on the linear plant, on the nonlinear one ``nonlinear``, or ``extended``
-    when ``design_turbulence`` gives the monitor gust states."""
+    """What predicts the monitor's states: linear, nonlinear, extended or auto (docs/reference/config.md#the-side-monitor)."""
     substeps: Annotated[int, NoBool, Field(ge=1, le=100)] = 5
-    """RK4 sub-steps per control period of the nonlinear prediction (5 at dt =
-    0.1 s: on the X8, from states far off trim, the body rates one period on
-    are within 3e-4 rad/s of 100 sub-steps', where 2 leave 4e-2; its roll mode
-    is -38.5 1/s)."""
+    """RK4 sub-steps per control period of the monitor's nonlinear prediction."""
     state_noise_scale: Annotated[float, NoBool, Field(ge=1.0, le=1e6, allow_inf_nan=False)] = 1.0
-    """Multiplies the process noise variance of the monitor's 6-DOF states
-    (``estimator.sigma_qx^2 dt``; not the gust states' or the fault
-    parameters'): room for what its model leaves out, such as the extended
-    filter's second-order gust terms.  In moderate turbulence on the
-    nonlinear plant, 100 cuts its false decisions from about 1,300 to about 6
-    per hour (docs/airframes.md)."""
+    """Factor on the process noise variance of the monitor's 6-DOF states (docs/reference/config.md#the-side-monitor)."""
     threshold: Pos = 30.0
-    """GLR threshold on each actuator's statistic (chi-square, 1 degree of
-    freedom, per tested change under no fault)."""
+    """GLR threshold on each actuator's statistic (chi-square, 1 degree of freedom)."""
     window_s: Pos = 2.0
     """GLR window [s]: the oldest change tested."""
     min_window_s: Pos = 0.3
-    """Shortest change tested [s] (a multiple of model.dt_s, at most window_s):
-    an outlier of one step is not a persistent change."""
+    """Shortest change tested [s] (a multiple of model.dt_s, at most window_s)."""
     startup_s: NonNeg = 1.0
     """Time from the start before a decision may be made [s]."""
     estimate_after_s: NonNeg = 1.0
-    """Time after the first decision at or after the switch at which the
-    monitor's estimate (lock position, b0, b1) is recorded [s]."""
+    """Time after the first decision at which the monitor's estimate is recorded [s]."""
     turn_offsets_deg: tuple[Finite, Finite] = (-14.0, 4.0)
-    """Lock offsets from trim [deg] the lock-turn table of a ``controller: lock_turn`` design spans, each side (``ftc_mc/design/lock_turn.py``; an estimate beyond them flies the end's design, and a run notes an end with a steady flight of its own). Where neither design bracketing the estimate has a steady flight of its own, the law holds the trim commands instead, or flies the rocking law (turn_beyond). Designed once per airframe and cached (about 1-10 s per lock)."""
+    """Lock offsets from trim [deg] the lock-turn table spans, each side (docs/reference/config.md#the-lock-turn-law)."""
     turn_step_deg: Pos = 1.0
     """Step of that table [deg]: its range must hold a whole number of steps."""
     turn_feedback: Literal["measured", "estimate"] = "measured"
-    """What the lock-turn law feeds back: ``measured``, the sensors' bank, pitch, body velocities and rates (the actuators from the monitor's estimate); ``estimate``, the monitor's estimate of every state, whose linear model drifts in steep turns."""
+    """What the lock-turn law feeds back: measured (the sensors) or estimate (the monitor's estimate)."""
     turn_model: Literal["auto", "linear", "nonlinear"] = "auto"
-    """What the lock-turn table is designed on: ``nonlinear``, the airframe's equations (their steady flights, the Jacobians at each); ``linear``, the 6-DOF linear model at trim, the linear plant's own (its steady flights, which have no banked turns of the equations' kind, and its matrices; ``ftc_mc/model/trimmable.py``); ``auto``, the truth plant's kind. The rocking law and the rollout guard fly the plant's own model ahead either way (on the linear plant, its linear model). On the linear plant (x8-pyfly, configs/sixdof_survival.yaml --plant linear), 93.0 / 92.4 % of the locks inside the linear model's trimmable set (-4.87 to +5.68 / -5.30 to +5.69 deg of the 6-DOF trim; a run on that plant reports the split) stay in for 60 s with ``linear``, 64.9 / 73.0 % with ``nonlinear``; the table must then reach past that set (docs/airframes.md)."""
+    """What the lock-turn table is designed on: nonlinear, linear or auto (docs/reference/config.md#the-lock-turn-law)."""
     turn_probe_rad: Annotated[float, NoBool, Field(ge=0, le=0.3, allow_inf_nan=False)] = 0.0
-    """Amplitude of a 3211 the lock-turn law sends on the elevon the monitor named, from the step it takes over [rad]; 0: none, and no hand-back. A locked elevon does not move; one that lost only part of its effectiveness follows it, and the monitor's b1 of that side learns which (``ftc_mc/core/sixdof/lockturn.py``)."""
+    """Amplitude of a 3211 the lock-turn law sends on the named elevon [rad]; 0: none (docs/reference/config.md#the-lock-turn-law)."""
     turn_probe_unit_s: Pos = 0.2
     """One unit of that 3211 [s] (it lasts 7 units; the paper's 3211 unit by default)."""
     hand_back_after_s: Pos = 3.0
     """Time after the lock-turn law took over at which a probed lane is judged [s]: at least the probe's 7 units."""
     hand_back_b1: Annotated[float, NoBool, Field(gt=0, le=1, allow_inf_nan=False)] = 0.5
-    """A probed lane whose monitor then estimates the named elevon's b1 (the share of its effectiveness lost) below this hands back: it flies the paper's reconfiguring loop and lateral autopilot again for the rest of the flight."""
+    """A probed lane whose estimated b1 of the named elevon falls below this hands back to the paper's loop."""
     hand_back_sd: NonNeg = 2.0
-    """Standard deviations of the monitor's b1 estimate (its covariance) by which b1 must lie below hand_back_b1 to hand back: in gusts the probe hardly moves b1, and its spread keeps a lock turning."""
+    """Standard deviations of that b1 estimate by which b1 must lie below hand_back_b1 to hand back."""
     turn_beyond: Literal["hold", "rollout", "guarded"] = "hold"
-    """What the lock-turn law flies where no steady flight exists about the lock estimate (beyond the steady band of the design box): ``hold``, the 6-DOF trim commands; ``guarded``, first a design about the lock's own steady flight in the validity envelope less 0.5 of each bound and rollout_guard_bank_margin_deg of bank, where it has one (on x8-pyfly, locks from -15 to -11 deg of trim: turns at 50 deg of bank and 12.5-14.7 m/s; the table needs turn_offsets_deg to reach there, e.g. [-20, 4]), and every LQR of the table flown under a rollout guard: each step the airframe's equations fly the LQR over rollout_horizon_s, and if it leaves the envelope, candidates that hold a (throttle, healthy elevon) pair for rollout_guard_holds_s and then fly the LQR are flown too, and the best one's first command is sent; beyond the wide box, as rollout; ``rollout``, the rocking law, which every step flies the airframe's equations over rollout_horizon_s under each of a set of bang-bang histories of the throttle and the healthy elevon (rollout_elevon_levels, rollout_switch_s) and sends the first command of the one that stays inside the validity envelope longest (on the linear plant its linear model flies them; ``ftc_mc/core/sixdof/lockturn.py``; with the default 5 levels, 190 histories, at most 11,400 RK4 steps per lane and step while it flies). It flies only where the table's two designs about the estimate (its last two beyond its ends) have no steady flight, so turn_offsets_deg must reach past the airframe's steady band (x8-gryte2018: [-20, 10])."""
+    """Where no steady flight exists about the lock: hold, rollout or guarded (docs/reference/config.md#the-rocking-law-and-the-rollout-guard)."""
     rollout_horizon_s: Pos = 3.0
     """rollout: how far ahead each candidate history is flown [s] (a multiple of model.dt_s)."""
     rollout_switch_s: tuple[Pos, ...] = (0.2, 1.0)
-    """rollout: times at which a candidate history switches from its first (throttle, healthy elevon) pair to its second [s] (distinct multiples of model.dt_s, below rollout_horizon_s; []: the held pairs only); each adds 2 levels (2 levels - 1) candidates to the 2 levels held pairs (30 to 6 with 3 levels)."""
+    """rollout: times at which a candidate history switches to its second pair [s]; []: held pairs only."""
     rollout_elevon_levels: Annotated[int, NoBool, Field(ge=2, le=9)] = 5
-    """rollout: positions of the healthy elevon in the candidates, evenly spaced from its lower to its upper limit (with the throttle's two limits, 2 x levels pairs: each held, and per switch time every ordered pair of two; 3 levels give 66 candidates, 5 give 190; on x8-pyfly 5 keep 38 of 312 locks from -20 to -10 deg in, where 3 keep 6, docs/airframes.md)."""
+    """rollout: positions of the healthy elevon in the candidates, from its lower to its upper limit."""
     rollout_guard_holds_s: tuple[Pos, ...] = (0.2, 0.5, 1.0)
-    """guarded: how long each of the guard's candidates holds its (throttle, healthy elevon) pair before the LQR takes over [s] (distinct multiples of model.dt_s, below rollout_horizon_s; at least one); with 5 elevon levels, 10 pairs each."""
+    """guarded: how long each guard candidate holds its pair before the LQR takes over [s]."""
     rollout_guard_bank_margin_deg: Annotated[float, NoBool, Field(ge=0.5, le=30, allow_inf_nan=False)] = 10.0
-    """guarded, and every table on the linear model (turn_model): room the designs about steady flights outside the design box leave below validity.bank_max_deg [deg] (the other bounds keep 0.5 m/s or deg). On x8-pyfly, locks from -15 to -10 deg, 150 per side: 0.5 keeps 214 of 300 in for 60 s (designs at 59.5 deg of bank, which the noise tips over 60), 2 to 8 keep 244-255, 10 keeps 258 (245 on another seed, against 195 with 0.5), 12 keeps 241, 15 (the design box's 45 deg) 172. x8-gryte2018 needs 15: inside its trimmable set 62.7 / 63.1 % stay in, against 58.2 / 57.7 % with 10 (docs/airframes.md)."""
+    """Bank room [deg] below validity.bank_max_deg of designs outside the design box (docs/reference/config.md#the-rocking-law-and-the-rollout-guard)."""
     rollout_substeps: Annotated[int, NoBool, Field(ge=1, le=100)] = 2
-    """rollout: RK4 sub-steps per control period of those flights (the trials' truth uses 10); a sub-step (model.dt_s / rollout_substeps) must be at most 0.05 s: x8-pyfly's roll mode, -38.5 1/s, then gives h lambda = 1.9, inside RK4's 2.8."""
+    """rollout: RK4 sub-steps per control period of those flights (a sub-step of at most 0.05 s)."""
 
     @model_validator(mode="after")
     def _ordered(self):
@@ -554,7 +526,7 @@ DEFAULT_SENSOR_BIAS = {
 
 
 class SensorDrawsConfig(_Strict):
-    """Sizes of the sensor faults of ``sensor_<kind>:<output>`` transitions (issue 14).
+    """Sizes of the sensor faults of ``sensor_<kind>:<output>`` transitions.
 
     Each trial's size is the first draw of its stream: a magnitude uniform in
     ``[low, high]`` with a random sign (one uniform draw over (-1, 1): its sign
@@ -563,23 +535,11 @@ class SensorDrawsConfig(_Strict):
     """
 
     bias: dict[str, SizeRange] = Field(default_factory=lambda: dict(DEFAULT_SENSOR_BIAS))
-    """Bias magnitude range per output, in its unit (rad/s, g, rad, m/s, m); outputs
-    left out keep their default.  Defaults from typical small-UAV sensors: gyro
-    1-5 deg/s (InvenSense MPU-6000 datasheet: initial zero-rate output +-20 deg/s;
-    ICM-20602: +-1 deg/s), accelerometer 20-80 mg (MPU-6000 zero-g offset +-50 mg
-    x/y, +-80 mg z), pitot airspeed 0.5-2 m/s (TE Connectivity MS4525DO, 1 psi:
-    +-0.25 % full scale, about 1 m/s at 20 m/s after calibration), vane angle of
-    attack 1-3 deg (typical vane alignment error), attitude 1-3 deg and flight
-    path 0.5-2 deg (AHRS/INS error of a MEMS unit, e.g. Analog Devices ADIS16470
-    class), GNSS position 1-5 m and velocities 0.2-1 m/s (u-blox NEO-M8: 2.5 m CEP,
-    0.05 m/s speed; wind makes body velocities worse)."""
+    """Bias magnitude range per output, in its unit; outputs left out keep their default (docs/reference/config.md#sensor-fault-sizes)."""
     drift_per_s: Pos = 0.1
-    """Drift rate range = this x the bias range, per second [1/s]: the drift
-    reaches the bias range after 10 s, the judging window (MEMS temperature drift
-    over a flight, MPU-6000: +-20 deg/s over -40..85 C)."""
+    """Drift rate range = this x the bias range, per second [1/s] (the bias range after 10 s)."""
     noise_factor: SizeRange = (2.0, 10.0)
-    """Range of the factor on the output's measurement noise standard deviation
-    (a vibrating mount or a failing sensor; factor >= 0)."""
+    """Range of the factor on the output's measurement noise standard deviation."""
 
     @field_validator("bias")
     @classmethod
@@ -621,12 +581,12 @@ RESERVED_DESIGN_NAMES = (*BUILTIN_DESIGNS, "both", "none")
 
 
 class DesignConfig(_Strict):
-    """A detection design (issue 13): estimator model x residual test x thresholds."""
+    """A detection design: estimator model x residual test x thresholds."""
 
     estimator: Literal["paper", "gust_aware"] = "paper"
-    """paper: the 14-state filter of eqs. 4-6; gust_aware: plus the 4 Dryden gust states (docs/architecture.md)."""
+    """paper: the 14-state filter of eqs. 4-6; gust_aware: plus the 4 Dryden gust states."""
     prediction: Literal["linear", "nonlinear"] = "linear"
-    """linear: the model of eq. 5; nonlinear: the airframe's equations predict the states and outputs (an extended filter; covariance with the trim Jacobians)."""
+    """linear: the model of eq. 5; nonlinear: the airframe's equations predict (an extended filter)."""
     design_turbulence: Literal["light", "moderate", "severe"] = "moderate"
     """Dryden level of the gust states' process noise and initial covariance (gust_aware only)."""
     test: Literal["one_step", "glr"] = "one_step"
@@ -634,13 +594,13 @@ class DesignConfig(_Strict):
     window_s: Pos = 2.0
     """GLR window [s] (a multiple of model.dt_s; glr only)."""
     settle_s: NonNeg = 0.0
-    """After a reset, the other block is not reset for this long [s] while the filter re-converges (a multiple of model.dt_s; 0: no wait)."""
+    """After a reset, the other block is not reset for this long [s]; 0: no wait."""
     startup_s: NonNeg = 0.0
-    """The test is armed this long after the flight's start [s] (a multiple of model.dt_s): before it no block is reset and the GLR window stays empty, so the filter's start-up transient (the truth meets its initial gust at trim) is not tested; 0: armed at once (issue 25)."""
+    """The test is armed this long after the start [s]; 0: at once (docs/reference/config.md#detection-designs)."""
     min_change_s: Pos | None = None
-    """Shortest change the GLR tests [s] (a multiple of model.dt_s, at most window_s): a one-step outlier is not a persistent change (it is divided by this length, not removed: innovation_clip limits it); null: one step (glr only)."""
+    """Shortest change the GLR tests [s] (at most window_s); null: one step (glr only)."""
     innovation_clip: Pos | None = None
-    """Each signed normalised innovation enters the GLR window clipped to [-c, c] (glr only): a single step's outlier, such as the n_x spike of a sharp vertical gust (lift's alpha^2 term), then adds at most c to a window's sum, while a persistent change still adds up; null: no clip (docs/designs.md)."""
+    """Clip each normalised innovation to [-c, c] in the GLR window (glr only); null: no clip (docs/reference/config.md#detection-designs)."""
     signature: Literal["paper", "swapped"] = "swapped"
     """Table 1 as printed (paper) or with its third clause swapped."""
     t_q: Pos = 25.0
@@ -652,36 +612,36 @@ class DesignConfig(_Strict):
     sigma_qb: Pos | None = None
     """Filter random-walk density of the fault parameters; null: estimator.sigma_qb."""
     state_noise: dict[Literal[STATE_NAMES], NonNeg] = Field(default_factory=dict)
-    """Extra filter process-noise standard deviation per step on named plant states (u, w [m/s], q [rad/s], ...): an allowance for the airframe model's error; {} adds none."""
+    """Extra filter process-noise standard deviation per step on named plant states (u, w, q, ...); {}: none."""
     relinearise_s: Pos | None = None
-    """prediction: nonlinear only: every this many seconds [s], the covariance's Jacobians are re-computed, the state map's about the lane's estimate and the outputs' about its prediction (an extended Kalman filter; a multiple of model.dt_s); null: the Jacobians at trim."""
+    """prediction nonlinear: re-compute the covariance's Jacobians every this many s (an EKF); null: at trim."""
     sensor_biases: list[Literal[BIASED_OUTPUTS]] = Field(default_factory=list)
-    """Outputs whose sensor bias the filter estimates (issue 14; q, n_x, n_z: the residuals' sensors): a bias opens, like a fault block, when Table 1 resets the block sharing its residual (n_x with thrust; q and n_z with elevons); [] estimates none."""
+    """Outputs whose sensor bias the filter estimates (of q, n_x, n_z); []: none (docs/reference/config.md#detection-designs)."""
     sensor_bias_sd: dict[Literal[BIASED_OUTPUTS], Pos] = Field(default_factory=dict)
-    """Standard deviation a bias takes when its hypothesis opens, per output [rad/s, g]; outputs left out take the largest bias of a typical small-UAV sensor (q 5 deg/s, n_x and n_z 80 mg: the upper ends of sensor_draws' defaults)."""
+    """Standard deviation a bias takes when its hypothesis opens, per output [rad/s, g]; left out: a typical sensor's."""
     sensor_bias_walk: dict[Literal[BIASED_OUTPUTS], NonNeg] = Field(default_factory=dict)
-    """Random-walk density of each estimated bias per sqrt(s), as a fraction of the output's measurement-noise standard deviation; outputs left out take q 0.3, n_z 0.3 (a bias too small for Table 1 is still learnt in the 30 s after it), n_x 0.05 (faster, it would hide small thrust losses); issue 14's note. The biases start at 0 with that standard deviation (a calibrated sensor)."""
+    """Random-walk density of each bias per sqrt(s), in measurement-noise sds (docs/reference/config.md#detection-designs)."""
     reset_scale: Pos = 1.0
-    """Factor on the variances a covariance reset gives the reset block's fault parameters (section 3.2.2; both blocks): 1, the paper's ((u_max - u_min)/t)^2 for b0 and 1/t^2 for b1 (a standard deviation of 0.04 on b1 at t = 25, against a change of up to 1); t^2/12 (52.08 at t = 25), the variance of a uniform distribution over each parameter's range, which the paper says a reset should allow for ('all the possible values'). A larger reset lets one reset and its excitation carry the estimate the whole way to a recovered actuator (docs/recoveries.md)."""
+    """Factor on the variances a covariance reset gives the fault parameters (docs/reference/config.md#detection-designs)."""
     excitation_policy: Literal[EXCITATION_POLICIES] = "none"
-    """Excitation beyond the paper's requests on resets (issue 25; docs/designs.md): none, the paper's (a doublet on a thrust reset, a 3211 on an elevon reset, the doublet re-check); periodic: also the engine doublet every excitation_period_s and the elevon 3211 half a period after each; ambiguous: also one of them (the other than the last sent) when the belief's most probable mode is below excitation_belief or r_q or r_nx reach excitation_residual, at most once per excitation_period_s. A signal is only sent while none runs; the excitation section sets both signals, but for the amplitudes a design sets itself (doublet_amplitude, s3211_amplitude_rad)."""
+    """Excitation beyond the paper's on resets: none, periodic or ambiguous (docs/reference/config.md#excitation)."""
     doublet_amplitude: DoubletAmplitude | None = None
-    """This design's engine doublet amplitude [throttle fraction], on resets and by its policy alike; null: the excitation section's (issue 25: a larger periodic signal finds smaller losses, at a measured tracking cost, docs/designs.md)."""
+    """This design's engine doublet amplitude [throttle fraction]; null: the excitation section's."""
     s3211_amplitude_rad: S3211Amplitude | None = None
     """This design's elevon 3211 amplitude [rad], on resets and by its policy alike; null: the excitation section's."""
     s3211_floor: Annotated[float, NoBool, Field(ge=0, le=1, allow_inf_nan=False)] = 0.0
-    """Under c2 the elevon 3211 is scaled by max(1 - b1_left_hat, s3211_floor) (issue 25; docs/recoveries.md): 0, eq. 23 as printed, which sends nothing to a left elevon estimated locked (b1_left_hat ~ 1), so a lock that clears at its trim command is never seen; a floor keeps a share of the 3211 on it."""
+    """Under c2 the elevon 3211 is scaled by max(1 - b1_left_hat, s3211_floor) (docs/reference/config.md#excitation)."""
     excitation_period_s: Pos = 5.0
-    """periodic: time between two doublets [s] (a multiple of model.dt_s, at least twice the longer signal, so they never overlap); ambiguous: the shortest time from a signal's start to the next one sent."""
+    """periodic: time between two doublets [s]; ambiguous: shortest time between two signals."""
     excitation_phase_s: NonNeg = 0.0
-    """periodic: the doublets start at this time plus whole periods [s] (a multiple of model.dt_s, below excitation_period_s); the 3211s half a period later."""
+    """periodic: the doublets start at this time plus whole periods [s]; the 3211s half a period later."""
     excitation_belief: Annotated[float, NoBool, Field(ge=0, le=1, allow_inf_nan=False)] = 0.9
     """ambiguous: send while the belief's most probable mode has a probability below this (0: never on the belief)."""
     excitation_residual: Pos | None = None
-    """ambiguous: send when r_q or r_nx (the design's decision statistics: one-step residuals or GLR) reach this; null: never on the residuals. Below Table 1's thresholds it excites a suspected change before it is decided."""
+    """ambiguous: send when r_q or r_nx reach this; null: never on the residuals."""
 
     controller: ControllerKind | None = None
-    """Controller of this design's flights: nominal (c0 throughout), reconfiguring (c0/c1/c2 chosen by eqs. 45-47), lock_turn (6-DOF plant: reconfiguring until the side monitor names an elevon, then the lock-turn controller of that side; the monitor also decides which block Table 1's resets open) or lock_turn_selected (6-DOF plant: eqs. 45-47 choose among c0, c1 and the left and right lock-turn controllers c2, c3 on the side monitor's belief), so one campaign compares them on the same trials; null: the controller section's kind."""
+    """Controller of this design's flights (as controller.kind); null: the controller section's kind."""
 
     @model_validator(mode="after")
     def _biases(self):
@@ -769,9 +729,7 @@ class CampaignConfig(_Strict):
 
     transitions: list[TransitionName] = Field(default_factory=lambda: ["elevon_lock"],
                                               min_length=1)
-    """Transitions to run (elevon, right_elevon or engine x lock, unlock, loss, loss_recover; elevon is the paper's left elevon), or
-    sensor faults ``sensor_<kind>:<output>`` (kind bias, stuck, drift, noise; output
-    one of the 12, e.g. ``sensor_bias:q``) from nominal at timing.fault_time_s."""
+    """Transitions: <elevon|right_elevon|engine>_<lock|unlock|loss|loss_recover>, or sensor_<kind>:<output>."""
     trials: Annotated[int, NoBool, Field(gt=0, le=10_000_000)] = 1000
     """Trials per transition."""
     seed: Annotated[int, NoBool, Field(ge=0, lt=2 ** 63)] = 2026
@@ -785,7 +743,7 @@ class CampaignConfig(_Strict):
     max_resets: Annotated[int, NoBool, Field(gt=0, le=100_000)] | None = None
     """Resets stored per trial (more are counted, not stored); null: one per step, all."""
     reset_log: str = "all"
-    """Resets written to resets.parquet: all, none or first-N (the first N per trial and design); trials and summary do not depend on it."""
+    """Resets written to resets.parquet: all, none or first-N (per trial and design)."""
 
     @field_validator("reset_log")
     @classmethod
@@ -837,7 +795,7 @@ class Config(_Sampled):
     monitor: MonitorConfig = Field(default_factory=MonitorConfig)
     sensor_draws: SensorDrawsConfig = Field(default_factory=SensorDrawsConfig)
     designs: Designs = Field(default_factory=dict)
-    """Detection designs compared on the same trials (issue 13): name -> design; run them with campaign.designs or --design NAME."""
+    """Detection designs compared on the same trials: name -> design; run them with campaign.designs or --design NAME."""
 
     @model_validator(mode="after")
     def _steps(self):
@@ -916,7 +874,7 @@ class SensorFaultEvent(_Strict):
     time_s: NonNeg
     """Onset [s] (a multiple of model.dt_s)."""
     kind: Literal[SENSOR_FAULT_KINDS]
-    """``bias`` (a step), ``stuck`` (frozen at its last healthy value), ``drift`` (a ramp) or ``noise`` (the noise multiplied)."""
+    """bias (a step), stuck (frozen), drift (a ramp) or noise (the noise multiplied)."""
     output: Literal[OUTPUT_NAMES]
     """Faulty output (u, w, q, x, z, theta, n_x, n_z, alpha, gamma, CAS, Va)."""
     size: Finite | None = None
@@ -942,7 +900,7 @@ class ScenarioSpec(_Strict):
     seed: Annotated[int, NoBool, Field(ge=0, lt=2 ** 63)] = 2026
     """Seed of the process and measurement noise."""
     signature: Literal["paper", "swapped"] = "swapped"
-    """Table 1 variant (swapped: fewer inappropriate resets in ftc-mc run, see docs)."""
+    """Table 1 variant (swapped: fewer inappropriate resets in ftc-mc run, docs/findings/paper-tables.md)."""
     design: str | None = None
     """A key of the designs section flown instead of the signature variant (null: the variant)."""
     reconfiguration_period_s: Pos = 1.0
@@ -989,7 +947,7 @@ class ScenarioConfig(_Sampled):
     validity: ValidityConfig = Field(default_factory=ValidityConfig)
     monitor: MonitorConfig = Field(default_factory=MonitorConfig)
     designs: Designs = Field(default_factory=dict)
-    """Detection designs (issue 13): name -> design; fly one with scenario.design or --design NAME."""
+    """Detection designs: name -> design; fly one with scenario.design or --design NAME."""
 
     @model_validator(mode="after")
     def _steps(self):
