@@ -20,6 +20,7 @@ import math
 
 import numpy as np
 
+from ..cache.engine_tables import cached_engine_tables
 from ..config.schema import Config, ScenarioConfig
 from ..conventions import LONGITUDINAL, VARIANTS
 from ..core.shared.interp import EngineTables
@@ -28,14 +29,14 @@ from ..core.longitudinal.settings import (Belief, Controller, Detection, Excitat
                                           Validity)
 from ..design.lqr import discounted_lqr, paper_q_lqr
 from ..design.terminal import terminal_costs
-from ..design.theorem41 import cached_engine_tables
 from ..model.linear import LinearPlant
 from ..model.source import load_plant
 from ..model.turbulence import DrydenModel
 from .designs import NO_POLICY, Design, build_designs
 from .estimator import (EstimatorSettings, belief_settings, detection, filter_model,
                         initial_covariance)
-from .truth import lateral_noise, sixdof_truth_plant, truth_plant
+from .noise import lateral_noise
+from .truth import sixdof_truth_plant, truth_plant
 
 CONTROLLER_KINDS = {"nominal": 0, "reconfiguring": 1, "lock_turn": 2, "lock_turn_selected": 3}
 """``Reconfig.kind`` of each controller kind (``controller.kind``, a design's
