@@ -298,7 +298,7 @@ class CloneFolderLocator(ContentCacheLocator):
 
     Numba's own locator keys such a kernel on its file's absolute path and its
     file's stamp alone: a new clone compiles every test kernel again (15 s of
-    the test suite's CPU, measured stop 42), and an edit of a file it inlines
+    the test suite's CPU, measured), and an edit of a file it inlines
     (``tests/single_trajectory.py`` from ``tests/test_soak.py``) would load it
     stale.  Here the folder and the stamp follow the content of the kernel
     sources (:func:`full_source_digest`) and of every file of

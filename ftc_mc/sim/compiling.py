@@ -52,12 +52,12 @@ EXPECTED_COMPILE = {LinearPlant: "30 s", NonlinearPlant: "30 s",
 """What the compile notice says a path's cold compile takes, by its plant marker
 (``core/shared/paths.py``), on 2 cores with the compile helper
 (:mod:`ftc_mc.sim.compile_helper`), each path on an empty cache
-(``scripts/benchmarks/bench_compile.py``, stop 44, once the stages were called by
+(``scripts/benchmarks/bench_compile.py``, once the stages were called by
 address: ``docs/performance.md`` lesson 17): the default (linear) path 22.8 s
 (``scripts/benchmarks/bench_campaign.py``'s ``compile_s``, setup included: 24.0-25.8 s),
 the paper's design on the nonlinear plant 21.8 s, ``robust`` 28.8 s, the
-paper's design on the 6-DOF plant 32.8 s; at stop 45 the same 33.6 and
-36.1 s, and the paper's design on the 6-DOF plant with the extended side
+paper's design on the 6-DOF plant 32.8 s; measured again later, the same 33.6
+and 36.1 s, and the paper's design on the 6-DOF plant with the extended side
 monitor (``configs/sixdof_moderate.yaml``) 34.5 and 33.7 s."""
 
 

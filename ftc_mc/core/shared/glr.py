@@ -1,4 +1,4 @@
-"""Windowed GLR test of the residuals for a persistent change (issue 13).
+"""Windowed GLR test of the residuals for a persistent change.
 
 The paper tests one step: ``r_i = mu_i^2 / S_ii`` against its threshold (eqs.
 9-11, Table 1).  A fault that shifts an innovation by less than its standard
