@@ -3,7 +3,7 @@
 The one home of every name list and index the rest of the package shares, so a
 kernel, a table and a report agree on what "index 11" or "mode 2" means.  Pure
 Python constants (Numba reads module-level ints and tuples as compile-time
-constants).  See ``docs/paper-map.md`` for the paper's symbols.
+constants).  See ``docs/reference/paper-map.md`` for the paper's symbols.
 
 Plant and filter (docs/airframes.md, paper eqs. 1-5)
 ------------------------------------------------------
@@ -179,7 +179,7 @@ STATUS_NAMES = ("ok", "nonfinite", "covariance_not_psd", "airspeed_out_of_bounds
 # ------------------------------------------------------------------ campaigns, plants
 PAPER_TRANSITIONS = ("elevon_lock", "elevon_unlock", "elevon_loss", "elevon_loss_recover",
                      "engine_lock", "engine_unlock", "engine_loss", "engine_loss_recover")
-"""The eight transitions of Tables 2-3 (docs/paper-map.md); their faulty elevon is
+"""The eight transitions of Tables 2-3 (docs/reference/paper-map.md); their faulty elevon is
 the left one, as in the paper."""
 RIGHT_ELEVON_TRANSITIONS = ("right_elevon_lock", "right_elevon_unlock", "right_elevon_loss",
                             "right_elevon_loss_recover")

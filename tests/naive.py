@@ -18,7 +18,7 @@ each stage of a trial step (``commands_ref``, ``truth_step_ref``,
 (``advance_ref``).
 
 Paper: "Reconfiguration control method for non-redundant actuator faults on UAV"
-(``docs/paper-map.md`` maps it to the code), sections 2-5.
+(``docs/reference/paper-map.md`` maps it to the code), sections 2-5.
 
 Conventions (``ftc_mc.model.faults``): augmented state
 ``X = [x (9), b0 (2), b1 (3)]`` with ``b0 = [thrust, elevon sum]`` and
@@ -65,7 +65,7 @@ class RefModel:
     t_q, t_nx : float
         Thresholds of Table 1.
     variant : str
-        ``"paper"`` or ``"swapped"`` (``docs/paper-map.md``).
+        ``"paper"`` or ``"swapped"`` (``docs/reference/paper-map.md``).
     reset_var : ndarray, shape (5,)
         Variances after a reset (section 3.2.2).
     """

@@ -141,7 +141,7 @@ def classify(spec: ChunkSpec, tr_name: str, variant: str, trial_ids, values,
              inp: TrialInputs, rec: TrialRecord):
     """Per-trial and per-reset columns of one kernel call.
 
-    Definitions (docs/paper-map.md), with ``k_f`` the switch step and the
+    Definitions (docs/reference/paper-map.md), with ``k_f`` the switch step and the
     window the steps ``k_f < k <= k_f + spec.window``:
 
     * ``correct``: the transition's block was reset in the window;

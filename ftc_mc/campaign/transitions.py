@@ -1,7 +1,7 @@
 """The fault transitions of Tables 2-3 and the ranges of their fault draws.
 
 A transition names the actuator (the paper's eight rows fault the left elevon,
-``docs/paper-map.md``; the ``right_elevon_*`` rows, the same four
+``docs/reference/paper-map.md``; the ``right_elevon_*`` rows, the same four
 elevon rows on the right elevon), the fault kind (lock or loss of effectiveness) and the direction
 (``onset``: nominal -> faulty; ``recovery``: faulty -> nominal).  Its trials fly
 a two-entry schedule (:meth:`Transition.schedule`): the initial mode from the

@@ -38,7 +38,28 @@ changes the flight before any reset, so it is part of the design key.
 
 A design changes only what the filter assumes: the truth noise of every trial
 comes from the config's ``estimator`` and ``noise`` sections, so all designs fly
-the same trials (common random numbers).
+the same trials (common random numbers); :func:`ftc_mc.sim.inputs.design_inputs`
+only pads the initial estimate with zeros and sets the design's ``P0``.  The
+truth starts at trim with a stationary gust draw, which the filter's first
+steps do not match: a design's ``startup_s`` (``Detection.startup``) arms its
+test only after that.  Histories keep the first 14 states, ``xa_end`` all of
+them (a sensor-aware design's final bias estimates, for
+:func:`ftc_mc.campaign.chunk.classify_sensor`'s ``isolated``).  The results'
+``variant`` column holds the design's name; ``paper`` is the baseline of the
+report's paired comparisons.
+
+In the kernels (``core/longitudinal/stages.filter_update``) the paper's
+14-state filter with a linear prediction runs the block-structured
+``batch.filter_predict_lanes`` / ``filter_correct_lanes`` (the golden results);
+anything else runs ``gustfilter.gust_predict_lanes`` / ``gust_correct_lanes``:
+dense ``F P F^T + Q`` and ``P c^T`` over every lane, and with
+``FilterModel.nl`` the airframe's RK4 predicting the plant states and ``h(x,
+wind)`` the outputs.  Between the halves the decision statistics are the
+one-step residuals or, with the GLR test, ``glr.glr_lanes`` over the lane's
+window (a reset empties it; each innovation is clipped to ``Detection.clip``,
+``inf`` without ``innovation_clip``).  The controller selection predicts with
+the paper's model on the first 14 states.  ``state_noise`` adds process noise
+on named plant states (the airframe model's error in turbulence).
 """
 
 from __future__ import annotations

@@ -183,7 +183,7 @@ def relinearise_outputs_lanes(xa, fm, st, tw):
     Taken about the estimate ``X_{k|k}`` instead, as before, they lagged the
     update by a step, and the re-linearised filter reset the thrust block 674
     times in 39.4 fault-free hours of moderate turbulence (38 about the
-    prediction; ``docs/designs.md``)."""
+    prediction; ``docs/findings/turbulence-designs.md``)."""
     xabs = tw.xabs
     wl = tw.wl
     y = tw.y

@@ -165,7 +165,7 @@ Timing = namedtuple("Timing", [
     "reconf_every",   # steps between belief updates (reconfiguration period)
     "detect_prob",    # belief of the final mode that counts as detected
 ])
-"""Trial timing (Tables 2-3; ``docs/paper-map.md``)."""
+"""Trial timing (Tables 2-3; ``docs/reference/paper-map.md``)."""
 
 TrialInputs = namedtuple("TrialInputs", [
     "k_switch",   # (E,) int64 steps at which the truth switches, k_switch[0] == 0

@@ -29,7 +29,7 @@ inlining) into the loop of one kernel,
 address once per reconfiguration period (``kernel(by_address=True)``,
 :mod:`ftc_mc.core.linking`), as it calls :func:`reconfigure`: each is compiled
 once, on its own, not again inside ``advance``, and a period costs one call,
-not one per stage or step (``docs/performance.md`` lesson 17).  Where the compile paths
+not one per stage or step (``docs/findings/performance.md`` lesson 17).  Where the compile paths
 part (``core/shared/paths.py``) a dispatcher compiles the one kernel its path
 reaches, also called by address.  The stages remain
 callable on their own (the tests do).

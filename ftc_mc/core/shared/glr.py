@@ -23,7 +23,7 @@ Each innovation may enter the window clipped to ``[-c, c]``
 Statistics*, 1981, section 4.5): the sum then grows by at most ``c`` per step,
 so one step's outlier of many standard deviations (the n_x spike of a sharp
 vertical gust, whose alpha^2 term the filter's linearisation does not see;
-docs/designs.md) no longer passes a threshold alone, while a persistent shift
+docs/findings/turbulence-designs.md) no longer passes a threshold alone, while a persistent shift
 ``nu < c`` is summed unchanged.
 
 Plain-NumPy twin: ``tests/naive.py::glr_ref``.
