@@ -1,6 +1,7 @@
 """Flying on with one elevon in the trial loop (``ftc_mc/core/sixdof/lockturn.py``):
-the law against its plain-NumPy twin, the design table's cache, a campaign in which the ``lock_turn`` design keeps locked trials in the
-envelope where the paper's loop does not, and the configs that cannot fly it."""
+the law against its plain-NumPy twin, the design table's cache, a campaign in
+which the ``lock_turn`` design keeps locked trials in the envelope where the
+paper's loop does not, and the configs that cannot fly it."""
 
 from __future__ import annotations
 

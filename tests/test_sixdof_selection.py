@@ -1,7 +1,7 @@
 """The selection among the four 6-DOF controllers (``ftc_mc/core/sixdof/selection.py``):
-eq. 45's prediction and eq. 47's choice against their plain-NumPy twins, the belief's boxes on the side monitor's six parameters,
-the terminal costs' order, the compile path, and a campaign in which the
-selection flies on after locks."""
+eq. 45's prediction and eq. 47's choice against their plain-NumPy twins, the
+belief's boxes on the side monitor's six parameters, the terminal costs' order,
+the compile path, and a campaign in which the selection flies on after locks."""
 
 from __future__ import annotations
 

@@ -29,9 +29,10 @@ def engine_tables_key(plant, b0_grid=None, b1_grid=None, Q=None, R=None, alpha=N
     """SHA-256 cache key of every input of :func:`~ftc_mc.design.theorem41.engine_fault_tables`.
 
     Covers ``A``, ``B``, ``u0``, both grids, ``Q``, ``R``, ``alpha``,
-    :data:`~ftc_mc.design.theorem41.TABLES_VERSION` and the OpenBLAS kernels in force (``ftc_mc/blas.py``:
-    tables computed with other kernels differ in their last bits), defaults
-    resolved first, so passing a default explicitly gives the same key.
+    :data:`~ftc_mc.design.theorem41.TABLES_VERSION` and the OpenBLAS kernels in
+    force (``ftc_mc/blas.py``: tables computed with other kernels differ in
+    their last bits), defaults resolved first, so passing a default explicitly
+    gives the same key.
 
     Returns
     -------
@@ -63,8 +64,8 @@ def cached_engine_tables(plant, b0_grid=None, b1_grid=None, Q=None, R=None, alph
     plant, b0_grid, b1_grid, Q, R, alpha
         As in :func:`~ftc_mc.design.theorem41.engine_fault_tables`.
     cache_dir : str or Path, optional
-        Cache root; default :func:`~ftc_mc.cache.store.default_cache_dir` (``~/.cache/ftc-mc/design``,
-        or ``$FTC_MC_CACHE_DIR/design``).
+        Cache root; default :func:`~ftc_mc.cache.store.default_cache_dir`
+        (``~/.cache/ftc-mc/design``, or ``$FTC_MC_CACHE_DIR/design``).
 
     Returns
     -------

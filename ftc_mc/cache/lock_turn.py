@@ -25,12 +25,12 @@ from .store import default_cache_dir, design_key, write_atomic
 def lock_turn_designs_key(airframe: Airframe, offsets, V0: float, gamma0_deg: float,
                           dt: float, wide: DesignBox | None = None,
                           linear: bool = False) -> str:
-    """SHA-256 cache key of every input of :func:`~ftc_mc.design.lock_turn.lock_turn_designs`: the packed
-    6-DOF parameters and command limits of the airframe, the grid, the glide,
-    the period, the default design box and weights, the wide box if any, the
-    linear model if designed on it,
-    :data:`~ftc_mc.design.lock_turn.LOCK_TURN_TABLE_VERSION` and the OpenBLAS kernels in force
-    (``ftc_mc/blas.py``)."""
+    """SHA-256 cache key of every input of
+    :func:`~ftc_mc.design.lock_turn.lock_turn_designs`: the packed 6-DOF
+    parameters and command limits of the airframe, the grid, the glide, the
+    period, the default design box and weights, the wide box if any, the linear
+    model if designed on it, :data:`~ftc_mc.design.lock_turn.LOCK_TURN_TABLE_VERSION`
+    and the OpenBLAS kernels in force (``ftc_mc/blas.py``)."""
     parts = [repr((DesignBox(), DesignWeights(), TurnWeights(), ALPHA, LOCK_TOLERANCE))]
     if wide is not None:
         parts.append(f"wide:{wide!r}")

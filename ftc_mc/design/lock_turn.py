@@ -58,7 +58,8 @@ with the locked elevon's command its lock position.
 
 5. **Table** (:func:`lock_turn_designs`): the designs of both sides
    over a uniform grid of lock offsets, computed once per airframe and cached
-   on disk (:func:`ftc_mc.cache.lock_turn.cached_lock_turn_designs`); the ``lock_turn`` controller of the trial loop flies them,
+   on disk (:func:`ftc_mc.cache.lock_turn.cached_lock_turn_designs`); the
+   ``lock_turn`` controller of the trial loop flies them,
    interpolated on the side monitor's lock estimate, with measurements in
    place of the oracle's true state (:mod:`ftc_mc.core.sixdof.lockturn`).
 6. **On the linear plant** (``monitor.turn_model: linear``, or ``auto``

@@ -1,7 +1,8 @@
 """Which elevon locks can any controller fly on from? The recoverable set.
 
-Feeds ``docs/findings/sixdof.md``.  A lock is *trimmable* (``ftc_mc.model.trimmable``) when a
-steady flight exists with it inside the validity envelope.  That does not
+Feeds ``docs/findings/sixdof.md``.  A lock is *trimmable*
+(``ftc_mc.model.trimmable``) when a steady flight exists with it inside the
+validity envelope.  That does not
 make it *recoverable*: the aircraft must also get from the nominal glide to
 that steady flight without leaving the envelope, while the lock rolls and
 pitches it.  This study asks the question with perfect knowledge (an oracle:
