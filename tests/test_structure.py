@@ -102,6 +102,27 @@ def test_no_import_circles():
     assert not found, "import circles among ftc_mc modules:\n" + "\n".join(detail)
 
 
+def test_no_circles_between_packages():
+    """The packages (and the single modules of ``ftc_mc/``) form layers: a
+    package imports only from those below it, never one that imports it back."""
+    graph = import_graph()
+
+    def package(module):
+        return module.split(".")[1] if "." in module else module
+
+    between = {}
+    for a, targets in graph.items():
+        for b in targets:
+            if package(a) != package(b):
+                between.setdefault(package(a), set()).add(package(b))
+    found = circles(between)
+    assert not found, "import circles between ftc_mc packages: " + "; ".join(
+        " <-> ".join(c) + " (" + ", ".join(
+            f"{a} -> {b}" for a in sorted(graph) for b in sorted(graph[a])
+            if package(a) in c and package(b) in c and package(a) != package(b)) + ")"
+        for c in found)
+
+
 def test_the_circle_finder_finds_one():
     """The check can fail: a three-module circle is found, a module outside it is not."""
     graph = {"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}}

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..scenario.run import controller_names
+from ..sim.setup import controller_names
 from .figure import plt, save
 
 

@@ -22,7 +22,8 @@ import numpy as np
 
 from ..cache.engine_tables import cached_engine_tables
 from ..config.schema import Config, ScenarioConfig
-from ..conventions import LONGITUDINAL, VARIANTS
+from ..conventions import (CONTROLLER_NAMES, LONGITUDINAL, SELECTED_CONTROLLER_NAMES,
+                           VARIANTS)
 from ..core.shared.interp import EngineTables
 from ..core.longitudinal.settings import (Belief, Controller, Detection, Excitation, FilterModel,
                                           Flight, Reconfig, Scheme, Timing, Track, TruthPlant,
@@ -180,6 +181,13 @@ def runs_of(cfg: Config | ScenarioConfig) -> tuple:
     if isinstance(cfg, ScenarioConfig):
         return (cfg.scenario.design or cfg.scenario.signature,)
     return cfg.campaign.runs()
+
+
+def controller_names(sc: ScenarioConfig) -> tuple:
+    """The names of the controller codes a scenario's design flies: the
+    paper's three, or the four of a ``lock_turn_selected`` design."""
+    selected = sc.controller_of(runs_of(sc)[0]) == "lock_turn_selected"
+    return SELECTED_CONTROLLER_NAMES if selected else CONTROLLER_NAMES
 
 
 def timing_of(cfg: Config | ScenarioConfig) -> Timing:
