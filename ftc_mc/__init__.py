@@ -1,7 +1,7 @@
 """ftc-mc: Monte Carlo fault injection for indirect active fault-tolerant control.
 
 Implements "Reconfiguration control method for non-redundant actuator faults on
-UAV" on a Skywalker X8 model; see ``docs/paper-map.md``.  The Python API, one
+UAV" on a Skywalker X8 model; see ``docs/reference/paper-map.md``.  The Python API, one
 function per command (see :mod:`ftc_mc.api`)::
 
     import ftc_mc

@@ -118,7 +118,7 @@ def _model_sixdof(spec, as_json, save, export, airspeed, gamma_deg, dt, suffix,
                   trimmable=False):
     """``ftc-mc model --dof 6``: the 6-DOF trim and named modes (its own import
     path, so a longitudinal ``model`` never loads the 6-DOF kernels); with
-    ``trimmable``, the trimmable sets (:func:`ftc_mc.model.sixdof.trimmable_summary`)."""
+    ``trimmable``, the trimmable sets (:func:`ftc_mc.model.trimmable.trimmable_summary`)."""
     from .io.atomic import atomic_path
     from .model.airframe_files import export_airframe
     from .model.presets import PRESETS, resolve_airframe
@@ -133,9 +133,11 @@ def _model_sixdof(spec, as_json, save, export, airspeed, gamma_deg, dt, suffix,
     plant = build_sixdof_plant(af, airspeed, gamma_deg, dt, where=f"airframe {spec}")
     summary = sixdof_summary(plant)
     if trimmable:
-        from .model.sixdof import trimmable_summary
+        from .cache.trimmable import cached_trimmable_sets
+        from .model.trimmable import trimmable_summary
 
-        summary["trimmable_set"] = trimmable_summary(plant, spec)
+        summary["trimmable_set"] = trimmable_summary(
+            plant, cached_trimmable_sets(plant.airframe, ("left", "right"), name=spec))
     source = str(PRESETS[spec].source) if spec in PRESETS else str(spec)
     if save is not None:
         with atomic_path(save) as tmp, open(tmp, "wb") as f:
@@ -143,8 +145,15 @@ def _model_sixdof(spec, as_json, save, export, airspeed, gamma_deg, dt, suffix,
     if export is not None:
         with atomic_path(export) as tmp:
             export_airframe(af, tmp, name=spec, source=source)
-    click.echo(json.dumps(summary, indent=2) if as_json
-               else format_sixdof_summary(summary, spec))
+    if as_json:
+        click.echo(json.dumps(summary, indent=2))
+    elif trimmable:
+        from .model.trimmable import format_trimmable_summary
+
+        click.echo(format_sixdof_summary(summary, spec) + "\n\n"
+                   + format_trimmable_summary(summary["trimmable_set"]))
+    else:
+        click.echo(format_sixdof_summary(summary, spec))
     for what, path in (("6-DOF linear model", save), ("airframe", export)):
         if path is not None and not as_json:
             click.echo(f"wrote the {what} to {path}")

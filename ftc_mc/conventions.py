@@ -3,7 +3,7 @@
 The one home of every name list and index the rest of the package shares, so a
 kernel, a table and a report agree on what "index 11" or "mode 2" means.  Pure
 Python constants (Numba reads module-level ints and tuples as compile-time
-constants).  See ``docs/paper-map.md`` for the paper's symbols.
+constants).  See ``docs/reference/paper-map.md`` for the paper's symbols.
 
 Plant and filter (docs/airframes.md, paper eqs. 1-5)
 ------------------------------------------------------
@@ -67,7 +67,7 @@ RESIDUAL_NAMES = ("r_q", "r_nx", "r_nz")
 """Normalised residuals of eqs. 9-11, on the outputs :data:`RESIDUAL_OUTPUTS`."""
 RESIDUAL_OUTPUTS = (OUT_Q, OUT_NX, OUT_NZ)
 BIASED_OUTPUTS = tuple(OUTPUT_NAMES[o] for o in RESIDUAL_OUTPUTS)
-"""Outputs whose sensor bias a sensor-aware design may estimate (issue 14)."""
+"""Outputs whose sensor bias a sensor-aware design may estimate."""
 
 NO_RESET = 0
 RESET_THRUST = 1
@@ -130,13 +130,13 @@ S3211_UNITS = (3, 2, 1, 1)
 
 EXCITATION_POLICIES = ("none", "periodic", "ambiguous")
 """When a design sends excitation beyond the paper's requests on resets
-(``Excitation.policy``, issue 25): ``none`` only those (the paper); ``periodic``
+(``Excitation.policy``): ``none`` only those (the paper); ``periodic``
 the doublet and the 3211 every period, staggered by half a period; ``ambiguous``
 one of them when the belief is unsure or a residual is high."""
 EXCITE_NONE, EXCITE_PERIODIC, EXCITE_AMBIGUOUS = range(len(EXCITATION_POLICIES))
 
 COST_NAMES = ("track_sq", "track_max") + tuple(f"u2_{n}" for n in INPUT_NAMES)
-"""Rows of ``TrialRecord.cost``, summed over the steps a trial flew (issue 25):
+"""Rows of ``TrialRecord.cost``, summed over the steps a trial flew:
 the squared glide-path cross-track error [m^2], its largest magnitude [m], then
 each command's squared deviation from trim [throttle^2, rad^2]."""
 N_COST = len(COST_NAMES)
@@ -179,11 +179,11 @@ STATUS_NAMES = ("ok", "nonfinite", "covariance_not_psd", "airspeed_out_of_bounds
 # ------------------------------------------------------------------ campaigns, plants
 PAPER_TRANSITIONS = ("elevon_lock", "elevon_unlock", "elevon_loss", "elevon_loss_recover",
                      "engine_lock", "engine_unlock", "engine_loss", "engine_loss_recover")
-"""The eight transitions of Tables 2-3 (docs/paper-map.md); their faulty elevon is
+"""The eight transitions of Tables 2-3 (docs/reference/paper-map.md); their faulty elevon is
 the left one, as in the paper."""
 RIGHT_ELEVON_TRANSITIONS = ("right_elevon_lock", "right_elevon_unlock", "right_elevon_loss",
                             "right_elevon_loss_recover")
-"""The four elevon rows with the right elevon faulty (issue 24; not in the paper)."""
+"""The four elevon rows with the right elevon faulty (not in the paper)."""
 TRANSITIONS = PAPER_TRANSITIONS + RIGHT_ELEVON_TRANSITIONS
 """Every actuator transition: the paper's eight, then the right elevon's four."""
 
@@ -203,7 +203,7 @@ OUTPUT_UNITS = ("m/s", "m/s", "rad/s", "m", "m", "rad", "g", "g", "rad", "rad", 
 (a drift: the unit per second)."""
 
 SENSOR_FAULT_KINDS = ("bias", "stuck", "drift", "noise")
-"""Sensor faults on one output (issue 14): ``bias`` a step of ``size``, ``stuck``
+"""Sensor faults on one output: ``bias`` a step of ``size``, ``stuck``
 frozen at its last healthy value, ``drift`` a ramp of ``size`` per second,
 ``noise`` the measurement noise multiplied by ``size``."""
 SENSOR_BIAS, SENSOR_STUCK, SENSOR_DRIFT, SENSOR_NOISE = range(len(SENSOR_FAULT_KINDS))

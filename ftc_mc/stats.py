@@ -22,7 +22,7 @@ import numpy as np
 def _scipy_stats():
     """``scipy.stats``, imported on first use: it takes 0.33 s, and the processes
     that import this module through the trial code (the parallel workers, the
-    scenario) mostly never call it (measured stop 42)."""
+    scenario) mostly never call it (measured)."""
     import scipy.stats
 
     return scipy.stats

@@ -135,12 +135,12 @@ def _quick_trimmable_sets(request, monkeypatch):
     """A run on the 6-DOF nonlinear plant with elevon-lock rows reports its
     survival inside and outside the airframe's equations' trimmable set, whose
     search takes a minute or two per airframe the first time
-    (``ftc_mc/design/trimmable_cache.py``).  Tests get the 6-DOF linear model's
+    (``ftc_mc/cache/trimmable.py``).  Tests get the 6-DOF linear model's
     exact set in its place (milliseconds, cached nowhere); a test marked
     ``trimmable_search`` gets the real search and cache."""
     if request.node.get_closest_marker("trimmable_search"):
         return
-    import ftc_mc.design.trimmable_cache as tc
+    import ftc_mc.cache.trimmable as tc
     from ftc_mc.model.sixdof import build_sixdof_plant
     from ftc_mc.model.trimmable import Envelope, linear_trimmable_set
 

@@ -36,7 +36,7 @@ CAMPAIGNS = {
                            "controller": {"kind": "reconfiguring"},
                            "plant": {"kind": "nonlinear", "turbulence": "moderate"},
                            "model": PINNED, "timing": SHORT},
-    # the 6-DOF flying wing (issue 26): left and right elevon and an engine row,
+    # the 6-DOF flying wing: left and right elevon and an engine row,
     # nonlinear equations in moderate turbulence, with the lateral autopilot
     "sixdof_moderate": {"campaign": {"transitions": ["elevon_lock", "right_elevon_loss",
                                                      "engine_loss"],

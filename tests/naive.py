@@ -18,7 +18,7 @@ each stage of a trial step (``commands_ref``, ``truth_step_ref``,
 (``advance_ref``).
 
 Paper: "Reconfiguration control method for non-redundant actuator faults on UAV"
-(``docs/paper-map.md`` maps it to the code), sections 2-5.
+(``docs/reference/paper-map.md`` maps it to the code), sections 2-5.
 
 Conventions (``ftc_mc.model.faults``): augmented state
 ``X = [x (9), b0 (2), b1 (3)]`` with ``b0 = [thrust, elevon sum]`` and
@@ -65,7 +65,7 @@ class RefModel:
     t_q, t_nx : float
         Thresholds of Table 1.
     variant : str
-        ``"paper"`` or ``"swapped"`` (``docs/paper-map.md``).
+        ``"paper"`` or ``"swapped"`` (``docs/reference/paper-map.md``).
     reset_var : ndarray, shape (5,)
         Variances after a reset (section 3.2.2).
     """
@@ -155,7 +155,7 @@ def ref_model(plant, settings):
 
 def aug(model, u):
     """``A_aug(u)``, ``B_aug``, ``C_aug`` of eq. (5), formed explicitly; with gust
-    states (issue 13) ``F = [[A, B_b0, D(u), G], [0, I, 0], [0, 0, A_d]]``,
+    states ``F = [[A, B_b0, D(u), G], [0, I, 0], [0, 0, A_d]]``,
     ``[B; 0; 0]`` and ``[C, 0, D_g]``."""
     A_aug, B_aug, C_aug = augmented(model.A, model.B, model.C, u, model.u0)
     ng = model.ng
@@ -334,7 +334,7 @@ def reset_ref(P, block, reset_var):
 
 def reset_extra_ref(P, block, reset_g):
     """The extra states that go with a reset block (a sensor-aware design's
-    output biases, issue 14): each ``g`` with ``reset_g[block, g] > 0`` gets its
+    output biases): each ``g`` with ``reset_g[block, g] > 0`` gets its
     row and column zeroed and that variance."""
     P = np.array(P, dtype=float, copy=True)
     if reset_g is None or not block:
@@ -730,7 +730,7 @@ def commands_ref(scheme, st, k):
         s, A_s = 0.0, 0.0
         if running_ref(k, st.s_start[l], s_len):
             s = signal_3211_ref(k - st.s_start[l], exc.s3211_unit, exc.s3211_amp)
-            if st.cur[l] == C2:  # eq. 23, with the design's floor (issue 25)
+            if st.cur[l] == C2:  # eq. 23, with the design's floor
                 g = 1.0 - X[B1_L]
                 if exc.s3211_floor > 0.0:
                     g = max(g, exc.s3211_floor)
@@ -918,7 +918,7 @@ def handle_resets_ref(exc, st, kn, block, res, reset_k, reset_block, reset_res, 
 
 
 POLICY_NONE, POLICY_PERIODIC, POLICY_AMBIGUOUS = 0, 1, 2
-"""``Excitation.policy`` codes (issue 25)."""
+"""``Excitation.policy`` codes."""
 
 
 def policy_signals_ref(exc, st, kn, res, d_start, s_start):
@@ -954,10 +954,10 @@ def policy_signals_ref(exc, st, kn, res, d_start, s_start):
 
 
 def record_cost_ref(track, k_switch, kn, x, u, alive, cost, marks):
-    """The cost sums after a truth step (issue 25): for each live lane, the
+    """The cost sums after a truth step: for each live lane, the
     glide path's cross-track error ``c = x sin(gamma0) + z cos(gamma0)`` of the
     true state ``x`` adds ``c^2`` to row 0 and raises row 1 to ``|c|``; each
-    command adds its square to rows 2-4.  The height marks (issue 26): a live
+    command adds its square to rows 2-4.  The height marks: a live
     lane's ``z`` goes to ``marks[1]``, and to ``marks[0]`` when the step reached
     ``kn`` is the switch ``k_switch``.  Returns updated copies of ``cost`` and
     ``marks``."""

@@ -1,4 +1,4 @@
-"""Big runs (issue 27): result tables streamed from the chunk store equal the tables
+"""Big runs: result tables streamed from the chunk store equal the tables
 sorted in memory and the golden files; the reset log's size is the user's choice
 and never changes the summary; result files honour the umask; resuming lists the
 chunk folder once.

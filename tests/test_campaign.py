@@ -83,7 +83,7 @@ def test_classification_of_hand_made_resets(spec):
                                           ("elevon_loss", [1, 2, 0])])
 def test_false_resets_count_only_while_the_truth_is_nominal(tr_name, false):
     """Resets before the switch are false alarms only in rows that start nominal:
-    an unlock or recover row flies faulted until the switch (issue 25)."""
+    an unlock or recover row flies faulted until the switch."""
     sp = chunk_spec(small_config([tr_name]))
     kf = sp.setup.tim.k_fault
     lanes = [[(kf - 10, 1)], [(kf - 30, 2), (kf, 1)], [(kf + 3, 2)]]

@@ -82,7 +82,7 @@ def residual_atol(X, P, z, ref):
     """Absolute accuracy of the three residuals ``r = mu^2 / s`` at (X, P):
     ``mu = z - C X`` loses ~eps (|z| + |C X|), propagated into ``r``.  (A
     residual of 1.3e-7 differed by 2.3e-17, 1.8e-10 relative, between the
-    kernel and the twin: hypothesis found it, stop 42.)"""
+    kernel and the twin: hypothesis found it.)"""
     mu, S = naive.innovation_ref(X, P, z, ref)
     idx = [naive.OUT_Q, naive.OUT_NX, naive.OUT_NZ]
     dmu = 1e-14 * (np.abs(z[idx]) + np.abs((z - mu)[idx]))

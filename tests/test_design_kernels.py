@@ -1,4 +1,4 @@
-"""The kernels of the detection designs (issue 13) against their twins and statistics.
+"""The kernels of the detection designs against their twins and statistics.
 
 * the gust-aware filter step (``core/longitudinal/gustfilter.py``) against the dense
   plain-NumPy filter of ``tests/naive.py`` (``F P F^T + Q``, Joseph update);

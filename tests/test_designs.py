@@ -1,4 +1,4 @@
-"""Detection designs (issue 13): config validation, --design, settings, common random
+"""Detection designs: config validation, --design, settings, common random
 numbers across designs."""
 
 import numpy as np

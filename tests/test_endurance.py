@@ -1,4 +1,4 @@
-"""Endurance runs (``ftc-mc endurance``, issue 25): fault-free flight hours per design.
+"""Endurance runs (``ftc-mc endurance``): fault-free flight hours per design.
 
 * the false resets equal those of the sweep's fault-free flights on the same
   flights and thresholds (another code path: the sweep shares each flight's

@@ -1,4 +1,4 @@
-"""A design's excitation policy and the cost of flying (issue 25): validation,
+"""A design's excitation policy and the cost of flying: validation,
 the kernels' settings, the design key that keeps a sweep's shared starts
 apart, the cost columns against the trial's own history, and a policy's
 effect on a small campaign."""
@@ -85,7 +85,7 @@ def test_policy_reaches_the_kernels_as_data():
 
 
 def test_s3211_floor_reaches_the_kernels():
-    """A design's ``s3211_floor`` (issue 25) fills ``Excitation.s3211_floor`` as a
+    """A design's ``s3211_floor`` fills ``Excitation.s3211_floor`` as a
     float, with or without a policy; the built-in designs keep 0 (eq. 23); it is
     part of the design key."""
     cfg = config(designs={"per": {**PERIODIC, "s3211_floor": 0.5},
@@ -102,7 +102,7 @@ def test_s3211_floor_reaches_the_kernels():
 
 
 def test_a_design_s_own_amplitudes_reach_the_kernels_and_fly():
-    """A design's ``doublet_amplitude`` and ``s3211_amplitude_rad`` (issue 25)
+    """A design's ``doublet_amplitude`` and ``s3211_amplitude_rad``
     replace the excitation section's in its ``Excitation`` only, as floats, and
     are part of the design key.  A design that sets the section's own values
     flies bit for bit as one that sets none; a larger 3211 on the same policy
@@ -164,7 +164,7 @@ def test_cost_sums_match_the_history():
     np.testing.assert_array_equal(rec.cost[COST_TRACK_MAX], np.abs(cross).max(axis=0))
     np.testing.assert_allclose(rec.cost[COST_U2:], (rec.hist_u ** 2).sum(axis=0), rtol=1e-12)
     assert np.any(rec.hist_exc[:, 2] == 1.0) and np.any(rec.hist_exc[:, 3] == 1.0)
-    # the height marks (issue 26): z after the switch step and after the last step,
+    # the height marks: z after the switch step and after the last step,
     # and the height lost between them, the glide path's descent included
     kf, n = setup.tim.k_fault, setup.tim.n_steps
     np.testing.assert_array_equal(rec.z_switch_last[0], z[kf - 1])
@@ -214,7 +214,7 @@ def test_sweep_runs_a_policy_like_any_design():
 
 
 def test_report_shows_the_cost_of_flying():
-    """The report's cost table (issue 25) reads the summary's cost columns, one
+    """The report's cost table reads the summary's cost columns, one
     row per transition and design; a run written before them gets none."""
     from ftc_mc.report.runs import cost_lines
 

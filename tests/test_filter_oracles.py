@@ -2,7 +2,8 @@
 the residuals, covariance health, the mode belief and an elevon lock in closed loop.
 
 The simulation loops are compiled with Numba here (no on-disk cache: a cached
-loop would keep stale copies of kernels edited in other files, docs/performance.md, lesson 6).
+loop would keep stale copies of kernels edited in other files,
+docs/findings/performance.md, lesson 6).
 Random numbers are drawn with NumPy outside the loops, one generator per test.
 """
 
@@ -492,7 +493,7 @@ def test_elevon_lock_b1_converges(plant, seed):
 
     Only ``b1_L + b1_R`` is identifiable from symmetric commands; the 3211 (sent
     on elevon resets, the last one about 7 s after the lock) is what separates
-    left from right (docs/paper-map.md).  So:
+    left from right (docs/reference/paper-map.md).  So:
 
     * the identifiable sum is at 1 within 0.05;
     * the split is right to within the belief's beta of 0.1: ``b1_L >= 0.9`` and

@@ -1,4 +1,4 @@
-"""The lateral loop of the 6-DOF X8 (issue 24 item 4, offline design): wings
+"""The lateral loop of the 6-DOF X8 (offline design): wings
 level and heading hold by the discounted LQR on the 6-DOF linear model."""
 
 import math
@@ -98,7 +98,7 @@ def test_lateral_model_is_the_named_states():
     assert np.max(np.abs(plant.A[np.ix_(idx[:5], lon)])) < 1e-9
 
 
-# ------------------------------------------------------------------ coupled c0 (issue 26 item 4)
+# ------------------------------------------------------------------ coupled c0
 def paper_c0(name):
     """The paper's c0 on ``name``'s longitudinal model: ``(K0, Q, R)``, and the model."""
     lon = load_plant(name, 20.0, -3.0, 0.1)

@@ -1,4 +1,4 @@
-"""The lock-turn controller (ftc_mc/design/lock_turn.py, issue 26 items 4-5):
+"""The lock-turn controller (ftc_mc/design/lock_turn.py):
 design point, reduced linear model about the steady turn, discounted LQR."""
 
 import math

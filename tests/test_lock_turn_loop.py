@@ -1,7 +1,7 @@
-"""Flying on with one elevon in the trial loop (``ftc_mc/core/sixdof/lockturn.py``;
-issue 26, item 4): the law against its plain-NumPy twin, the design table's
-cache, a campaign in which the ``lock_turn`` design keeps locked trials in the
-envelope where the paper's loop does not, and the configs that cannot fly it."""
+"""Flying on with one elevon in the trial loop (``ftc_mc/core/sixdof/lockturn.py``):
+the law against its plain-NumPy twin, the design table's cache, a campaign in
+which the ``lock_turn`` design keeps locked trials in the envelope where the
+paper's loop does not, and the configs that cannot fly it."""
 
 from __future__ import annotations
 
@@ -13,6 +13,7 @@ import pytest
 
 from ftc_mc import api
 from ftc_mc.core.sixdof.lockturn import LockTurnTable, hands_back, lock_turn_law, turn_probe
+from ftc_mc.cache import lock_turn as lt_cache
 from ftc_mc.design import lock_turn as lt
 from ftc_mc.model.presets import PRESETS
 from ftc_mc.sim.monitor import MEASURED, lock_turn_table
@@ -348,19 +349,19 @@ def test_designs_are_cached(tmp_path, monkeypatch):
     equal to the bit; another grid is another file; a steady lock is designed
     about itself."""
     off = np.radians([-2.0, 0.0])
-    first = lt.cached_lock_turn_designs(AF, off, cache_dir=tmp_path)
+    first = lt_cache.cached_lock_turn_designs(AF, off, cache_dir=tmp_path)
     assert len(list((tmp_path / "lock_turn").glob("*.npz"))) == 1
 
     def refuse(*a, **k):
         raise AssertionError("designed again")
 
-    monkeypatch.setattr(lt, "lock_turn_designs", refuse)
-    again = lt.cached_lock_turn_designs(AF, off, cache_dir=tmp_path)
+    monkeypatch.setattr(lt_cache, "lock_turn_designs", refuse)
+    again = lt_cache.cached_lock_turn_designs(AF, off, cache_dir=tmp_path)
     for f in ("offsets", "lock", "x", "cmd", "K", "k", "steady"):
         assert np.array_equal(getattr(first, f), getattr(again, f)), f
     assert first.steady.all()  # -2 and 0 deg are inside the trimmable set
     with pytest.raises(AssertionError, match="designed again"):
-        lt.cached_lock_turn_designs(AF, np.radians([-2.0, 1.0]), cache_dir=tmp_path)
+        lt_cache.cached_lock_turn_designs(AF, np.radians([-2.0, 1.0]), cache_dir=tmp_path)
     # the entries are lock_turn_lqr's, on one BLAS thread
     from threadpoolctl import threadpool_limits
 
@@ -386,7 +387,7 @@ def flies_on_config(trim):
 
 def test_lock_turn_design_flies_on(tmp_path, monkeypatch):
     """Every trial of the lock-turn design stays inside the envelope for the
-    60 s after a lock within -4 to +1 deg of trim (issue 26's trimmable band;
+    60 s after a lock within -4 to +1 deg of trim (the trimmable band;
     the oracle study flies -10 to +2 deg), where the paper's loop keeps at most
     half; both fly the same trials, and the monitor's first decision is the
     same in both (the flights are the same until it).  From that decision on,
@@ -532,7 +533,7 @@ def test_on_the_linear_plant_the_table_is_the_linear_models(tmp_path, capfd):
 
 def test_the_linear_models_table_has_its_own_cache_entry():
     off = np.radians([-2.0, 0.0])
-    keys = {lt.lock_turn_designs_key(AF, off, 20.0, -3.0, 0.1, linear=lin)
+    keys = {lt_cache.lock_turn_designs_key(AF, off, 20.0, -3.0, 0.1, linear=lin)
             for lin in (False, True)}
     assert len(keys) == 2
 
@@ -654,7 +655,7 @@ def test_designs_do_not_depend_on_the_blas_threads(tmp_path):
     """The table is computed on one BLAS thread: processes started with one and
     with two OpenBLAS threads design the same table to the bit.  One offset is
     enough to fail: without the limit, the design points at -6 deg alone
-    differ by 1.6e-7 between the two (measured stop 42, ``_designs`` called
+    differ by 1.6e-7 between the two (measured, ``_designs`` called
     in both processes)."""
     import os
     import subprocess

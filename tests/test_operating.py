@@ -1,4 +1,4 @@
-"""The operating characteristic of a sweep's designs (issue 13, part 4).
+"""The operating characteristic of a sweep's designs.
 
 * ``correct_reset_s`` equals the first in-window reset of the correct block in
   the golden resets tables (no simulation);
@@ -166,8 +166,8 @@ def test_recommend_design_picks_the_best_point_meeting_the_target():
 
 
 def test_a_point_meets_the_target_only_when_its_upper_bound_does():
-    """0 false resets in 299 h (bound 0.01002 / h) do not show 0.01 per hour (issue 25:
-    the report recommended `robust` from 0 resets in 0.875 h)."""
+    """0 false resets in 299 h (bound 0.01002 / h) do not show 0.01 per hour (the
+    report once recommended `robust` from 0 resets in 0.875 h)."""
     for hours in (0.875, 299.0):
         rec = recommend_design(_table(SPEC, hours=hours), target=0.01)
         assert not rec["met"] and not rec["baseline_met"]

@@ -1,4 +1,4 @@
-"""PyFly as an external oracle of the 6-DOF equations (issue 24 item 3).
+"""PyFly as an external oracle of the 6-DOF equations.
 
 PyFly (``pyfly-fixed-wing`` 0.1.2 on PyPI, MIT, E. Bøhn; the ``test`` extra) is a
 6-DOF X8 simulator nobody here wrote: quaternion attitude, Beard & McLain's

@@ -1,4 +1,4 @@
-"""A design's ``reset_scale`` (docs/recoveries.md): the covariance reset of section
+"""A design's ``reset_scale`` (docs/findings/recoveries.md): the covariance reset of section
 3.2.2 with wider variances, opt-in; the default is the paper's reset, unchanged."""
 
 import math
@@ -75,7 +75,7 @@ def _recovery(design):
 def test_wide_reset_returns_to_nominal_after_a_recovery():
     """The paper's reset (b1 standard deviation 0.04) leaves the estimate part-way
     to the recovered engine after the one reset and doublet; 25 times the variance
-    lets them carry it the whole way (docs/recoveries.md)."""
+    lets them carry it the whole way (docs/findings/recoveries.md)."""
     det_p, b1_p, b0_p = _recovery(None)
     det_w, b1_w, b0_w = _recovery("wide")
     assert det_p[1] <= 3.0 and det_w[1] <= 3.0  # the loss is found either way

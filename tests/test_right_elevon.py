@@ -1,4 +1,4 @@
-"""The right elevon's campaign rows and the ``correct_side`` metric (issue 24, item 5)."""
+"""The right elevon's campaign rows and the ``correct_side`` metric."""
 
 import re
 

@@ -427,7 +427,7 @@ def test_bad_scenario_input(tmp_path, name, text, field):
 def test_sixdof_scenario_tracks_its_own_path_and_draws_the_lateral_figure(tmp_path):
     """On the 6-DOF plant the scenario's tracking errors come from the 6-DOF
     state's x and z (not from the rows of the same number, bank and pitch),
-    and Fig. 13 shows the lateral motion (issue 26, item 6)."""
+    and Fig. 13 shows the lateral motion."""
     from ftc_mc.io.results import provenance
     from ftc_mc.scenario.write import write_scenario
 

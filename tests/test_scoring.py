@@ -1,4 +1,4 @@
-"""Metrics comparable with real-flight studies (issue 25): ALFA scoring and
+"""Metrics comparable with real-flight studies: ALFA scoring and
 FDDBenchmark's names on hand-made trials, where each count is known."""
 
 import numpy as np

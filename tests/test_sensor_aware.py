@@ -1,4 +1,4 @@
-"""The sensor-aware design (issue 14): biases of the q, n_x and n_z sensors in the
+"""The sensor-aware design: biases of the q, n_x and n_z sensors in the
 augmented filter.
 
 * the filter stage with bias states, linear (with gust states) and extended

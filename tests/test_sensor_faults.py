@@ -1,4 +1,4 @@
-"""Sensor faults (issue 14): schema, kernel vs twin, campaign rows, CLI and report."""
+"""Sensor faults: schema, kernel vs twin, campaign rows, CLI and report."""
 
 from __future__ import annotations
 

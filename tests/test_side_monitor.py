@@ -1,4 +1,4 @@
-"""The 6-DOF side monitor (``ftc_mc/core/sixdof/monitor.py``; issue 26, items 1-2):
+"""The 6-DOF side monitor (``ftc_mc/core/sixdof/monitor.py``):
 its kernel against a plain-NumPy twin and against filterpy, its direction
 projections against their no-fault distribution, and what a campaign makes of
 it."""

@@ -1,4 +1,4 @@
-"""The 6-DOF model layer and kernels (issue 24): kernels against their NumPy
+"""The 6-DOF model layer and kernels: kernels against their NumPy
 twins, trim, linearisation, named modes against an independent implementation,
 the 6-DOF model file, ``ftc-mc model --dof 6``, and that no longitudinal path
 imports the 6-DOF kernels."""

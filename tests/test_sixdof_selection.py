@@ -1,8 +1,7 @@
-"""The selection among the four 6-DOF controllers (``ftc_mc/core/sixdof/selection.py``;
-issue 26, item 4): eq. 45's prediction and eq. 47's choice against their
-plain-NumPy twins, the belief's boxes on the side monitor's six parameters,
-the terminal costs' order, the compile path, and a campaign in which the
-selection flies on after locks."""
+"""The selection among the four 6-DOF controllers (``ftc_mc/core/sixdof/selection.py``):
+eq. 45's prediction and eq. 47's choice against their plain-NumPy twins, the
+belief's boxes on the side monitor's six parameters, the terminal costs' order,
+the compile path, and a campaign in which the selection flies on after locks."""
 
 from __future__ import annotations
 
@@ -214,7 +213,7 @@ def test_selected_design_flies_on(tmp_path):
 
 def test_only_a_selecting_design_imports_the_selection(tmp_path):
     """A run of the ``lock_turn`` design alone (6-DOF plant) never imports the
-    selection's kernels: its compile path does not reach them (issue 23: a
+    selection's kernels: its compile path does not reach them (a
     run compiles only what it flies)."""
     import json
     import subprocess

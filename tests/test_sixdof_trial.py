@@ -1,4 +1,4 @@
-"""The 6-DOF plant in the trial loop (issue 24): its truth stage against a
+"""The 6-DOF plant in the trial loop: its truth stage against a
 plain-NumPy twin, campaigns that run on it, reproducibility across chunks, the
 bank-angle stop and the errors of a config that cannot fly it."""
 

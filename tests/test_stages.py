@@ -400,7 +400,7 @@ def test_commands(fixture, request):
 @pytest.mark.parametrize("floor", [0.0, 0.2, 0.5])
 def test_commands_s3211_floor(linear, floor):
     """Under c2 the 3211 is scaled by ``max(1 - b1_left_hat, floor)`` (a design's
-    ``s3211_floor``, issue 25): with the left elevon estimated locked (b1 = 1)
+    ``s3211_floor``): with the left elevon estimated locked (b1 = 1)
     eq. 23 sends nothing, a floor sends ``floor`` times the signal; an estimate
     whose ``1 - b1`` exceeds the floor is scaled as eq. 23 prints."""
     scheme = scheme_of(linear)
@@ -551,7 +551,7 @@ config's, which have none)."""
 def test_handle_resets(linear, policy):
     """Reset records (including beyond capacity and on stopped lanes) and the
     excitation they start, the doublet re-check above and below threshold, and
-    the design's excitation policy (issue 25): periodic starts at their phase,
+    the design's excitation policy: periodic starts at their phase,
     ambiguous on an unsure belief or a high residual, neither while a signal
     runs nor on a stopped lane."""
     exc = linear.exc._replace(**POLICIES[policy])
@@ -646,7 +646,7 @@ def test_policy_signals_follow_the_schedule(linear):
 
 
 def test_record_cost(linear, nonlinear_gusts):
-    """The cost sums (issue 25) against their twin, exactly: live lanes only, the
+    """The cost sums against their twin, exactly: live lanes only, the
     largest cross-track error kept, on the longitudinal plant's track."""
     rng = np.random.default_rng(82)
     for setup in (linear, nonlinear_gusts):
@@ -744,8 +744,8 @@ def test_advance_matches_the_chained_twins(fixture, policy, request):
     reconfiguration periods, resets firing with low thresholds, the schedule
     switching): every record field, discrete ones exactly, continuous ones to
     1e-11 (per-step differences of 1e-16 grow along the trajectory: measured
-    up to 7e-13 on the nonlinear plant in gusts); with each excitation policy
-    (issue 25), whose signals then start beside those of the resets."""
+    up to 7e-13 on the nonlinear plant in gusts); with each excitation policy,
+    whose signals then start beside those of the resets."""
     setup = request.getfixturevalue(fixture)
     scheme = scheme_of(setup, t_q=8.0, t_nx=8.0)
     # the ambiguous policy also on residuals below the thresholds, so it fires

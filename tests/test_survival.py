@@ -1,4 +1,4 @@
-"""Survival after an elevon lock (issue 26, item 5; ftc_mc/campaign/survival.py):
+"""Survival after an elevon lock (ftc_mc/campaign/survival.py):
 the table's counts, censored medians and exclusions against a hand-made trials
 table, its Markdown and figure, and the columns it reads on a real run."""
 
@@ -262,7 +262,7 @@ def test_the_equations_set_is_searched_once_and_cached(tmp_path, monkeypatch):
     joblib runs it in this process, where the stub holds."""
     import io
 
-    import ftc_mc.design.trimmable_cache as tc
+    import ftc_mc.cache.trimmable as tc
     from ftc_mc.campaign.runner import resolve_config
     from ftc_mc.campaign.survival import trimmable_sets
     from ftc_mc.model.presets import PRESETS

@@ -17,6 +17,8 @@ from scipy.interpolate import RegularGridInterpolator
 
 from ftc_mc.core.longitudinal.control import elevon_allocation
 from ftc_mc.core.shared.interp import bilinear, engine_controller
+from ftc_mc.cache import engine_tables as et
+from ftc_mc.cache import store
 from ftc_mc.design import theorem41 as t41
 from ftc_mc.design.lqr import discounted_lqr, paper_q_lqr
 
@@ -325,7 +327,7 @@ def test_cache_hit_and_key(plant, tmp_path, monkeypatch):
     grid_b0 = np.linspace(0.0, 1.0, 41)
     grid_b1 = np.linspace(0.0, 1.0, 41)
     t = time.perf_counter()
-    cold = t41.cached_engine_tables(plant, grid_b0, grid_b1, cache_dir=tmp_path)
+    cold = et.cached_engine_tables(plant, grid_b0, grid_b1, cache_dir=tmp_path)
     t_cold = time.perf_counter() - t
     files = list((tmp_path / "engine_tables").glob("*.npz"))
     assert len(files) == 1 and not list((tmp_path / "engine_tables").glob(".*tmp"))
@@ -333,9 +335,9 @@ def test_cache_hit_and_key(plant, tmp_path, monkeypatch):
     def boom(*a, **k):
         raise AssertionError("cache miss")
 
-    monkeypatch.setattr(t41, "engine_fault_tables", boom)
+    monkeypatch.setattr(et, "engine_fault_tables", boom)
     t = time.perf_counter()
-    hot = t41.cached_engine_tables(plant, grid_b0, grid_b1, cache_dir=tmp_path)
+    hot = et.cached_engine_tables(plant, grid_b0, grid_b1, cache_dir=tmp_path)
     t_hot = time.perf_counter() - t
     for a, b in zip(cold, hot):
         assert np.array_equal(a, b)
@@ -345,22 +347,22 @@ def test_cache_hit_and_key(plant, tmp_path, monkeypatch):
     engine_controller(hot, 0.5, 0.5, np.ones(9), u)
     assert np.all(np.isfinite(u))
 
-    key = t41.engine_tables_key(plant, grid_b0, grid_b1)
+    key = et.engine_tables_key(plant, grid_b0, grid_b1)
     assert files[0].stem == key
     Q0 = paper_q_lqr(plant.trim.gamma0)
-    assert t41.engine_tables_key(plant, grid_b0, grid_b1, Q0, 0.1 * np.eye(3), 0.999) == key
+    assert et.engine_tables_key(plant, grid_b0, grid_b1, Q0, 0.1 * np.eye(3), 0.999) == key
     changed = [
-        t41.engine_tables_key(plant, grid_b0[:-1], grid_b1),
-        t41.engine_tables_key(plant, grid_b0, grid_b1 * 0.99),
-        t41.engine_tables_key(plant, grid_b0, grid_b1, Q=2 * Q0),
-        t41.engine_tables_key(plant, grid_b0, grid_b1, R=0.2 * np.eye(3)),
-        t41.engine_tables_key(plant, grid_b0, grid_b1, alpha=0.99),
+        et.engine_tables_key(plant, grid_b0[:-1], grid_b1),
+        et.engine_tables_key(plant, grid_b0, grid_b1 * 0.99),
+        et.engine_tables_key(plant, grid_b0, grid_b1, Q=2 * Q0),
+        et.engine_tables_key(plant, grid_b0, grid_b1, R=0.2 * np.eye(3)),
+        et.engine_tables_key(plant, grid_b0, grid_b1, alpha=0.99),
     ]
     for field in ("A", "B"):
         M = getattr(plant, field).copy()
         M[0, 0] += 1e-12
-        changed.append(t41.engine_tables_key(_Fake(plant, **{field: M}), grid_b0, grid_b1))
-    changed.append(t41.engine_tables_key(_Fake(plant, u0=plant.u0 + [1e-9, 0, 0]),
+        changed.append(et.engine_tables_key(_Fake(plant, **{field: M}), grid_b0, grid_b1))
+    changed.append(et.engine_tables_key(_Fake(plant, u0=plant.u0 + [1e-9, 0, 0]),
                                          grid_b0, grid_b1))
     assert len(set(changed + [key])) == len(changed) + 1
 
@@ -375,12 +377,12 @@ class _Fake:
 
 def test_cache_env_dir_and_corrupt_file(plant, tmp_path, monkeypatch):
     monkeypatch.setenv("FTC_MC_CACHE_DIR", str(tmp_path))
-    assert t41.default_cache_dir() == tmp_path / "design"
-    tab = t41.cached_engine_tables(plant)
-    path = tmp_path / "design" / "engine_tables" / f"{t41.engine_tables_key(plant)}.npz"
+    assert store.default_cache_dir() == tmp_path / "design"
+    tab = et.cached_engine_tables(plant)
+    path = tmp_path / "design" / "engine_tables" / f"{et.engine_tables_key(plant)}.npz"
     assert path.exists()
     path.write_bytes(b"not an npz")
-    again = t41.cached_engine_tables(plant)          # recomputed and rewritten
+    again = et.cached_engine_tables(plant)          # recomputed and rewritten
     assert np.array_equal(again.k, tab.k)
     with np.load(path) as z:
         assert np.array_equal(z["K"], tab.K)

@@ -1,7 +1,7 @@
-"""Steady flight with one elevon locked (ftc_mc/model/trimmable.py, issue 26 item 5).
+"""Steady flight with one elevon locked (ftc_mc/model/trimmable.py).
 
 Reference: the project's held-out trim analysis of the authors' equations
-(DESIGN.md section 11 and issue 26): at 20 m/s and -3 deg a lock 5 deg above
+(DESIGN.md section 11): at 20 m/s and -3 deg a lock 5 deg above
 trim admits no steady flight, straight or turning, and steady no-rudder turns
 keep the locked elevon within about +0.4 to +0.6 deg of trim."""
 

@@ -1,4 +1,4 @@
-"""The truth plant of the trials (issue 7): nonlinear X8 and Dryden gusts in
+"""The truth plant of the trials: nonlinear X8 and Dryden gusts in
 core/trial.advance, the linear plant's gust matrices, streams and the CLI.
 
 Tolerances:

@@ -141,7 +141,7 @@ def classify(spec: ChunkSpec, tr_name: str, variant: str, trial_ids, values,
              inp: TrialInputs, rec: TrialRecord):
     """Per-trial and per-reset columns of one kernel call.
 
-    Definitions (docs/paper-map.md), with ``k_f`` the switch step and the
+    Definitions (docs/reference/paper-map.md), with ``k_f`` the switch step and the
     window the steps ``k_f < k <= k_f + spec.window``:
 
     * ``correct``: the transition's block was reset in the window;
@@ -151,7 +151,7 @@ def classify(spec: ChunkSpec, tr_name: str, variant: str, trial_ids, values,
     * ``false_resets``: resets at or before ``k_f`` while the truth is nominal,
       i.e. in rows that start nominal (``mode_pre``); an unlock or recover row
       starts faulted, so its resets before the switch are no false alarms and
-      count 0 (issue 25);
+      count 0;
     * ``first_reset_s``: delay from the switch to the first reset in the window;
     * ``correct_reset_s``: delay from the switch to the first reset of the
       correct block in the window (NaN when it had none), whatever was reset
@@ -342,7 +342,7 @@ def _first_after(mask, steps, kf, dt):
 
 def classify_sensor(spec: ChunkSpec, tr_name: str, variant: str, trial_ids, sizes,
                     inp: TrialInputs, rec: TrialRecord):
-    """Per-trial and per-reset columns of a sensor transition (issue 14).
+    """Per-trial and per-reset columns of a sensor transition.
 
     The actuators stay healthy, so the correct block is ``none`` and every
     action of the FTC scheme after the sensor fault (step ``k_f``) up to the end
@@ -358,7 +358,7 @@ def classify_sensor(spec: ChunkSpec, tr_name: str, variant: str, trial_ids, size
     * ``envelope_exit``: the aircraft left the airspeed or angle-of-attack
       envelope (the trial stopped there);
     * ``sensor_bias_hat_end``: the design's estimate of the faulty output's bias
-      at the end (NaN when the design does not estimate it, issue 14);
+      at the end (NaN when the design does not estimate it);
     * ``isolated``: a bias fault the design names: the trial flew to the end,
       the estimated bias is within :data:`ISOLATION_TOLERANCE` of the true one,
       and the belief's most probable mode at the last update is nominal.
@@ -450,7 +450,7 @@ def classify_sensor(spec: ChunkSpec, tr_name: str, variant: str, trial_ids, size
 ISOLATION_TOLERANCE = 0.25
 """Largest relative error of the estimated bias of an isolated sensor fault: the
 filter then carries at most a quarter of the bias as a wrong state or fault
-parameter (issue 14)."""
+parameter."""
 
 
 def _isolation(design, tr, sizes, rec: TrialRecord) -> dict:
@@ -547,7 +547,7 @@ COST_COLUMNS = ("track_rms_m", "track_max_m") + tuple(
 
 
 def cost_columns(rec: TrialRecord, n_steps: int, dt: float) -> dict:
-    """What flying a trial cost (issue 25), over the steps it flew (to its end,
+    """What flying a trial cost, over the steps it flew (to its end,
     or to its exit from the validity envelope; ``TrialRecord.cost``):
     ``track_rms_m`` and ``track_max_m``, the RMS and the largest magnitude of the
     glide path's cross-track error ``x sin(gamma0) + z cos(gamma0)`` [m] of the

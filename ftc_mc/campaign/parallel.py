@@ -9,7 +9,7 @@ chunk function runs everywhere, and results do not depend on where they ran.
 * ``threads`` (the default) runs chunks on worker threads of this process: the
   kernels release the GIL (``nogil``), so the threads share one core each, with
   no worker start-up, no second load of the kernels and no results pickled
-  back (``docs/performance.md``, lesson 5).  Even ``jobs=1`` runs its chunks on
+  back (``docs/findings/performance.md``, lesson 5).  Even ``jobs=1`` runs its chunks on
   one worker thread, so that the main thread is free to react to Ctrl-C.
 * ``loky`` runs worker processes (``joblib.externals.loky``); the chunk spec is
   sent to each worker once, when it starts.  With one worker it runs on one

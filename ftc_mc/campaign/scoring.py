@@ -1,4 +1,4 @@
-"""Metrics comparable with published real-flight fault-detection results (issue 25).
+"""Metrics comparable with published real-flight fault-detection results.
 
 Beside Tables 2-3, each (transition, design) row of a campaign is scored the way
 real-flight studies score a detector, so a reader can set our figures beside

@@ -1,4 +1,4 @@
-"""Which actuator failed, by the 6-DOF side monitor (issue 26, items 1-2).
+"""Which actuator failed, by the 6-DOF side monitor.
 
 On the 6-DOF plant a side monitor flies beside every design
 (:mod:`ftc_mc.core.sixdof.monitor`): an augmented filter of the 6-DOF model
@@ -52,7 +52,8 @@ after ``none``), in the order of the longitudinal actuators
 assert len(DIRECTIONS) == len(ACTUATOR_NAMES) + 1
 
 LARGE_LOSS = 0.5
-"""``b1`` from which a loss counts as large (issue 26's target: ``b1 >= 0.5``)."""
+"""``b1`` from which a loss counts as large (``b1 >= 0.5``): the losses the side
+monitor is asked to name (``side_correct_rate_large``)."""
 
 SIDE_COLUMNS = ("side_block", "side_s", "side_correct", "side_false", "side_b0", "side_b1",
                 "side_position")

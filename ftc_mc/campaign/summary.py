@@ -3,7 +3,7 @@
 Rates carry 95 % Wilson score intervals (:func:`ftc_mc.stats.wilson`).  The
 paper's own counts stand beside ours.
 
-A sensor transition (``sensor_<kind>:<output>``, issue 14) has no correct
+A sensor transition (``sensor_<kind>:<output>``) has no correct
 actuator block, so its row has no Tables 2-3 columns (inappropriate, no reset,
 correct, delay, detection, the paper's counts: NaN in a run that mixes both
 kinds); it has the misattribution columns instead (:func:`sensor_row`).
@@ -154,7 +154,7 @@ def summary_row(name: str, variant: str, g: pd.DataFrame) -> dict:
 
 
 def cost_summary(ok: pd.DataFrame) -> dict:
-    """What flying cost over the judged trials ``ok`` (issue 25; the trial columns
+    """What flying cost over the judged trials ``ok`` (the trial columns
     of :func:`ftc_mc.campaign.chunk.cost_columns`): ``track_rms_m``, the RMS of
     the glide path's cross-track error (``sqrt`` of the mean of the trials'
     squares, each trial weighted equally) [m]; ``track_max_m_mean`` and
@@ -252,7 +252,7 @@ def sensor_row(name: str, variant: str, g: pd.DataFrame) -> dict:
 
 
 def sensor_markdown_table(summary: pd.DataFrame, intervals: bool = True) -> str:
-    """The misattribution table of the sensor rows of a summary (issue 14).
+    """The misattribution table of the sensor rows of a summary.
 
     Per sensor transition and variant: judged trials, the share with an
     actuator-block reset, a wrong mode (an actuator fault most probable with
@@ -333,7 +333,7 @@ def side_text(r, intervals: bool = True) -> str:
 def extra_columns(r) -> dict:
     """The columns of a summary row that only some runs have: the 6-DOF plant's
     bank and heading RMS [deg], and the glide-path tracking RMS [m] with the
-    control energy of the commands (issue 25)."""
+    control energy of the commands."""
     out = {}
     if "bank_rms_deg" in r and np.isfinite(r["bank_rms_deg"]):
         out["bank / heading RMS [deg]"] = (f"{r['bank_rms_deg']:.2f} / "

@@ -1,4 +1,4 @@
-"""Survivability after an elevon lock (issue 26, item 5): does the aircraft stay
+"""Survivability after an elevon lock: does the aircraft stay
 inside the validity envelope, and for how long, by how far the elevon locked
 from trim?
 
@@ -37,7 +37,7 @@ from ..stats import wilson
 from .transitions import LEFT, transition_of
 
 HORIZON_S = 60.0
-"""Time after the lock over which survival is judged [s] (issue 26)."""
+"""Time after the lock over which survival is judged [s]."""
 
 OFFSET_EDGES_DEG = (-math.inf, -20.0, -10.0, -5.0, -2.0, -0.5, 0.5, 2.0, 5.0, 10.0, math.inf)
 """Bins of lock offset from trim [deg]: the finer the nearer trim, where the
@@ -164,8 +164,8 @@ def _stats(fate: dict, sel: np.ndarray, g: pd.DataFrame):
 def trimmable_table(trials: pd.DataFrame, fault_time_s: float, duration_s: float,
                     sets: dict) -> pd.DataFrame:
     """Survival inside and outside the trimmable set of each elevon-lock row
-    (issue 26's targets: 90 % of the locks inside stay in; outside, the median
-    time to leave).
+    (what a lock-turn design aims at: 90 % of the locks inside stay in; outside,
+    the median time to leave).
 
     Parameters
     ----------
@@ -219,7 +219,7 @@ def trimmable_sets(config, stream=None) -> dict:
     * nonlinear plant: the airframe's equations' set, by bisection of
       steady-flight searches from the trim (a minute or two on the first run per
       airframe and envelope, then cached:
-      :func:`ftc_mc.design.trimmable_cache.cached_trimmable_sets`; ``stream``
+      :func:`ftc_mc.cache.trimmable.cached_trimmable_sets`; ``stream``
       gets its notice).
     """
     if config.plant.dof != 6:
@@ -243,7 +243,7 @@ def trimmable_sets(config, stream=None) -> dict:
         plant = build_sixdof_plant(af, m.airspeed_mps, m.gamma_deg, m.dt_s)
         ends = {side: linear_trimmable_set(plant, side, env) for side in set(rows.values())}
     else:
-        from ..design.trimmable_cache import cached_trimmable_sets
+        from ..cache.trimmable import cached_trimmable_sets
 
         ends = cached_trimmable_sets(af, sorted(set(rows.values())), env, name=m.airframe,
                                      stream=stream)

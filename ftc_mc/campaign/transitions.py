@@ -1,7 +1,7 @@
 """The fault transitions of Tables 2-3 and the ranges of their fault draws.
 
 A transition names the actuator (the paper's eight rows fault the left elevon,
-``docs/paper-map.md``; the ``right_elevon_*`` rows, issue 24, the same four
+``docs/reference/paper-map.md``; the ``right_elevon_*`` rows, the same four
 elevon rows on the right elevon), the fault kind (lock or loss of effectiveness) and the direction
 (``onset``: nominal -> faulty; ``recovery``: faulty -> nominal).  Its trials fly
 a two-entry schedule (:meth:`Transition.schedule`): the initial mode from the
@@ -125,7 +125,7 @@ TRANSITION_TABLE = {
                    "Engine less efficient → Engine nominal"),
     ]
 }
-# issue 24: the elevon rows again on the right elevon (not in the paper)
+# the elevon rows again on the right elevon (not in the paper)
 TRANSITION_TABLE.update(
     (f"right_{t.name}", dataclasses.replace(t, name=f"right_{t.name}", actuator=RIGHT,
                                             label=t.label.replace("Elevon", "Right elevon")))
@@ -195,7 +195,7 @@ def fault_ranges(draws, u_lower, u_upper) -> FaultRanges:
 
 @dataclasses.dataclass(frozen=True)
 class SensorTransition:
-    """A sensor fault from nominal (issue 14): ``sensor_<kind>:<output>``.
+    """A sensor fault from nominal: ``sensor_<kind>:<output>``.
 
     The actuators stay healthy throughout, so the correct covariance block is
     ``none``: any reset after the fault step is a misattribution.  The trial's

@@ -1,6 +1,6 @@
 """The one place that sets how every kernel is compiled.
 
-Compiled kernels are cached on disk (``docs/performance.md``, lesson 6), keyed
+Compiled kernels are cached on disk (``docs/findings/performance.md``, lesson 6), keyed
 on the content of every kernel source.  Numba on its own keys a cached kernel on
 its own file only (its folder on the file's absolute path, its stamp on that
 file alone), so a kernel that inlines others would be loaded stale after an edit of
@@ -298,7 +298,7 @@ class CloneFolderLocator(ContentCacheLocator):
 
     Numba's own locator keys such a kernel on its file's absolute path and its
     file's stamp alone: a new clone compiles every test kernel again (15 s of
-    the test suite's CPU, measured stop 42), and an edit of a file it inlines
+    the test suite's CPU, measured), and an edit of a file it inlines
     (``tests/single_trajectory.py`` from ``tests/test_soak.py``) would load it
     stale.  Here the folder and the stamp follow the content of the kernel
     sources (:func:`full_source_digest`) and of every file of
@@ -481,7 +481,7 @@ def kernel(func=None, *, internal=False, by_address=False, **overrides):
     internal : bool
         The kernel is called by other kernels only: it is compiled without
         its Python wrappers (:data:`NO_WRAPPERS`), which shortens every
-        path's cold compile (``docs/performance.md``, lesson 14).  A call
+        path's cold compile (``docs/findings/performance.md``, lesson 14).  A call
         from Python still works: it compiles a twin with its
         wrappers once (cached beside the kernel, :class:`InternalKernel`).
     by_address : bool
@@ -491,7 +491,7 @@ def kernel(func=None, *, internal=False, by_address=False, **overrides):
         or a small kernel LLVM would inline into its caller (the paper
         filter's lane kernels ``project_lanes``, ``_symmetric_copy``,
         ``reset_lanes`` and ``_normalised_lanes`` by address cost
-        ``bench_core``'s batch filter about 6 %; ``docs/performance.md``
+        ``bench_core``'s batch filter about 6 %; ``docs/findings/performance.md``
         lessons 12 and 17).
     **overrides
         Options that replace the defaults for this kernel.
@@ -661,7 +661,7 @@ def announce_compile(dispatcher, what="", duration="1 min", stream=None,
 
     ``what`` names the path compiled, ``duration`` the time it takes (the
     measured figures per path, and why they are less when the kernels they
-    share are cached: ``docs/performance.md``, lesson 11).
+    share are cached: ``docs/findings/performance.md``, lesson 11).
     """
     import sys
     if (needs_compile(dispatcher) if needed is None else needed) is not True:

@@ -4,7 +4,7 @@ Numba compiles every kernel as a code library of its own, and a kernel that
 calls another links the callee's library into its own: the callee's code is
 optimised and emitted again inside every caller, up the chain to
 :func:`ftc_mc.core.longitudinal.trial.advance`.  For the default path that was
-about 10 s of ``advance``'s 25 s of cold compile (``docs/performance.md``,
+about 10 s of ``advance``'s 25 s of cold compile (``docs/findings/performance.md``,
 lessons 14 and 15).
 
 A call of a kernel declared ``kernel(by_address=True)`` (the trial's stage

@@ -1,4 +1,4 @@
-"""Lateral-directional loop of the 6-DOF X8: wings level and heading hold (issue 24).
+"""Lateral-directional loop of the 6-DOF X8: wings level and heading hold.
 
 An offline design on the 6-DOF linear model (:mod:`ftc_mc.model.sixdof`), by
 the discounted LQR of :mod:`ftc_mc.design.lqr` (the paper's approach, eq. 43,
@@ -19,7 +19,7 @@ unweighted.  The cross-track position ``y`` is not held (heading hold, not
 track hold), so it stays an integrator of the closed loop.
 
 :func:`coupled_lqr` is the alternative c0 (``controller.coupling:
-coupled``, issue 26 item 4): one discounted LQR on the whole 6-DOF model whose
+coupled``): one discounted LQR on the whole 6-DOF model whose
 cost is the sum of the two loops' costs, so that it is the pair of separate
 gains exactly when the model does not couple them; :func:`coupled_engine_tables`
 is c1's Theorem 4.1 tables on the same model and weights.
@@ -142,7 +142,7 @@ class CoupledDesign:
 
 def coupled_lqr(plant, K_lon: np.ndarray, Q_lon: np.ndarray, R_lon: np.ndarray,
                 alpha: float, lat: LateralDesign) -> CoupledDesign:
-    """c0 as one discounted LQR on the 6-DOF linear model (issue 26 item 4).
+    """c0 as one discounted LQR on the 6-DOF linear model.
 
     The cost is the sum of the two loops' costs: the paper's ``Q_lqr``
     (section 5.1) on the longitudinal states by name, the lateral design's
@@ -209,7 +209,7 @@ def coupled_lqr(plant, K_lon: np.ndarray, Q_lon: np.ndarray, R_lon: np.ndarray,
 def coupled_engine_tables(plant, design: CoupledDesign, b0_grid: np.ndarray,
                           b1_grid: np.ndarray):
     """c1 on the 6-DOF model: Theorem 4.1's tables (section 4.1.5, eqs.
-    26-44) with the coupled design's weights (issue 26 item 4).
+    26-44) with the coupled design's weights.
 
     The paper's engine-fault tables (:func:`ftc_mc.design.theorem41.engine_fault_tables`)
     on the 6-DOF linear model, its throttle faulty and its own trim throttle

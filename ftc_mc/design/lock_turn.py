@@ -1,4 +1,4 @@
-"""The reconfigured controller of a locked elevon: fly the steady turn (issue 26, items 4-5).
+"""The reconfigured controller of a locked elevon: fly the steady turn.
 
 The X8 has no rudder.  With one elevon locked away from trim, the healthy
 elevon and the throttle must fly pitch and roll together, and a straight glide
@@ -56,9 +56,10 @@ The law (:meth:`LockTurnDesign.command`), on the true state (the oracle)::
 
 with the locked elevon's command its lock position.
 
-5. **Table** (:func:`cached_lock_turn_designs`): the designs of both sides
+5. **Table** (:func:`lock_turn_designs`): the designs of both sides
    over a uniform grid of lock offsets, computed once per airframe and cached
-   on disk; the ``lock_turn`` controller of the trial loop flies them,
+   on disk (:func:`ftc_mc.cache.lock_turn.cached_lock_turn_designs`); the
+   ``lock_turn`` controller of the trial loop flies them,
    interpolated on the side monitor's lock estimate, with measurements in
    place of the oracle's true state (:mod:`ftc_mc.core.sixdof.lockturn`).
 6. **On the linear plant** (``monitor.turn_model: linear``, or ``auto``
@@ -76,8 +77,6 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import time
-from pathlib import Path
 
 import numpy as np
 import scipy.optimize
@@ -89,7 +88,6 @@ from ..model.linear import jacobian, zoh
 from ..model.sixdof import build_sixdof_plant, derivatives, outputs, trim6
 from ..model.trimmable import (UNKNOWNS, _state, linear_closest, linear_quantities,
                                linear_steady, steady_flight)
-from .cache import default_cache_dir, design_key, write_atomic
 from .theorem41 import ALPHA, biased_discounted_lqr
 
 TURN_RIGID = ("phi", "theta", "u", "v", "w", "p", "q", "r")
@@ -728,74 +726,7 @@ def _designs(airframe, offsets, V0, gamma0_deg, dt, wide=None, linear=False) -> 
                            steady=steady)
 
 
-def lock_turn_designs_key(airframe: Airframe, offsets, V0: float, gamma0_deg: float,
-                          dt: float, wide: DesignBox | None = None,
-                          linear: bool = False) -> str:
-    """SHA-256 cache key of every input of :func:`lock_turn_designs`: the packed
-    6-DOF parameters and command limits of the airframe, the grid, the glide,
-    the period, the default design box and weights, the wide box if any, the
-    linear model if designed on it,
-    :data:`LOCK_TURN_TABLE_VERSION` and the OpenBLAS kernels in force
-    (``ftc_mc/blas.py``)."""
-    parts = [repr((DesignBox(), DesignWeights(), TurnWeights(), ALPHA, LOCK_TOLERANCE))]
-    if wide is not None:
-        parts.append(f"wide:{wide!r}")
-    if linear:
-        parts.append("model:linear")
-    return design_key(LOCK_TURN_TABLE_VERSION, *parts,
-                      arrays=(trim6(airframe, V0, gamma0_deg).params, airframe.command_lower,
-                              airframe.command_upper, offsets, [V0, gamma0_deg, dt]))
-
-
-def cached_lock_turn_designs(airframe: Airframe, offsets, V0: float = 20.0,
-                             gamma0_deg: float = -3.0, dt: float = 0.1,
-                             cache_dir=None, stream=None,
-                             wide: DesignBox | None = None,
-                             linear: bool = False) -> LockTurnDesigns:
-    """:func:`lock_turn_designs`, cached on disk as ``.npz``
-    (``<cache_dir>/lock_turn/<sha256>.npz``, key :func:`lock_turn_designs_key`,
-    written atomically; an unreadable or mismatching file is recomputed).
-
-    Parameters
-    ----------
-    airframe, offsets, V0, gamma0_deg, dt, wide, linear
-        As :func:`lock_turn_designs`.
-    cache_dir : str or Path, optional
-        Cache root; default :func:`ftc_mc.design.cache.default_cache_dir`.
-    stream : file, optional
-        When the designs are computed (not in the cache), a line saying so
-        before and one with the time taken after.
-
-    Returns
-    -------
-    LockTurnDesigns
-    """
-    offsets = np.asarray(offsets, dtype=float)
-    key = lock_turn_designs_key(airframe, offsets, V0, gamma0_deg, dt, wide, linear)
-    folder = Path(cache_dir) if cache_dir is not None else default_cache_dir()
-    path = folder / "lock_turn" / f"{key}.npz"
-    fields = [f.name for f in dataclasses.fields(LockTurnDesigns)]
-    if path.exists():
-        try:
-            with np.load(path, allow_pickle=False) as z:
-                if str(z["key"]) == key:
-                    return LockTurnDesigns(**{f: np.ascontiguousarray(z[f]) for f in fields})
-        except (OSError, ValueError, KeyError):
-            pass  # corrupt or foreign file: recompute below
-    if stream is not None:
-        print(f"ftc-mc: designing the lock-turn controllers ({offsets.size} lock positions "
-              "per elevon; cached afterwards)", file=stream, flush=True)
-    t0 = time.perf_counter()
-    d = lock_turn_designs(airframe, offsets, V0, gamma0_deg, dt, wide, linear)
-    if stream is not None:
-        print(f"ftc-mc: lock-turn controllers designed in {time.perf_counter() - t0:.1f} s",
-              file=stream, flush=True)
-    write_atomic(path, lambda f: np.savez(f, key=np.array(key),
-                                          **{n: getattr(d, n) for n in fields}))
-    return d
-
-
 __all__ = ["TURN_RIGID", "LOCK_TOLERANCE", "healthy", "turn_states", "DesignBox", "envelope_box",
            "DesignWeights", "TurnWeights", "DesignPoint", "design_point",
            "LockTurnDesign", "lock_turn_lqr", "LOCK_TURN_TABLE_VERSION", "LockTurnDesigns",
-           "SIDES", "lock_turn_designs", "lock_turn_designs_key", "cached_lock_turn_designs"]
+           "SIDES", "lock_turn_designs"]

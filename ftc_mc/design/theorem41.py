@@ -72,17 +72,13 @@ See :func:`ftc_mc.core.longitudinal.control.elevon_allocation`: eq. 25 as printe
 
 from __future__ import annotations
 
-import hashlib
 import math
-import os
-from pathlib import Path
 from typing import NamedTuple
 
 import numpy as np
 import scipy.linalg
 
 from ..core.shared.interp import EngineTables
-from .cache import default_cache_dir, write_atomic
 from .lqr import paper_q_lqr
 
 #: Bumped whenever the table computation changes, so old cache entries are ignored.
@@ -355,78 +351,3 @@ def engine_fault_tables(plant, b0_grid=None, b1_grid=None, Q=None, R=None, alpha
             K_tab[i, j] = sol.K
             k_tab[i, j] = alpha * np.linalg.solve(S, E.T @ (sol.P @ F - v))
     return EngineTables(K=K_tab, k=k_tab, b0_grid=b0_grid, b1_grid=b1_grid)
-
-
-# --------------------------------------------------------------------- cache
-def _hash_array(h, name, a):
-    a = np.ascontiguousarray(a, dtype=np.float64)
-    h.update(f"{name}:{a.shape}:".encode())
-    h.update(a.tobytes())
-
-
-def engine_tables_key(plant, b0_grid=None, b1_grid=None, Q=None, R=None, alpha=None) -> str:
-    """SHA-256 cache key of every input of :func:`engine_fault_tables`.
-
-    Covers ``A``, ``B``, ``u0``, both grids, ``Q``, ``R``, ``alpha``,
-    :data:`TABLES_VERSION` and the OpenBLAS kernels in force (``ftc_mc/blas.py``:
-    tables computed with other kernels differ in their last bits), defaults
-    resolved first, so passing a default explicitly gives the same key.
-
-    Returns
-    -------
-    str
-        64 hexadecimal digits.
-    """
-    b0_grid, b1_grid, Q, R, alpha = _defaults(plant, b0_grid, b1_grid, Q, R, alpha)
-    h = hashlib.sha256()
-    h.update(TABLES_VERSION.encode())
-    h.update(f"blas:{os.environ.get('OPENBLAS_CORETYPE')}".encode())
-    for name, a in (("A", plant.A), ("B", plant.B), ("u0", plant.u0), ("b0_grid", b0_grid),
-                    ("b1_grid", b1_grid), ("Q", Q), ("R", R), ("alpha", [alpha])):
-        _hash_array(h, name, a)
-    return h.hexdigest()
-
-
-def cached_engine_tables(plant, b0_grid=None, b1_grid=None, Q=None, R=None, alpha=None,
-                         cache_dir=None):
-    """:func:`engine_fault_tables`, cached on disk as ``.npz``.
-
-    The file is ``<cache_dir>/engine_tables/<sha256>.npz`` with the key of
-    :func:`engine_tables_key`; it is written atomically (temporary file in the
-    same folder, then ``os.replace``), so concurrent processes at worst compute
-    the same tables twice.  An unreadable or mismatching file is recomputed and
-    replaced.
-
-    Parameters
-    ----------
-    plant, b0_grid, b1_grid, Q, R, alpha
-        As in :func:`engine_fault_tables`.
-    cache_dir : str or Path, optional
-        Cache root; default :func:`default_cache_dir` (``~/.cache/ftc-mc/design``,
-        or ``$FTC_MC_CACHE_DIR/design``).
-
-    Returns
-    -------
-    EngineTables
-    """
-    key = engine_tables_key(plant, b0_grid, b1_grid, Q, R, alpha)
-    folder = Path(cache_dir) if cache_dir is not None else default_cache_dir()
-    path = folder / "engine_tables" / f"{key}.npz"
-    if path.exists():
-        try:
-            with np.load(path, allow_pickle=False) as z:
-                if str(z["key"]) == key:
-                    return EngineTables(K=np.ascontiguousarray(z["K"]),
-                                        k=np.ascontiguousarray(z["k"]),
-                                        b0_grid=np.ascontiguousarray(z["b0_grid"]),
-                                        b1_grid=np.ascontiguousarray(z["b1_grid"]))
-        except (OSError, ValueError, KeyError):
-            pass  # corrupt or foreign file: recompute below
-    tables = engine_fault_tables(plant, b0_grid, b1_grid, Q, R, alpha)
-    # a file object: np.savez would append ".npz" to a name
-    write_atomic(path, lambda f: np.savez(
-        f, key=np.array(key), version=np.array(TABLES_VERSION), K=tables.K, k=tables.k,
-        b0_grid=tables.b0_grid, b1_grid=tables.b1_grid))
-    return tables
-
-

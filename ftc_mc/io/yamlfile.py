@@ -9,7 +9,7 @@ where PyYAML was built with libyaml (its wheels are), else the pure-Python
 ``SafeLoader``.  Both construct with ``SafeConstructor``, so they return the
 same data; the C scanner and parser read the shipped configs 15 times faster
 (329 ms -> 22 ms for the 19 of them; the test suite spent 27 s of 380 in the
-pure-Python scanner, measured stop 42), and
+pure-Python scanner, measured), and
 refuse nesting deeper than libyaml's limit (1000 levels) with a scanner error
 where the Python parser recursed until ``RecursionError``.
 """

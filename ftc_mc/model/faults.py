@@ -1,6 +1,6 @@
 """Actuator fault model (paper eqs. 2-4) and the augmented system (eq. 5).
 
-Conventions (docs/paper-map.md):
+Conventions (docs/reference/paper-map.md):
 
 * ``u`` is the command deviation from trim ``u0``.  The effect of actuator ``i``
   (eq. 2) is ``e_i = b0_i + (1 - b1_i) u_i - b1_i u0_i``, so the *absolute* effect
@@ -155,7 +155,7 @@ def mode_of(b1, beta_engine: float, beta_elevon: float):
 
     The engine is faulty when its ``b1`` exceeds ``beta_engine``, else an elevon
     when its ``b1`` exceeds ``beta_elevon`` (the left one first); otherwise the
-    mode is nominal (docs/paper-map.md).
+    mode is nominal (docs/reference/paper-map.md).
 
     Parameters
     ----------

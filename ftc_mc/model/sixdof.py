@@ -532,37 +532,9 @@ def sixdof_summary(plant: SixDofPlant) -> dict:
     }
 
 
-def trimmable_summary(plant, name: str = "the airframe") -> dict:
-    """The trimmable set of each elevon (issue 26, item 5): the locks with a
-    steady flight inside the default validity envelope
-    (:class:`~ftc_mc.model.trimmable.Envelope`), of ``plant``'s linear model
-    (exact, :func:`~ftc_mc.model.trimmable.linear_trimmable_set`) and of the
-    airframe's equations (a bisection of steady-flight searches, cached:
-    :func:`ftc_mc.design.trimmable_cache.cached_trimmable_sets`; its notice on
-    stderr the first time).  Model -> side -> ``lo_deg``, ``hi_deg`` (offsets
-    from ``plant``'s trim position of that elevon) and ``lo_rad``, ``hi_rad``
-    (absolute), or None where no lock has a steady flight."""
-    from ..design.trimmable_cache import cached_trimmable_sets
-    from .trimmable import linear_trimmable_set
-
-    sides = ("left", "right")
-    found = {"linear": {side: linear_trimmable_set(plant, side) for side in sides},
-             "equations": cached_trimmable_sets(plant.airframe, sides, name=name)}
-    out = {}
-    for model_name, ends in found.items():
-        out[model_name] = {}
-        for side in sides:
-            e = ends[side]
-            trim = plant.u0[COMMAND[side]]
-            out[model_name][side] = None if e is None else {
-                "lo_deg": math.degrees(e[0] - trim), "hi_deg": math.degrees(e[1] - trim),
-                "lo_rad": e[0], "hi_rad": e[1]}
-    return out
-
-
 def format_sixdof_summary(s: dict, name: str = "") -> str:
-    """Human-readable text of :func:`sixdof_summary` (and of
-    :func:`trimmable_summary` when it holds one)."""
+    """Human-readable text of :func:`sixdof_summary` (the trimmable sets:
+    :func:`ftc_mc.model.trimmable.format_trimmable_summary`)."""
     t = s["trim"]
     lines = [
         f"{name + ': ' if name else ''}6-DOF trim at Va = {t['airspeed_mps']:g} m/s, "
@@ -575,21 +547,6 @@ def format_sixdof_summary(s: dict, name: str = "") -> str:
         f"{t['aileron_rad']:.5f})",
         "",
     ] + mode_table(s["eigenvalues"])
-    if "trimmable_set" in s:
-        from .trimmable import Envelope
-
-        env = Envelope()
-        lines += ["", "trimmable set: the elevon locks with a steady flight (straight or "
-                      "turning) inside the validity envelope ({:g}-{:g} m/s, alpha {:g} to "
-                      "{:g} deg, bank up to {:g} deg), offsets from trim".format(
-                          *env.airspeed, *np.degrees(env.alpha), math.degrees(env.bank))]
-        for model_name, label in (("linear", "linear model (exact)"),
-                                  ("equations", "equations (bisection, 0.05 deg)")):
-            sets = s["trimmable_set"][model_name]
-            lines.append(f"  {label:34s}" + ", ".join(
-                f"{side} " + ("none" if sets[side] is None else
-                              f"{sets[side]['lo_deg']:+.2f} to {sets[side]['hi_deg']:+.2f} deg")
-                for side in ("left", "right")))
     return "\n".join(lines)
 
 

@@ -1,4 +1,4 @@
-"""Steady flight of the flying wing with one elevon locked (issue 26, item 5).
+"""Steady flight of the flying wing with one elevon locked.
 
 The X8 has no rudder: with one elevon locked, pitch and roll share the healthy
 elevon, and the throttle is the only other control.  A lock offset is
@@ -434,3 +434,45 @@ def linear_trimmable_set(plant, side: str, envelope: Envelope = Envelope()):
                                f"{sol.message}")
         ends.append(float(sol.x[-1]))
     return tuple(ends)
+
+
+def trimmable_summary(plant, equations: dict) -> dict:
+    """The trimmable set of each elevon: the locks with a steady flight inside
+    the default validity envelope (:class:`Envelope`), of ``plant``'s linear
+    model (exact, :func:`linear_trimmable_set`) and of the airframe's equations
+    (``equations``: side -> ``(lo, hi)`` or None, as
+    :func:`equations_trimmable_set` finds them; cached by
+    :func:`ftc_mc.cache.trimmable.cached_trimmable_sets`).  Model -> side ->
+    ``lo_deg``, ``hi_deg`` (offsets from ``plant``'s trim position of that
+    elevon) and ``lo_rad``, ``hi_rad`` (absolute), or None where no lock has a
+    steady flight."""
+    sides = ("left", "right")
+    found = {"linear": {side: linear_trimmable_set(plant, side) for side in sides},
+             "equations": equations}
+    out = {}
+    for model_name, ends in found.items():
+        out[model_name] = {}
+        for side in sides:
+            e = ends[side]
+            trim = plant.u0[COMMAND[side]]
+            out[model_name][side] = None if e is None else {
+                "lo_deg": math.degrees(e[0] - trim), "hi_deg": math.degrees(e[1] - trim),
+                "lo_rad": e[0], "hi_rad": e[1]}
+    return out
+
+
+def format_trimmable_summary(sets: dict) -> str:
+    """Human-readable text of :func:`trimmable_summary`."""
+    env = Envelope()
+    lines = ["trimmable set: the elevon locks with a steady flight (straight or "
+             "turning) inside the validity envelope ({:g}-{:g} m/s, alpha {:g} to "
+             "{:g} deg, bank up to {:g} deg), offsets from trim".format(
+                 *env.airspeed, *np.degrees(env.alpha), math.degrees(env.bank))]
+    for model_name, label in (("linear", "linear model (exact)"),
+                              ("equations", "equations (bisection, 0.05 deg)")):
+        found = sets[model_name]
+        lines.append(f"  {label:34s}" + ", ".join(
+            f"{side} " + ("none" if found[side] is None else
+                          f"{found[side]['lo_deg']:+.2f} to {found[side]['hi_deg']:+.2f} deg")
+            for side in ("left", "right")))
+    return "\n".join(lines)

@@ -227,7 +227,7 @@ def psd_q(omega, m: DrydenModel):
 
 
 # ----------------------------------------------------------------------------
-# lateral components (6-DOF plant, issue 24)
+# lateral components (6-DOF plant)
 
 DrydenLateralModel = collections.namedtuple(
     "DrydenLateralModel",

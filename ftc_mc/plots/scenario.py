@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..scenario.run import controller_names
+from ..sim.setup import controller_names
 from .figure import plt, save
 
 
@@ -114,7 +114,7 @@ def scenario_figures(res, out: Path) -> list:
     axs[-1].set_xlabel("time [s]")
     fig.suptitle("Fig. 12: commands (difference from trim)")
     paths.append(save(fig, out / "fig12_commands.png"))
-    if "phi_true" in ts:  # the 6-DOF plant: its lateral motion (issue 26)
+    if "phi_true" in ts:  # the 6-DOF plant: its lateral motion
         paths.append(lateral_figure(res, out / "fig13_lateral.png"))
     return paths
 

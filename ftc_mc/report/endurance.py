@@ -1,4 +1,4 @@
-"""The report section of an endurance run (``ftc-mc endurance``, issue 25), and the
+"""The report section of an endurance run (``ftc-mc endurance``), and the
 endurance rows a sweep's operating characteristic uses.
 
 Per design: the fault-free flight hours, the false resets, their rate per hour

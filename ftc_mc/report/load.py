@@ -36,7 +36,7 @@ TRIAL_COLUMNS = ("transition", "variant", "trial_id", "correct", "inappropriate"
                  *SIDE_COLUMNS, *SUMMARY_COLUMNS)
 """The ``trials.parquet`` columns the report reads (its sections, figures, the
 summary function and the side monitor's table); only these are loaded, so the
-report of a run of millions of trials fits in memory (issue 27).  The others (draws, final estimates, the
+report of a run of millions of trials fits in memory.  The others (draws, final estimates, the
 first reset's block, reset counts) are left on disk."""
 
 

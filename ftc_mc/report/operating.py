@@ -1,4 +1,4 @@
-"""The operating characteristic of a sweep's detection designs (issue 13, part 4).
+"""The operating characteristic of a sweep's detection designs.
 
 A *design* (the sweep's ``variant`` column: estimator model x residual test x
 thresholds, e.g. ``paper``, ``swapped``, ``gust_glr``) is judged by the flight
@@ -27,7 +27,7 @@ sweep's transitions:
   :func:`~ftc_mc.report.sweep.recommend_threshold`);
 * ``false_resets_per_hour_upper95`` [1/h]: the one-sided 95 % upper bound of
   the false-reset rate (:func:`ftc_mc.stats.poisson_upper`): a point meets a
-  false-alarm target only when this bound does (issue 25), and otherwise
+  false-alarm target only when this bound does, and otherwise
   ``hours_to_show`` [h] says how many flight hours would show it with no
   further false reset (3.0 / target with none seen).
 

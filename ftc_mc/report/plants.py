@@ -146,7 +146,7 @@ def condition_rates(trials: pd.DataFrame, fault_time_s: float) -> pd.DataFrame:
         Flight before the switch in every trial [s]: the exposure of
         ``false_resets``, counted only in trials whose truth is nominal before
         the switch (``mode_pre``; unlock and recover rows start faulted and
-        have no false resets, issue 25).
+        have no false resets).
 
     Returns
     -------

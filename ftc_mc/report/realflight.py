@@ -1,4 +1,4 @@
-"""The report's "metrics comparable with real-flight studies" of a run (issue 25).
+"""The report's "metrics comparable with real-flight studies" of a run.
 
 Per design and transition row, from ``trials.parquet`` (so older runs are scored
 too): ALFA precision, recall and detection delays, and FDDBenchmark's average

@@ -110,7 +110,7 @@ def paper_tables(summary: pd.DataFrame) -> list:
 
 
 def cost_lines(summary: pd.DataFrame) -> list:
-    """Markdown lines: what flying cost, per row and design (issue 25), from the
+    """Markdown lines: what flying cost, per row and design, from the
     summary's cost columns (:func:`ftc_mc.campaign.summary.cost_summary`);
     nothing for a run written before them."""
     if "track_rms_m" not in summary:

@@ -1,4 +1,4 @@
-"""The misattribution table of runs with sensor transitions (issue 14).
+"""The misattribution table of runs with sensor transitions.
 
 A sensor fault leaves the actuators healthy, so every action of the actuator
 FDI after it is a misattribution: a covariance-block reset, the belief's most
@@ -79,7 +79,7 @@ SIZE_BINS = 4
 
 
 def isolation_table(rows: pd.DataFrame, trials: pd.DataFrame | None) -> list:
-    """Markdown lines of the isolation rates of the sensor-aware designs (issue 14).
+    """Markdown lines of the isolation rates of the sensor-aware designs.
 
     A bias fault is isolated when the trial flew to the end, the design's
     estimate of the bias is within 25 % of the true one, and the belief's most

@@ -27,10 +27,10 @@ def recommend_threshold(table: pd.DataFrame, variant: str,
     """The threshold point a sweep recommends for one signature variant.
 
     Among the points whose false-reset rate per flight hour is shown to be at
-    most ``target`` (its one-sided 95 % upper bound, :func:`ftc_mc.stats.poisson_upper`,
-    issue 25), the one with the smallest mean over transitions of the
-    inappropriate-reset rate plus the *unexplained* no-reset rate (no-reset
-    trials not explained by a small ``b1`` or a lock near trim).  If no point
+    most ``target`` (its one-sided 95 % upper bound, :func:`ftc_mc.stats.poisson_upper`),
+    the one with the smallest mean over transitions of the inappropriate-reset rate
+    plus the *unexplained* no-reset rate (no-reset trials not explained by a small
+    ``b1`` or a lock near trim).  If no point
     meets the target, the point with the lowest bound.
 
     Parameters

@@ -19,8 +19,7 @@ import numpy as np
 import pandas as pd
 
 from ..config.schema import ScenarioConfig
-from ..conventions import (CONTROLLER_NAMES, LONGITUDINAL, MODE_NAMES,
-                           SELECTED_CONTROLLER_NAMES, STATUS_NAMES)
+from ..conventions import LONGITUDINAL, MODE_NAMES, STATUS_NAMES
 from ..core.longitudinal.trial import advance
 from ..core.longitudinal.workspace import EXC_3211, EXC_3211_START, EXC_DOUBLET, EXC_DOUBLET_START
 from ..model.faults import estimator_params, mode_of
@@ -28,7 +27,7 @@ from ..sim.compiling import compiled_once
 from ..sim.paths import path_of
 from ..sim.inputs import scenario_inputs
 from ..sim.lanes import HISTORY_RESETS, run_alone
-from ..sim.setup import SimSetup, build_setup, runs_of
+from ..sim.setup import SimSetup, build_setup, controller_names, runs_of
 from ..paper import PAPER_TIMELINE
 
 
@@ -162,13 +161,6 @@ def _timeseries(setup, sc, rec, k_sw, b0, b1) -> pd.DataFrame:
     # steps before k_switch[idx] belong to the previous entry; the commands of
     # step k act during (k dt, (k+1) dt], logged at the end of the step
     return df
-
-
-def controller_names(sc: ScenarioConfig) -> tuple:
-    """The names of the controller codes the scenario's design flies: the
-    paper's three, or the four of a ``lock_turn_selected`` design."""
-    selected = sc.controller_of(runs_of(sc)[0]) == "lock_turn_selected"
-    return SELECTED_CONTROLLER_NAMES if selected else CONTROLLER_NAMES
 
 
 def _events(ts: pd.DataFrame, sc: ScenarioConfig, rec, setup) -> pd.DataFrame:

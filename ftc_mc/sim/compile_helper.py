@@ -12,7 +12,7 @@ cache while this process compiles the other before it types ``advance``
 loads it from the cache, and one the helper is still compiling it waits for
 (the *claims* of :class:`ftc_mc.core.jit.ContentFunctionCache`).  ``advance``'s
 own compile, which calls its stages by address (:mod:`ftc_mc.core.linking`),
-stays in this process (measured: ``docs/performance.md``, lessons 11, 14 and
+stays in this process (measured: ``docs/findings/performance.md``, lessons 11, 14 and
 17).
 
 The helper must know each stage's Numba signature before ``advance`` is typed.

@@ -2,7 +2,7 @@
 
 A cold compile of a path of :func:`ftc_mc.core.longitudinal.trial.advance`
 (``core/shared/paths.py``) takes tens of seconds (``scripts/benchmarks/bench_campaign.py``,
-``docs/performance.md`` lesson 11).  Processes that start together on an empty
+``docs/findings/performance.md`` lesson 11).  Processes that start together on an empty
 cache (two runs launched at once, Dask or test workers on one machine) would
 each compile it, on cores they then share.  :func:`compiled_once` makes the
 first one compile while the others wait for it and then load the result from
@@ -32,7 +32,7 @@ WAIT_NOTICE = ("ftc-mc: another process is compiling the simulation kernels; wai
 
 WAIT_LIMIT_S = 900.0
 """Longest wait for another process's compile [s] (a path's cold compile takes
-minutes at most, ``docs/performance.md`` lesson 11); a holder stopped for longer
+minutes at most, ``docs/findings/performance.md`` lesson 11); a holder stopped for longer
 is no longer waited for."""
 
 GAVE_UP_NOTICE = ("ftc-mc: the other process has not finished compiling after {:.0f} s; "
@@ -52,12 +52,12 @@ EXPECTED_COMPILE = {LinearPlant: "30 s", NonlinearPlant: "30 s",
 """What the compile notice says a path's cold compile takes, by its plant marker
 (``core/shared/paths.py``), on 2 cores with the compile helper
 (:mod:`ftc_mc.sim.compile_helper`), each path on an empty cache
-(``scripts/benchmarks/bench_compile.py``, stop 44, once the stages were called by
-address: ``docs/performance.md`` lesson 17): the default (linear) path 22.8 s
+(``scripts/benchmarks/bench_compile.py``, once the stages were called by
+address: ``docs/findings/performance.md`` lesson 17): the default (linear) path 22.8 s
 (``scripts/benchmarks/bench_campaign.py``'s ``compile_s``, setup included: 24.0-25.8 s),
 the paper's design on the nonlinear plant 21.8 s, ``robust`` 28.8 s, the
-paper's design on the 6-DOF plant 32.8 s; at stop 45 the same 33.6 and
-36.1 s, and the paper's design on the 6-DOF plant with the extended side
+paper's design on the 6-DOF plant 32.8 s; measured again later, the same 33.6
+and 36.1 s, and the paper's design on the 6-DOF plant with the extended side
 monitor (``configs/sixdof_moderate.yaml``) 34.5 and 33.7 s."""
 
 

@@ -1,5 +1,5 @@
 """Detection designs: the kernel settings of each estimator model x residual test x
-thresholds (issue 13, docs/architecture.md).
+thresholds.
 
 A design (:class:`~ftc_mc.config.schema.DesignConfig`) becomes a :class:`Design`:
 the filter model, the Table 1 detection at the design's thresholds with its
@@ -21,7 +21,7 @@ equations predict the plant states and the outputs
 takes the Jacobians at trim, or with ``relinearise_s`` those about each lane's
 estimate, re-computed every ``relinearise_s`` seconds (``FilterModel.relin``).
 
-A sensor-aware design (``sensor_biases``, issue 14) appends the biases of the
+A sensor-aware design (``sensor_biases``) appends the biases of the
 residuals' sensors (q, n_x, n_z) after any gust states: random walks that only
 add to their output.  Table 1 still picks an actuator block; its reset also opens
 the biases of the sensors sharing its residual (:data:`BIAS_BLOCK`), so the
@@ -29,7 +29,7 @@ filter, with the excitation the reset sends, sorts the change into an actuator
 fault or an output bias (:func:`_with_sensor_biases`).
 
 A design may also send excitation beyond the paper's requests on resets
-(``excitation_policy``, issue 25): its :attr:`Design.excitation` fills the
+(``excitation_policy``): its :attr:`Design.excitation` fills the
 policy fields of the kernels' :class:`~ftc_mc.core.longitudinal.settings.Excitation`
 (:data:`NO_POLICY` for the paper's, which leaves the kernels as before), and
 the signals' amplitudes where the design sets its own (``doublet_amplitude``,
@@ -38,7 +38,28 @@ changes the flight before any reset, so it is part of the design key.
 
 A design changes only what the filter assumes: the truth noise of every trial
 comes from the config's ``estimator`` and ``noise`` sections, so all designs fly
-the same trials (common random numbers).
+the same trials (common random numbers); :func:`ftc_mc.sim.inputs.design_inputs`
+only pads the initial estimate with zeros and sets the design's ``P0``.  The
+truth starts at trim with a stationary gust draw, which the filter's first
+steps do not match: a design's ``startup_s`` (``Detection.startup``) arms its
+test only after that.  Histories keep the first 14 states, ``xa_end`` all of
+them (a sensor-aware design's final bias estimates, for
+:func:`ftc_mc.campaign.chunk.classify_sensor`'s ``isolated``).  The results'
+``variant`` column holds the design's name; ``paper`` is the baseline of the
+report's paired comparisons.
+
+In the kernels (``core/longitudinal/stages.filter_update``) the paper's
+14-state filter with a linear prediction runs the block-structured
+``batch.filter_predict_lanes`` / ``filter_correct_lanes`` (the golden results);
+anything else runs ``gustfilter.gust_predict_lanes`` / ``gust_correct_lanes``:
+dense ``F P F^T + Q`` and ``P c^T`` over every lane, and with
+``FilterModel.nl`` the airframe's RK4 predicting the plant states and ``h(x,
+wind)`` the outputs.  Between the halves the decision statistics are the
+one-step residuals or, with the GLR test, ``glr.glr_lanes`` over the lane's
+window (a reset empties it; each innovation is clipped to ``Detection.clip``,
+``inf`` without ``innovation_clip``).  The controller selection predicts with
+the paper's model on the first 14 states.  ``state_noise`` adds process noise
+on named plant states (the airframe model's error in turbulence).
 """
 
 from __future__ import annotations
@@ -69,7 +90,7 @@ under c2 scaled by ``1 - b1_left_hat`` as eq. 23 prints)."""
 def design_excitation(dc: DesignConfig, dt: float) -> dict:
     """The fields of the kernels' ``Excitation`` the design ``dc`` sets (``dt``:
     the control period [s]): the policy's, :data:`NO_POLICY` for ``none``, with
-    the design's ``s3211_floor`` (issue 25) either way, and the signals'
+    the design's ``s3211_floor`` either way, and the signals'
     amplitudes (``doublet_amp``, ``s3211_amp``) where the design sets its own."""
     own = {"s3211_floor": float(dc.s3211_floor)}
     if dc.doublet_amplitude is not None:
@@ -273,7 +294,7 @@ SENSOR_BIAS_WALK = {"q": 0.3, "n_x": 0.05, "n_z": 0.3}
 """Default random-walk density of each bias per sqrt(s), in measurement-noise
 standard deviations: q and n_z fast enough that a bias below Table 1's
 threshold is learnt within 30 s; n_x slower, as faster walks hide small thrust
-losses (measured on Tables 2-3, issue 14's note)."""
+losses (measured on Tables 2-3)."""
 
 BIAS_BLOCK = {"q": RESET_ELEVONS, "n_x": RESET_THRUST, "n_z": RESET_ELEVONS}
 """The Table 1 block whose reset opens each bias: the one deciding on its residual
@@ -282,7 +303,7 @@ BIAS_BLOCK = {"q": RESET_ELEVONS, "n_x": RESET_THRUST, "n_z": RESET_ELEVONS}
 
 def _with_sensor_biases(fm: FilterModel, P0: np.ndarray, dc: DesignConfig, dt: float):
     """``fm`` and ``P0`` with the output biases of ``dc.sensor_biases`` appended
-    after the other extra states (issue 14).
+    after the other extra states.
 
     Bias ``s_o`` of output ``o``: ``s+ = s + w``, ``Var w = (walk_o sigma_o)^2 dt``
     (``walk_o``: ``dc.sensor_bias_walk`` or :data:`SENSOR_BIAS_WALK`)

@@ -5,7 +5,7 @@ augmented filter model (eqs. 4-6), the Table 1 detection with its reset
 variances (section 3.2.2), and the mode boxes of the belief (eq. 12).  Paper
 values (section 5.1): ``Q^x = 0.01^2 dt I_9``, ``Q^b = 0.001^2 dt I_5``, R from
 the sensor accuracies (``e^{-2}`` read as 1e-2 and ``e^{-6}`` as 1e-6,
-docs/paper-map.md), thresholds ``t_q = t_nx = 25`` and the transition matrix
+docs/reference/paper-map.md), thresholds ``t_q = t_nx = 25`` and the transition matrix
 ``T_M``.  The tunable values come from the validated ``estimator`` section
 (:class:`~ftc_mc.config.schema.EstimatorConfig`, which holds their defaults);
 the builders here trust them.
@@ -64,7 +64,7 @@ class EstimatorSettings:
         ``"paper"`` (Table 1 as printed) or ``"swapped"``.
     beta_engine, beta_elevon : float
         Effectiveness loss above which an actuator counts as faulty in the mode
-        boxes (docs/paper-map.md).
+        boxes (docs/reference/paper-map.md).
     b0_nominal_engine, b0_nominal_elevon : float
         Half-width of the nominal box of b0 (throttle [-], elevon sum [rad]).
     tm : tuple
@@ -155,7 +155,7 @@ def detection(plant: LinearPlant, s: EstimatorSettings) -> Detection:
 
 
 def belief_settings(plant: LinearPlant, s: EstimatorSettings) -> Belief:
-    """Mode boxes of eq. (12) and ``T_M`` (docs/paper-map.md).
+    """Mode boxes of eq. (12) and ``T_M`` (docs/reference/paper-map.md).
 
     Parameters are ``[b0_T, b0_e, b1_T, b1_L, b1_R]``.  Nominal: every ``b1`` in
     ``[0, beta]`` and each ``b0`` within ``+-b0_nominal``.  Actuator ``i`` faulty:

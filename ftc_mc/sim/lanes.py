@@ -67,7 +67,7 @@ def run_trials(scheme, flight, inp: TrialInputs, rec: TrialRecord) -> None:
     state and step range.  The step kernel is called from Python, not from a
     compiled wrapper: Numba re-optimises and re-emits all the code a compiled
     caller links in, so a wrapper kernel cost the cold compile about 20 s
-    (``docs/performance.md``, lesson 6).
+    (``docs/findings/performance.md``, lesson 6).
     """
     st = start_lanes(scheme, flight, inp, rec)
     advance(path_of(scheme, flight), scheme, flight, inp, rec, st, 0, flight.timing.n_steps)

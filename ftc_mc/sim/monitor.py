@@ -9,7 +9,7 @@ airframe's equations predict); its noise follows the paper's filter:
   parameter (the paper's ``Q^x``, ``Q^b``, estimator section of the config);
 * ``R``: the paper's filter's ``R`` on the 12 longitudinal outputs, and on the
   5 lateral ones the variance of the longitudinal sensor of the same kind
-  (:data:`ftc_mc.sim.truth.LATERAL_NOISE_AS`), as the truth draws them;
+  (:data:`ftc_mc.sim.noise.LATERAL_NOISE_AS`), as the truth draws them;
 * ``P0``: ``10 Q`` on the states and the reset variances on the fault
   parameters, as the paper's filter starts (:func:`ftc_mc.sim.estimator.initial_covariance`);
 * gust states (``monitor.design_turbulence`` other than ``none``): the
@@ -172,7 +172,7 @@ def monitor_spec(cfg, fm, det, lock_turn: bool = False) -> MonitorSpec | None:
         spec carries the lock-turn table's offsets (``monitor.turn_offsets_deg``,
         ``turn_step_deg``).
     """
-    from .truth import lateral_noise
+    from .noise import lateral_noise
 
     mc = cfg.monitor
     if not mc.enabled:
@@ -301,7 +301,7 @@ def lock_turn_table(six, u0: np.ndarray, offsets=(), airframe=None,
     """The kernels' :class:`LockTurnTable` (empty, ``x`` of shape ``(2, 0, 10)``,
     when ``offsets`` is).
 
-    The designs come from :func:`ftc_mc.design.lock_turn.cached_lock_turn_designs`
+    The designs come from :func:`ftc_mc.cache.lock_turn.cached_lock_turn_designs`
     at the 6-DOF trim's airspeed and air-path angle and the model's period;
     states become deviations from the 6-DOF trim on the monitor's rows
     (``layout.MONITOR_STATES``), commands deviations from the longitudinal trim.
@@ -334,7 +334,8 @@ def lock_turn_table(six, u0: np.ndarray, offsets=(), airframe=None,
     Designs the cache does not hold are computed with a notice on stderr and
     their duration.
     """
-    from ..design.lock_turn import SIDES, cached_lock_turn_designs, healthy, turn_states
+    from ..cache.lock_turn import cached_lock_turn_designs
+    from ..design.lock_turn import SIDES, healthy, turn_states
 
     nf = len(turn_states("left"))
     rows = np.array([[MONITOR_STATES.index(n) for n in turn_states(side)] for side in SIDES],

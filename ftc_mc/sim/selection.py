@@ -1,4 +1,4 @@
-"""Settings of the selection among the four 6-DOF controllers (issue 26, item 4).
+"""Settings of the selection among the four 6-DOF controllers.
 
 A ``controller: lock_turn_selected`` design (:mod:`ftc_mc.core.sixdof.selection`)
 keeps the paper's belief and selection, read on the 6-DOF model:

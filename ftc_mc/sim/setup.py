@@ -20,22 +20,24 @@ import math
 
 import numpy as np
 
+from ..cache.engine_tables import cached_engine_tables
 from ..config.schema import Config, ScenarioConfig
-from ..conventions import LONGITUDINAL, VARIANTS
+from ..conventions import (CONTROLLER_NAMES, LONGITUDINAL, SELECTED_CONTROLLER_NAMES,
+                           VARIANTS)
 from ..core.shared.interp import EngineTables
 from ..core.longitudinal.settings import (Belief, Controller, Detection, Excitation, FilterModel,
                                           Flight, Reconfig, Scheme, Timing, Track, TruthPlant,
                                           Validity)
 from ..design.lqr import discounted_lqr, paper_q_lqr
 from ..design.terminal import terminal_costs
-from ..design.theorem41 import cached_engine_tables
 from ..model.linear import LinearPlant
 from ..model.source import load_plant
 from ..model.turbulence import DrydenModel
 from .designs import NO_POLICY, Design, build_designs
 from .estimator import (EstimatorSettings, belief_settings, detection, filter_model,
                         initial_covariance)
-from .truth import lateral_noise, sixdof_truth_plant, truth_plant
+from .noise import lateral_noise
+from .truth import sixdof_truth_plant, truth_plant
 
 CONTROLLER_KINDS = {"nominal": 0, "reconfiguring": 1, "lock_turn": 2, "lock_turn_selected": 3}
 """``Reconfig.kind`` of each controller kind (``controller.kind``, a design's
@@ -179,6 +181,13 @@ def runs_of(cfg: Config | ScenarioConfig) -> tuple:
     if isinstance(cfg, ScenarioConfig):
         return (cfg.scenario.design or cfg.scenario.signature,)
     return cfg.campaign.runs()
+
+
+def controller_names(sc: ScenarioConfig) -> tuple:
+    """The names of the controller codes a scenario's design flies: the
+    paper's three, or the four of a ``lock_turn_selected`` design."""
+    selected = sc.controller_of(runs_of(sc)[0]) == "lock_turn_selected"
+    return SELECTED_CONTROLLER_NAMES if selected else CONTROLLER_NAMES
 
 
 def timing_of(cfg: Config | ScenarioConfig) -> Timing:

@@ -225,19 +225,3 @@ def coupled_controllers(six, lat, paper):
     G1 = EngineTables(K=kernel_gain(t6.K, eng.K), k=np.ascontiguousarray(t6.k - eng.k),
                       b0_grid=eng.b0_grid, b1_grid=eng.b1_grid)
     return kernel_gain(d.K, K0), G1
-
-
-LATERAL_NOISE_AS = {"phi": "theta", "v": "w", "p": "q", "r": "q", "psi": "theta"}
-"""The longitudinal output whose measurement noise each measured lateral state
-of the 6-DOF loop takes (same kind of sensor: attitude, body velocity, rate)."""
-
-
-def lateral_noise(r_std: np.ndarray) -> np.ndarray:
-    """Noise standard deviations (5,) of the lateral loop's measured states
-    (``core/sixdof/truth.LATERAL_LOOP``), from the longitudinal outputs' (12,)
-    by :data:`LATERAL_NOISE_AS`."""
-    from ..conventions import LONGITUDINAL
-    from ..core.sixdof.truth import LATERAL_LOOP, N_LAT_MEASURED
-
-    return np.array([r_std[LONGITUDINAL.output(LATERAL_NOISE_AS[n])]
-                     for n in LATERAL_LOOP[:N_LAT_MEASURED]])

@@ -1,4 +1,4 @@
-"""Benchmark of `ftc-mc run configs/paper_tables.yaml` (issue: campaign speed).
+"""Benchmark of `ftc-mc run configs/paper_tables.yaml`.
 
 Prints, for the full reproduction (1000 trials per transition, 8 transitions,
 both signature variants, 500 steps each):

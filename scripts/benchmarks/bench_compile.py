@@ -1,4 +1,4 @@
-"""Benchmark of the cold compile of each compile path (issue 23).
+"""Benchmark of the cold compile of each compile path.
 
 For each path below, a fresh interpreter with an empty Numba cache
 (``NUMBA_CACHE_DIR`` pointed at an empty folder) warms the kernels of one
@@ -39,7 +39,7 @@ PATHS = {
                   {"plant": {"kind": "nonlinear", "turbulence": "moderate"}}),
     "dense_glr": ("designs.yaml", "gust_glr", {}),
     "robust": ("robust_moderate.yaml", "robust", {}),
-    "sixdof": ("sixdof_tables.yaml", "paper", {}),  # issue 24: the 6-DOF plant's path
+    "sixdof": ("sixdof_tables.yaml", "paper", {}),  # the 6-DOF plant's path
     # the 6-DOF plant in moderate turbulence: its side monitor the extended filter
     "sixdof_extended": ("sixdof_moderate.yaml", "paper", {}),
 }

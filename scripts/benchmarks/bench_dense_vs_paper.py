@@ -1,5 +1,5 @@
 """Benchmark: the paper's 14-state filter problem through its own structured
-kernels and through the dense (general) filter's kernels (issue 23, item 5).
+kernels and through the dense (general) filter's kernels.
 
 Both fly the same 256 trials of ``configs/paper_tables.yaml``'s
 ``elevon_loss`` row (linear plant, still air, one thread, the controller given

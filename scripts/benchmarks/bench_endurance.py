@@ -5,7 +5,7 @@ turbulence, reconfiguring controller, 50 s flights) flies ``--hours`` fault-free
 flight hours with ``--jobs`` workers (threads), after one warm-up flight that
 compiles or loads the kernels.  Prints the wall time, the flights, and the
 flight hours per minute of wall time, and per minute of CPU time (on a
-machine shared with other work the wall time says less).  Target (issue 25): at least 100 flight
+machine shared with other work the wall time says less).  Target: at least 100 flight
 hours per minute on 2 cores.
 
 Usage: ``python scripts/benchmarks/bench_endurance.py [--hours H] [--jobs N] [--design NAME]``.

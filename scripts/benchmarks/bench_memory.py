@@ -1,4 +1,4 @@
-"""Peak memory and wall time of a big run, and of the report on it (issue 27).
+"""Peak memory and wall time of a big run, and of the report on it.
 
 Runs ``ftc-mc run CONFIG --controller nominal --trials N`` (both signature
 variants, the default threads backend and ``--jobs``) as a child process and

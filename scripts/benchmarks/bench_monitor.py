@@ -1,4 +1,4 @@
-"""Speed of the 6-DOF side monitor's filter beside the paper's 14-state filter (issue 26, item 1).
+"""Speed of the 6-DOF side monitor's filter beside the paper's 14-state filter.
 
 One process, one thread.  Both filters run on lanes of data from their own
 model, nominal, so that no reset or decision fires:

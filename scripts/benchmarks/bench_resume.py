@@ -1,4 +1,4 @@
-"""Resuming at scale (issue 27): a run of 15 000+ chunks resumes in time
+"""Resuming at scale: a run of 15 000+ chunks resumes in time
 proportional to the chunks still to run.
 
 Builds the chunk store of ``elevon_lock`` (nominal controller, the paper's

@@ -1,4 +1,4 @@
-"""Benchmark of `ftc-mc scenario configs/paper_scenario.yaml` (issue: scenario speed).
+"""Benchmark of `ftc-mc scenario configs/paper_scenario.yaml`.
 
 Prints:
 
@@ -17,7 +17,7 @@ Prints:
   files and figures is timed once;
 * the ratio to the paper's 7 s in Matlab R2014b (section 5.2).
 
-Targets (issue): kernel under 0.05 s; offline design under 30 s cold, 1 s cached.
+Targets: kernel under 0.05 s; offline design under 30 s cold, 1 s cached.
 The last line is
 ``scenario_kernel_s=<x> scenario_total_s=<y> design_cold_s=<z> design_cached_s=<w>``
 with ``scenario_total_s`` the median of ``run_scenario(sc, setup=prebuilt)``.
@@ -46,7 +46,7 @@ import numpy as np
 from ftc_mc.config import load_scenario
 from ftc_mc.design.lqr import paper_q_lqr
 from ftc_mc.design.terminal import terminal_costs
-from ftc_mc.design.theorem41 import cached_engine_tables
+from ftc_mc.cache.engine_tables import cached_engine_tables
 from ftc_mc.sim.setup import build_setup
 import_s = time.perf_counter() - t0
 cfg = load_scenario(sys.argv[1])

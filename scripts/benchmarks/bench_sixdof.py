@@ -1,4 +1,4 @@
-"""Steps per second of the 6-DOF nonlinear plant against the longitudinal one (issue 24).
+"""Steps per second of the 6-DOF nonlinear plant against the longitudinal one.
 
 Times the nonlinear truth plants alone, one thread: ``--lanes`` trajectories of
 ``--steps`` control periods (dt = 0.1 s, 10 RK4 sub-steps each, commands and
@@ -7,16 +7,16 @@ each plant's own ``propagate`` kernel called from one compiled loop (the way the
 trial kernel calls the longitudinal one per lane).  Median of ``--repeat``
 after a warm-up call.  With ``--trial`` it also times the longitudinal
 nonlinear plant's full trial (``scripts/benchmarks/bench_truth.py``'s measure: filter,
-controllers and classification included), the reference of issue 24's target
+controllers and classification included), the reference of the 6-DOF plant's speed target
 (6-DOF plant at least 0.5x the longitudinal nonlinear plant's trial steps/s);
 that compiles the trial kernel when it is not cached (1.5-3 min).
 
-With ``--campaign N`` it also times issue 26's speed target: the reconfiguring
+With ``--campaign N`` it also times the reconfiguring 6-DOF campaign's speed: the reconfiguring
 6-DOF campaign, ``configs/sixdof_tables.yaml``'s twelve rows with the design
 ``sixdof`` alone (the paper's filter and loop, the side monitor, the lock-turn
 law; ``--design sixdof_selected``: the selection among the four 6-DOF
 controllers instead), ``N`` trials per row, ``--jobs 2``, on the linear 6-DOF plant (the
-issue's setting) and on the nonlinear one, each after a small warm-up run of
+setting of its target) and on the nonlinear one, each after a small warm-up run of
 the same path (its compile and the lock-turn designs are not timed): trial
 steps per second of the whole ``api.run_campaign`` call (setup, trials, summary).
 

@@ -1,4 +1,4 @@
-"""Trials per second on each truth plant, same process (issue 7).
+"""Trials per second on each truth plant, same process.
 
 For every (plant, turbulence) pair of ``--plants`` the script times
 ``ftc_mc.campaign.chunk.run_chunk`` -- drawing the trials, running both
@@ -13,17 +13,17 @@ Usage::
 
     .venv/bin/python scripts/benchmarks/bench_truth.py [--lanes 128] [--repeat 3]
 
-Then the detection designs of issue 13 (``DESIGNS``) on the nonlinear plant in
+Then the detection designs (``DESIGNS``) on the nonlinear plant in
 moderate turbulence, each run alone on the same chunk: the paper's filter
 (``swapped``), the gust-aware filter (18 states, linear prediction) and the
 extended filter (the airframe predicts), with the one-step or the GLR test, and
-the sensor-aware design of issue 14 (the paper's filter with three sensor biases:
+the sensor-aware design (the paper's filter with three sensor biases:
 17 states on the general filter); ratios against ``swapped``.
 
 The last line is ``linear_trials_per_s=<a> nonlinear_trials_per_s=<b>
 nonlinear_moderate_trials_per_s=<c> ratio=<a/b> sixdof_trials_per_s=<d>
 sixdof_vs_nonlinear=<d/b>`` (nominal controller unless told otherwise; the last
-ratio is issue 24's: the 6-DOF nonlinear plant's full trial against the
+ratio has a target: the 6-DOF nonlinear plant's full trial against the
 longitudinal nonlinear one's, target at least 0.5).
 """
 
@@ -51,7 +51,7 @@ from ftc_mc.config import Config  # noqa: E402
 PLANTS = (("linear", "none", 3), ("nonlinear", "none", 3), ("linear", "moderate", 3),
           ("nonlinear", "moderate", 3), ("nonlinear", "none", 6), ("nonlinear", "moderate", 6))
 """(plant, turbulence, degrees of freedom) timed; the 6-DOF rows fly the 6-DOF
-flying wing with its lateral loop (issue 24)."""
+flying wing with its lateral loop."""
 TRANSITIONS = ("elevon_lock", "engine_loss")
 
 DESIGNS = {

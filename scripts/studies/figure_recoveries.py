@@ -1,4 +1,4 @@
-"""Figures of the paper scenario's engine recoveries (docs/recoveries.md, issue 25).
+"""Figures of the paper scenario's engine recoveries (feeds ``docs/findings/recoveries.md``).
 
 Runs ``configs/paper_scenario.yaml`` (or the config given) and draws, from 25 s
 to the end: the thrust's b1 and b0, true and estimated (with the estimate's

@@ -1,11 +1,12 @@
 """How long could any controller keep a run's locks outside the trimmable set in?
 
-Issue 26 asks that, for elevon locks outside the trimmable set, the
-reconfiguring loop at least double the nominal controller's median time to
-leave the envelope.  ``scripts/studies/study_recoverable.py --json F`` finds, per lock
-offset, the longest stay any command history it searched keeps the aircraft
-inside (an oracle: side and lock known from the lock's first instant).  This
-script puts that beside a run's trials:
+Feeds ``docs/findings/sixdof.md``.  The aim for elevon locks outside the
+trimmable set: the reconfiguring loop at least doubles the nominal
+controller's median time to leave the envelope.
+``scripts/studies/study_recoverable.py --json F`` finds, per lock offset, the
+longest stay any command history it searched keeps the aircraft inside (an
+oracle: side and lock known from the lock's first instant).  This script puts
+that beside a run's trials:
 
 * the run's elevon-lock trials of the studied side outside the trimmable set
   of the model the run flies, in its validity envelope

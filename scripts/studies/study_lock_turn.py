@@ -1,7 +1,7 @@
 """Oracle study: can the lock-turn LQR keep a one-elevon-locked X8 in the envelope?
 
-Issue 26, items 4-5.  For each side and lock offset from trim, the nonlinear
-6-DOF equations (the repo's RK4 kernel, ``ftc_mc.core.sixdof.plant.propagate``,
+Feeds ``docs/findings/sixdof.md``.  For each side and lock offset from trim,
+the nonlinear 6-DOF equations (the repo's RK4 kernel, ``ftc_mc.core.sixdof.plant.propagate``,
 10 sub-steps of 0.01 s per 0.1 s control period) fly 60 s from the nominal
 6-DOF trim (20 m/s, -3 deg, wings level) with the elevon locked at ``t = 0``
 (the locked actuator follows its lock with its 0.05 s lag, as eq. (2) does in

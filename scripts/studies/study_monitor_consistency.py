@@ -1,7 +1,7 @@
 """Study: is the gust-aware side monitor consistent on the nonlinear 6-DOF plant?
 
-Issue 26 (nonlinear 6-DOF, moderate turbulence).  In a campaign on the
-nonlinear plant in moderate turbulence the side monitor
+Feeds ``docs/findings/sixdof.md`` (nonlinear 6-DOF, moderate turbulence).  In
+a campaign on the nonlinear plant in moderate turbulence the side monitor
 (``ftc_mc/core/sixdof/monitor.py``, ``design_turbulence: moderate``,
 ``prediction: nonlinear``) makes thousands of false decisions per fault-free
 hour, and still about 1,800 per hour at a GLR threshold of 1000 (against 30

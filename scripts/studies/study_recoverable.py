@@ -1,7 +1,8 @@
 """Which elevon locks can any controller fly on from? The recoverable set.
 
-Issue 26, item 5.  A lock is *trimmable* (``ftc_mc.model.trimmable``) when a
-steady flight exists with it inside the validity envelope.  That does not
+Feeds ``docs/findings/sixdof.md``.  A lock is *trimmable*
+(``ftc_mc.model.trimmable``) when a steady flight exists with it inside the
+validity envelope.  That does not
 make it *recoverable*: the aircraft must also get from the nominal glide to
 that steady flight without leaving the envelope, while the lock rolls and
 pitches it.  This study asks the question with perfect knowledge (an oracle:
@@ -52,8 +53,8 @@ Per side and lock offset from trim, four questions:
    least excess from the eight starts is not positive, nodes every 0.1 s up
    to 3 s and every 1 s beyond; beside it, the time the nominal 6-DOF LQR
    (the paper's longitudinal law and the wings-level lateral law,
-   ``scripts/studies/study_lock_turn.py``) leaves.  Their ratio bounds what issue
-   26's "the reconfiguring loop at least doubles the time to leave" can reach
+   ``scripts/studies/study_lock_turn.py``) leaves.  Their ratio bounds what the
+   target "the reconfiguring loop at least doubles the time to leave" can reach
    for that lock.
 
 ``--plant linear`` asks the same of the linear plant: the 6-DOF linear model

@@ -1,7 +1,7 @@
 """Which elevon locks admit a steady flight: the trimmable set, per airframe and model.
 
-Issue 26, item 5 ("report it per airframe").  A lock offset from trim is
-*trimmable* when some steady flight exists with it inside the validity
+Feeds ``docs/findings/sixdof.md`` (the set, per airframe).  A lock offset from
+trim is *trimmable* when some steady flight exists with it inside the validity
 envelope (airspeed 12-30 m/s, angle of attack -8 to 12 deg, bank up to 60
 deg), with the healthy elevon and the throttle within the airframe's limits:
 

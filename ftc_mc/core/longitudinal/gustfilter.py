@@ -1,4 +1,4 @@
-"""The gust-aware augmented filter on every lane (issue 13; DESIGN.md section 9).
+"""The gust-aware augmented filter on every lane (DESIGN.md section 9).
 
 The paper's filter (:mod:`ftc_mc.core.longitudinal.batch`) models turbulence as white process
 noise, which it is not: the Dryden gusts are coloured, and in moderate
@@ -13,7 +13,7 @@ after the fault parameters, ``X = [x (9), b (5), g (ng)]``:
 
 with ``B_w``, ``D_w`` the wind Jacobians the truth plant uses
 (``ftc_mc/model/wind.py``) and the Dryden model at a *design* turbulence level.
-A sensor-aware design (issue 14) appends output biases ``s`` to ``g``: columns
+A sensor-aware design appends output biases ``s`` to ``g``: columns
 of ``G`` and ``C_d`` zero, ``A_d`` the identity on them, ``Q_g`` their random
 walk, ``D_g`` (and ``D_z``) a unit entry on the biased output; a reset of a
 Table 1 block also resets the biases ``FilterModel.reset_g`` names.
@@ -121,7 +121,7 @@ def _at_point(xabs, cmd, wl, xs, c0, w0):
 @kernel(internal=True)
 def relinearise_lanes(xa, u, fm, st, tw):
     """Every lane's state-map Jacobians about its estimate ``X_{k|k}`` by
-    forward finite differences (issue 13 item 2).
+    forward finite differences.
 
     The one-period map ``x_{k+1} = f(x0 + x, u0 + e, w)`` (:func:`_nl_state`: RK4
     over ``fm.dt`` with ``fm.n_sub`` steps, effect ``e`` of eq. 2 under the
@@ -183,7 +183,7 @@ def relinearise_outputs_lanes(xa, fm, st, tw):
     Taken about the estimate ``X_{k|k}`` instead, as before, they lagged the
     update by a step, and the re-linearised filter reset the thrust block 674
     times in 39.4 fault-free hours of moderate turbulence (38 about the
-    prediction; ``docs/designs.md``)."""
+    prediction; ``docs/findings/turbulence-designs.md``)."""
     xabs = tw.xabs
     wl = tw.wl
     y = tw.y
@@ -611,7 +611,7 @@ def gust_predict_lanes(fkind, xa, P, fm, tw, st, k):
 
 @kernel(internal=True)
 def reset_extra_lanes(P, block, reset_g):
-    """Reset the extra states that go with each lane's block (issue 14).
+    """Reset the extra states that go with each lane's block.
 
     A sensor-aware design opens the hypothesis of an output bias beside the
     actuator block whose residuals it shares: for each extra state ``g`` with

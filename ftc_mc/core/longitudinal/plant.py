@@ -17,7 +17,7 @@ step (deviations from trim, ``TrialWork.u``):
 4. the true air-relative airspeed and angle of attack, for the validity check
    (``TrialWork.va``, ``TrialWork.alpha``);
 5. the lane's sensor fault, if any, on its one output ``o`` from the onset step
-   ``k_s`` on (:func:`sensor_fault`, issue 14): bias ``z_o += size``; drift
+   ``k_s`` on (:func:`sensor_fault`): bias ``z_o += size``; drift
    ``z_o += size (k + 1 - k_s) dt``; stuck ``z_o = `` the last healthy ``z_o``
    (``LaneState.zhold``); noise ``z_o += (size - 1) v_o`` (the noise scaled by
    ``size``).  The air data of step 4 stay true: a sensor fault misleads the

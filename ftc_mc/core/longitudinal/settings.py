@@ -51,8 +51,8 @@ FilterModel = namedtuple("FilterModel", [
 The estimate is ``[x (9), b (5), g (ng)]``: the paper's filter has ``ng = 0``
 (the gust arrays are empty, :mod:`ftc_mc.core.longitudinal.batch`); a gust-aware filter
 carries the ``ng = 4`` Dryden states of the longitudinal gusts
-(:mod:`ftc_mc.core.longitudinal.gustfilter`, issue 13); a sensor-aware design appends output
-biases after them (``Dz``, ``reset_g``; issue 14)."""
+(:mod:`ftc_mc.core.longitudinal.gustfilter`); a sensor-aware design appends output
+biases after them (``Dz``, ``reset_g``)."""
 
 _DetectionFields = namedtuple("Detection", [
     "thresholds",  # (3,) threshold of each residual channel r_q, r_nx, r_nz (Table 1;
@@ -67,7 +67,7 @@ _DetectionFields = namedtuple("Detection", [
                   #      [-clip, clip] (inf: none; DesignConfig.innovation_clip)
     "settle",     # steps after a reset during which the other block is not reset (0: none)
     "startup",    # steps from the start before the test is armed: no reset, GLR window
-                  # kept empty (0: armed at once; DesignConfig.startup_s, issue 25)
+                  # kept empty (0: armed at once; DesignConfig.startup_s)
 ])
 
 
@@ -143,7 +143,7 @@ Excitation = namedtuple("Excitation", [
     "s3211_unit",       # steps of one unit of the 3211
     "resend_delay",     # steps after a thrust reset before the doublet re-check (3 s)
     "resend_b1",        # re-send the doublet if b1_thrust estimate exceeds this (0.7)
-    # the design's excitation policy beyond the requests on resets (issue 25)
+    # the design's excitation policy beyond the requests on resets
     "policy",           # conventions.EXCITE_NONE (the paper), EXCITE_PERIODIC or
                         #    EXCITE_AMBIGUOUS (stages.policy_signals)
     "period",           # periodic: steps between two doublets (the 3211 half-way);
@@ -154,10 +154,10 @@ Excitation = namedtuple("Excitation", [
     "suspect",          # ambiguous: send when r_q or r_nx (the decision statistics)
                         #    reach this (inf: never)
     "s3211_floor",      # under c2 the 3211 is scaled by max(1 - b1_left_hat, this)
-                        #    (0: eq. 23 as printed; DesignConfig.s3211_floor, issue 25)
+                        #    (0: eq. 23 as printed; DesignConfig.s3211_floor)
 ])
 """Excitation on reset requests (paper sections 3.2.3 and 4.1.1), and the
-design's policy of sending more (issue 25)."""
+design's policy of sending more."""
 
 Timing = namedtuple("Timing", [
     "n_steps",        # steps simulated
@@ -165,7 +165,7 @@ Timing = namedtuple("Timing", [
     "reconf_every",   # steps between belief updates (reconfiguration period)
     "detect_prob",    # belief of the final mode that counts as detected
 ])
-"""Trial timing (Tables 2-3; ``docs/paper-map.md``)."""
+"""Trial timing (Tables 2-3; ``docs/reference/paper-map.md``)."""
 
 TrialInputs = namedtuple("TrialInputs", [
     "k_switch",   # (E,) int64 steps at which the truth switches, k_switch[0] == 0
@@ -347,6 +347,6 @@ TruthPlant = namedtuple("TruthPlant", [
     "Bw",     # (9, 3) linear plant: discrete (zero-order hold) input matrix of the gust
     "Dw",     # (12, 3) linear plant: gust feed-through into the outputs
 ])
-"""The truth plant a trial simulates (issue 7): linear or nonlinear, with or
+"""The truth plant a trial simulates: linear or nonlinear, with or
 without turbulence.  The estimator and the controllers always use the linear
 model (:class:`FilterModel`)."""

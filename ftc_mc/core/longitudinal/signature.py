@@ -7,13 +7,28 @@ Table 1 as printed (variant ``paper``)::
 
 Variant ``swapped`` exchanges the ``r_nz`` comparison of the third clause (an
 elevon fault drives ``r_q`` and ``r_nz`` far above ``r_nx``, which the printed
-rule sends to the thrust block; see ``docs/paper-map.md``).
+rule sends to the thrust block; see ``docs/reference/paper-map.md``).
 
 The kernel reads Table 1 as data the family supplies (``conventions.TABLE1``,
-``Detection.thresholds`` and ``.table``): a threshold per residual channel and
-a decision table over the channels' hit patterns, whose rows may compare two
-channels (the third clause).  Another plant family (the 6-DOF one, with a roll
-channel and a block per elevon) brings its own channels, thresholds and table.
+``Layout.thresholded``, ``Layout.decisions``):
+
+* a threshold per residual channel (``Detection.thresholds``; ``inf`` for a
+  channel that is only compared, ``r_nz``);
+* a decision table (``Detection.table``), one row per hit pattern of the
+  channels (bit ``i`` set when channel ``i`` reaches its threshold):
+  ``(block_if, block_else, cmp_a, cmp_b)``, ``block_if`` when the row compares
+  nothing (``cmp_a`` -1) or ``r[cmp_a] >= r[cmp_b]``, else ``block_else``.
+  The third clause of Table 1 is such a comparison (``r_nz`` against
+  ``r_nx``), and ``paper`` and ``swapped`` differ only in its two blocks;
+* block membership (``Layout.block_params``).
+
+:func:`signature_lanes` reads them for any number of channels and blocks, so another
+plant family (the 6-DOF one, with a roll channel and separate left and right
+elevon blocks) brings new data, not new kernel code.  The paper's names stay as
+read-only views for the code outside the kernels (``Detection.t_q``, ``.t_nx``,
+``.swapped``, and ``_replace(t_q=...)``).  Checked exhaustively around the
+thresholds and ties, and on random residuals, against Table 1 written clause by
+clause (``tests/naive.py::signature_ref``).
 """
 
 from __future__ import annotations
@@ -53,7 +68,7 @@ def signature_lanes(res, det, block):
     docstring's rules, per variant).  The decision is written out here, not
     called per lane: a call that passes arrays costs two reference-count
     updates per lane, which made this stage 150 times slower
-    (``docs/performance.md``, lesson 12).
+    (``docs/findings/performance.md``, lesson 12).
 
     Parameters
     ----------

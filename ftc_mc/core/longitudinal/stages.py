@@ -29,7 +29,7 @@ inlining) into the loop of one kernel,
 address once per reconfiguration period (``kernel(by_address=True)``,
 :mod:`ftc_mc.core.linking`), as it calls :func:`reconfigure`: each is compiled
 once, on its own, not again inside ``advance``, and a period costs one call,
-not one per stage or step (``docs/performance.md`` lesson 17).  Where the compile paths
+not one per stage or step (``docs/findings/performance.md`` lesson 17).  Where the compile paths
 part (``core/shared/paths.py``) a dispatcher compiles the one kernel its path
 reaches, also called by address.  The stages remain
 callable on their own (the tests do).
@@ -106,7 +106,7 @@ def commands(path, scheme, st, k, work):
     headroom (eq. 15, eq. 16 without a signal): the doublet on the engine while
     one runs; the 3211 on the left elevon and its negative on the right while
     one runs, scaled by ``1 - b1_left_hat`` under c2 (eq. 23), or by the
-    design's ``exc.s3211_floor`` where that is larger (issue 25; 0: eq. 23).
+    design's ``exc.s3211_floor`` where that is larger (0: eq. 23).
 
     Parameters
     ----------
@@ -166,8 +166,8 @@ def commands(path, scheme, st, k, work):
 # ------------------------------------------------------------------ 2b. cost
 @kernel(inline="always")
 def record_cost(track, k_switch, st, kn, work, rec):
-    """After the truth step: the costs of flying the step (issue 25), and the
-    height marks of the survivability study (issue 26).
+    """After the truth step: the costs of flying the step, and the
+    height marks of the survivability study.
 
     For every live lane (its steps until it stops, the step that takes it out
     of the envelope included, as ``TrialRecord.sq_lat``): the cross-track error
@@ -541,7 +541,7 @@ def handle_resets(excitation, st, kn, work, rec):
 
 @kernel(inline="always")
 def policy_signals(excitation, st, kn, work):
-    """The design's excitation beyond the requests on resets (issue 25).
+    """The design's excitation beyond the requests on resets.
 
     A live lane on which neither signal runs at step ``kn`` (after the
     requests of this step, :func:`handle_resets`) starts one:

@@ -145,7 +145,7 @@ def trial_steps(path, scheme, flight, inp, k0, k1, st, work, rec):
     they reach (the truth plant, the filter's prediction and correction, the
     side monitor) are called by address (``core/linking.py``), so each is
     compiled once, and a period costs one call of ``advance``'s, not one per
-    stage or per step (``docs/performance.md`` lesson 17).  Parameters as
+    stage or per step (``docs/findings/performance.md`` lesson 17).  Parameters as
     :func:`advance`'s.
     """
     for k in range(k0, k1):

@@ -1,4 +1,4 @@
-"""Windowed GLR test of the residuals for a persistent change (issue 13).
+"""Windowed GLR test of the residuals for a persistent change.
 
 The paper tests one step: ``r_i = mu_i^2 / S_ii`` against its threshold (eqs.
 9-11, Table 1).  A fault that shifts an innovation by less than its standard
@@ -23,7 +23,7 @@ Each innovation may enter the window clipped to ``[-c, c]``
 Statistics*, 1981, section 4.5): the sum then grows by at most ``c`` per step,
 so one step's outlier of many standard deviations (the n_x spike of a sharp
 vertical gust, whose alpha^2 term the filter's linearisation does not see;
-docs/designs.md) no longer passes a threshold alone, while a persistent shift
+docs/findings/turbulence-designs.md) no longer passes a threshold alone, while a persistent shift
 ``nu < c`` is summed unchanged.
 
 Plain-NumPy twin: ``tests/naive.py::glr_ref``.

@@ -3,14 +3,16 @@
 Numba types and compiles every branch a kernel can reach, whatever the values
 of run-time flags.  A run of the paper's design on the linear plant would
 therefore compile the dense and extended filters, the GLR test, the nonlinear
-plant and the controller selection it never calls (``docs/performance.md``,
+plant and the controller selection it never calls (``docs/findings/performance.md``,
 lesson 11).  Instead, the choices that select large kernels travel as
 *types*: a :class:`Path` of empty marker namedtuples, one per choice, passed
 as the first argument of :func:`ftc_mc.core.longitudinal.trial.advance` and of the stages.
 At each point where the paths part, a dispatcher (a stub with a typing
 template and a lowering of its own, :func:`on_path`) looks at the marker's
-type while the caller is being typed and calls one implementation; the others
-are never typed, lowered or optimised.  Each path is one signature of
+type while the caller is being typed and calls one implementation, directly
+(no wrapper function between) and by address (:mod:`ftc_mc.core.linking`: the
+implementation is compiled once, on its own, and no caller keeps a copy of its
+code); the others are never typed, lowered or optimised.  Each path is one signature of
 ``advance``, compiled on its first use and cached on disk like any other.
 
 The choices:
@@ -152,7 +154,7 @@ def on_path(field: str, impls: dict, passes: str | None = None):
     kernel by address (:mod:`ftc_mc.core.linking`: its code is not linked into
     the caller's); nothing is IR-inlined (Numba's typed inlining of overloads
     gave wrong results inside the trial loop: lanes read as out of the
-    envelope at the first step; ``docs/performance.md`` lesson 11).
+    envelope at the first step; ``docs/findings/performance.md`` lesson 11).
 
     Parameters
     ----------
@@ -184,7 +186,7 @@ def _register_dispatch(stub, field: str, table: "_LazyTable", passes):
     returning ``lambda ...: impl(...)`` compiled that lambda as a library of
     its own, which linked, re-optimised and re-emitted a whole copy of the
     kernel it called: 20 of the default path's 120 s of cold compile,
-    ``docs/performance.md`` lesson 11.)
+    ``docs/findings/performance.md`` lesson 11.)
     """
 
     at = Path._fields.index(field)

@@ -148,7 +148,7 @@ assert LAYOUT.states[:N_RIGID] == LAYOUT.rigid
 assert LAYOUT.outputs[:N_RIGID] == LAYOUT.rigid
 assert tuple(LAYOUT.states[N_RIGID:]) == LAYOUT.actuators
 
-# The side monitor's augmented filter (core/sixdof/monitor.py; issue 26, items 1-2)
+# The side monitor's augmented filter (core/sixdof/monitor.py)
 MONITOR_STATES = tuple(n for n in LAYOUT.states if n != "y")
 """States of the side monitor's filter: the 6-DOF states but the cross-track
 position, which no row of the linear model reads and no sensor measures (the

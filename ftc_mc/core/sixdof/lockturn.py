@@ -1,4 +1,4 @@
-"""Flying on with one elevon: the lock-turn law scheduled on the side monitor (issue 26, item 4).
+"""Flying on with one elevon: the lock-turn law scheduled on the side monitor.
 
 A design with ``controller: lock_turn`` flies the paper's reconfiguring loop
 until the side monitor (:mod:`ftc_mc.core.sixdof.monitor`) names an elevon.
@@ -125,7 +125,7 @@ thrust block, either elevon to the elevon block).  Until the monitor's first
 decision Table 1 decides both.  The longitudinal filter sees a locked elevon
 through pitch only, and once the law banks the wing its model (wings level)
 reads the turn as a thrust change; the monitor reads roll and pitch together
-(issue 26, item 2: the side decided by the direction's GLR).
+(the side is decided by the direction's GLR).
 
 Plain-NumPy twins: ``tests/naive_sixdof.py::lock_turn_law_ref``,
 ``rocking_law_ref``, ``guarded_law_ref``, ``turn_probe_ref``, ``side_blocks_ref``.

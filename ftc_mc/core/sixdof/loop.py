@@ -1,4 +1,4 @@
-"""The paper's loop on the flying wing: its command plus the lateral terms (issue 24).
+"""The paper's loop on the flying wing: its command plus the lateral terms.
 
 On the 6-DOF plant the paper's controllers (c0, c1, c2 of the longitudinal
 model) keep flying pitch and speed, and a lateral-directional autopilot

@@ -1,4 +1,4 @@
-"""The 6-DOF side monitor: which elevon failed, read from roll and pitch (issue 26, items 1-2).
+"""The 6-DOF side monitor: which elevon failed, read from roll and pitch.
 
 On the 6-DOF plant the paper's scheme keeps its longitudinal filter, which sees
 a locked elevon only through pitch (``docs/airframes.md``).  Beside it, the

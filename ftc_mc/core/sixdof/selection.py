@@ -1,4 +1,4 @@
-"""The selection among the four 6-DOF controllers (eqs. 45-47; issue 26, item 4).
+"""The selection among the four 6-DOF controllers (eqs. 45-47).
 
 A design with ``controller: lock_turn_selected`` keeps the paper's structure
 on the flying wing: a mode belief, and every reconfiguration period a

@@ -1,4 +1,4 @@
-"""The 6-DOF truth step of a trial: the flying wing the paper's scheme flies (issue 24).
+"""The 6-DOF truth step of a trial: the flying wing the paper's scheme flies.
 
 The 6-DOF family's entry into the trial loop
 (:func:`ftc_mc.core.longitudinal.trial.advance`): on the ``SIXDOF_PLANT``

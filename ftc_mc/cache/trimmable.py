@@ -1,4 +1,4 @@
-"""The trimmable set of an airframe's equations, cached on disk (issue 26, item 5).
+"""The trimmable set of an airframe's equations, cached on disk.
 
 :func:`ftc_mc.model.trimmable.equations_trimmable_set` runs about 20
 steady-flight searches per elevon: both elevons of ``x8-pyfly`` in 75 s on 2
@@ -6,7 +6,7 @@ cores, of ``x8-gryte2018`` in 14 s.  A run on the
 6-DOF nonlinear plant with elevon-lock rows reports its survival inside and
 outside that set (:func:`ftc_mc.campaign.survival.trimmable_sets`), so the
 set is found once per airframe and envelope and kept as JSON under
-``<cache>/trimmable/<sha256>.json`` (:func:`ftc_mc.design.cache.default_cache_dir`),
+``<cache>/trimmable/<sha256>.json`` (:func:`ftc_mc.cache.store.default_cache_dir`),
 written atomically.  The two elevons are searched in parallel.
 """
 
@@ -21,7 +21,7 @@ from pathlib import Path
 from ..model.airframe import Airframe
 from ..model.sixdof import trim6
 from ..model.trimmable import Envelope, equations_trimmable_set
-from .cache import default_cache_dir, design_key, write_atomic
+from .store import default_cache_dir, design_key, write_atomic
 
 TRIMMABLE_SET_VERSION = "1"
 """Bump when :func:`~ftc_mc.model.trimmable.steady_flight` or the bisection
@@ -51,7 +51,7 @@ def cached_trimmable_sets(airframe: Airframe, sides, envelope: Envelope = Envelo
     name : str
         The airframe's name, for the notice.
     cache_dir : str or Path, optional
-        Cache root; default :func:`~ftc_mc.design.cache.default_cache_dir`.
+        Cache root; default :func:`~ftc_mc.cache.store.default_cache_dir`.
     stream : file, optional
         Where the notice goes when a set is searched (default stderr).
 

@@ -1,4 +1,4 @@
-"""The on-disk cache of offline designs: its folder, and atomic writes into it.
+"""The on-disk cache of offline computations: its folder, its keys, and atomic writes into it.
 
 A cache file is written under a temporary name in its final folder and then
 renamed onto its name (``os.replace``), so a reader never sees a half-written
