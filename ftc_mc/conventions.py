@@ -5,7 +5,7 @@ kernel, a table and a report agree on what "index 11" or "mode 2" means.  Pure
 Python constants (Numba reads module-level ints and tuples as compile-time
 constants).  See ``docs/reference/paper-map.md`` for the paper's symbols.
 
-Plant and filter (docs/airframes.md, paper eqs. 1-5)
+Plant and filter (docs/reference/airframes.md, paper eqs. 1-5)
 ------------------------------------------------------
 The linear plant's state has ``N_X = 9`` entries (:data:`STATE_NAMES`), its
 outputs ``N_Z = 12`` (:data:`OUTPUT_NAMES`, the paper's order), its commands
@@ -190,7 +190,7 @@ TRANSITIONS = PAPER_TRANSITIONS + RIGHT_ELEVON_TRANSITIONS
 AIRFRAME_PRESETS = ("x8-pyfly", "x8-gryte2018")
 """Airframe presets (:mod:`ftc_mc.model.presets`), the default first."""
 DEFAULT_AIRFRAME = AIRFRAME_PRESETS[0]
-"""Airframe flown when a config names none (``docs/airframes.md``: why)."""
+"""Airframe flown when a config names none (``docs/reference/airframes.md``: why)."""
 
 PLANT_KINDS = ("linear", "nonlinear")
 TURBULENCE_LEVELS = ("none", "light", "moderate", "severe")

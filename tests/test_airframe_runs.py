@@ -48,7 +48,7 @@ def test_airframes_lists_both_presets_with_sources_and_trims():
     assert res.exit_code == 0, res.output
     for name, p in PRESETS.items():
         assert name in res.output and p.source.commit[:12] in res.output
-    # trims of the presets (docs/airframes.md; tests/test_airframes.py checks them)
+    # trims of the presets (docs/reference/airframes.md; tests/test_airframes.py checks them)
     assert "throttle 0.084" in res.output and "throttle 0.329" in res.output
     assert f"{DEFAULT_AIRFRAME} (default)" in res.output
 

@@ -159,7 +159,7 @@ def test_todays_x8_is_unchanged_and_is_not_the_preset():
 
 # Trim at 20 m/s, -3 deg, to the digits quoted.  The design notes quoted
 # alpha 1.074 deg for gryte2018; that is the earlier rounded X8 (1.0737); the
-# full-precision file gives 1.0731 (docs/airframes.md).
+# full-precision file gives 1.0731 (docs/reference/airframes.md).
 TRIMS = {"x8-gryte2018": (0.084, 1.073, 0.0614), "x8-pyfly": (0.329, 1.088, 0.0576)}
 
 

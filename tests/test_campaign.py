@@ -221,7 +221,7 @@ def test_every_transition_behaves(airframe):
     elevon fault), elevon faults reset the elevon block in most trials, almost
     no trial resets before the fault, and no-reset trials concentrate at small
     b1 or locks near trim.  Which trials leave the envelope depends on the
-    airframe (docs/airframes.md): the authors' engine (full throttle 22 times
+    airframe (docs/findings/paper-tables.md): the authors' engine (full throttle 22 times
     the trim thrust) overspeeds after engine locks far from trim; PyFly's (4.4
     times) does not, but its weaker pitch stiffness lets elevon locks beyond
     about -0.41 rad (-24 deg) dive out of the envelope.  The paper's eight rows;

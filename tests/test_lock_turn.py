@@ -139,7 +139,7 @@ def test_on_the_linear_model_the_gain_is_its_own_lqr(linear_plant):
 
 def test_on_the_linear_model_a_far_lock_designs_about_its_nearest(linear_plant):
     """-6 deg has no steady flight of the linear model in the design box (its
-    steady flights end near -3.5 deg on the left, docs/airframes.md): the
+    steady flights end near -3.5 deg on the left, docs/findings/sixdof-lock-turn.md): the
     design is about the nearest lock that has one, and the held offset
     enters as the plant's own constant input, its actuator's column and its
     command's."""

@@ -470,7 +470,7 @@ def test_the_rocking_law_outlasts_the_held_trim(tmp_path):
     exists there with the healthy elevon and the throttle): with the trim
     held (``turn_beyond: hold``) every trial leaves the envelope within 15 s
     of the lock; the rocking law keeps every one of the same trials inside
-    for the 30 s flown (docs/airframes.md has the campaign)."""
+    for the 30 s flown (docs/findings/sixdof-rocking-guard.md has the campaign)."""
     hold, rock = fly_both_ways(tmp_path, (5.0, 12.0), [-2.0, 6.0], "rollout", 30.0)
     assert (hold["lock_position"] == rock["lock_position"]).all()
     assert (rock["side_correct"] == 1).all()
@@ -485,7 +485,7 @@ def test_the_guard_flies_locks_the_design_box_cannot(tmp_path):
     trim held (``turn_beyond: hold``) every trial leaves the envelope within
     5 s of the lock; with the guard (``guarded``), which designs about those
     turns and flies the LQR under its rollouts, every one of the same trials
-    stays inside for the 30 s flown (docs/airframes.md has the campaign)."""
+    stays inside for the 30 s flown (docs/findings/sixdof-rocking-guard.md has the campaign)."""
     # the table reaches the trim side too: the monitor's first lock estimates
     # lie there (with it cut at -4 deg, a right lock at -12.5 deg left after 3.8 s)
     hold, guard = fly_both_ways(tmp_path, (-13.0, -11.5), [-14.0, 4.0], "guarded", 35.0)
@@ -503,7 +503,7 @@ def test_on_the_linear_plant_the_table_is_the_linear_models(tmp_path, capfd):
     the linear model (``monitor.turn_model: auto`` there) every trial stays
     inside the envelope for the 30 s flown; with the table designed on the
     equations (``nonlinear``) every one of the same trials leaves within 5 s
-    of the lock (docs/airframes.md has the campaign).  Each run notes once
+    of the lock (docs/findings/sixdof-lock-turn.md has the campaign).  Each run notes once
     that the table's -2 deg ends lie inside the steady band (the linear
     model's, -4.75 / -5.25 to +5.5 deg; the equations', -29 to +2.25 deg),
     and not its +6 deg ends, beyond both."""

@@ -22,7 +22,7 @@ is the right-hand side of its ODE; it is compared with
   needs no switch.
 
 What each difference does when not switched is measured and documented in
-``docs/airframes.md`` ("PyFly's own simulator").  Attitude: PyFly's quaternion
+``docs/reference/airframes.md`` ("PyFly's own simulator").  Attitude: PyFly's quaternion
 derivative is mapped to Euler-angle rates through the exact Jacobian of the
 Euler-to-quaternion map (complex step), and both derivative functions are
 integrated by one fixed-step RK4 in our coordinates.

@@ -268,7 +268,7 @@ def test_direction_projections_are_standard_normal_without_fault(setup, request)
     mon = setup.truth.monitor._replace(threshold=np.inf, startup=0)
     n_steps, transient = 150, 20
     if mon.nonlinear and mon.A.shape[0] > len(MONITOR_STATES):
-        # Known limits (docs/airframes.md, scripts/studies/study_monitor_consistency.py):
+        # Known limits (docs/findings/sixdof-side-monitor.md, scripts/studies/study_monitor_consistency.py):
         # at the excursions of moderate gusts (bank RMS about 10 deg) the trim
         # Jacobians misstate the covariance (mean square here about 8 over the
         # three directions, 16 on the throttle's); the extended filter's, taken
@@ -330,7 +330,7 @@ def test_nonlinear_prediction_reads_an_engine_unlock_as_the_engine():
     airframe's equations names the throttle or nothing in every trial; the
     linear one, on the same trials, names an elevon in at least 5 of 32 (13
     when written: the propeller's torque and the moments off the trim
-    airspeed it does not model; ``docs/airframes.md``)."""
+    airspeed it does not model; ``docs/findings/sixdof-side-monitor.md``)."""
     named = {}
     for prediction in ("linear", "nonlinear"):
         cfg = monitor_config("nonlinear", transitions=["engine_unlock"], trials=32,

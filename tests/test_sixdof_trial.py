@@ -116,7 +116,7 @@ def test_fault_free_sixdof_flight_holds_wings_level(coupling):
     with the lateral autopilot (or c0 as the coupled 6-DOF LQR) flies 50 s
     with no exit and the bank within a degree (the open-loop Dutch roll is
     unstable: without the lateral loop it diverges in seconds,
-    docs/airframes.md)."""
+    docs/reference/airframes.md)."""
     cfg = sixdof_config(turbulence="none")
     cfg["controller"] = {"coupling": coupling, "kind": "nominal"}
     res = api.run_endurance(cfg, hours=16 * 50 / 3600, flight_s=50.0, jobs=1, progress=False)

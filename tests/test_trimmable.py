@@ -98,7 +98,7 @@ def test_the_linear_trimmable_set_agrees_with_a_search_of_its_plane(offset_deg):
     them (12-30 m/s by 0.05, +-60 deg by 0.25) finds one inside the envelope
     and the limits exactly where the programme does.  The linear model is
     narrower than the airframe's equations, which have steady turns from -29
-    to +2.25 deg (docs/airframes.md): at -6 and -8 deg neither finds one."""
+    to +2.25 deg (docs/findings/sixdof-survival.md): at -6 and -8 deg neither finds one."""
     from ftc_mc.core.sixdof.layout import COMMAND
     from ftc_mc.model.trimmable import linear_quantities, linear_steady, linear_steady_flight
 

@@ -161,7 +161,7 @@ def side_markdown(table: pd.DataFrame, level: int = 2) -> str:
              "First decision of the side monitor (augmented 6-DOF filter, one windowed "
              "GLR per actuator, roll and pitch) in the window after the switch, over "
              "the trials flying at the switch; false decisions before it in the rows "
-             "that start fault-free (docs/airframes.md, \"Which elevon failed: the side "
+             "that start fault-free (docs/findings/sixdof-side-monitor.md, \"Which elevon failed: the side "
              "monitor\").", "",
              "| transition | design | correct actuator | b1 >= 0.5 | median delay | "
              "wrong actuator | false decisions (fault-free hours) | median lock error |",

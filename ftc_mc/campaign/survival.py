@@ -41,7 +41,7 @@ HORIZON_S = 60.0
 
 OFFSET_EDGES_DEG = (-math.inf, -20.0, -10.0, -5.0, -2.0, -0.5, 0.5, 2.0, 5.0, 10.0, math.inf)
 """Bins of lock offset from trim [deg]: the finer the nearer trim, where the
-trimmable set's edges lie (``docs/airframes.md``)."""
+trimmable set's edges lie (``docs/findings/sixdof-survival.md``)."""
 
 EXITS = tuple(STATUS_NAMES[s] for s in (STATUS_AIRSPEED, STATUS_ALPHA, STATUS_BANK))
 """Statuses of a trial that left the validity envelope."""

@@ -156,7 +156,7 @@ def coupled_lqr(plant, K_lon: np.ndarray, Q_lon: np.ndarray, R_lon: np.ndarray,
     With a model whose longitudinal and lateral motions do not act on each
     other, the minimiser of this sum is the pair of separate gains; on
     ``x8-pyfly`` the propeller's torque couples them and the throttle joins
-    the roll control (``docs/airframes.md``).
+    the roll control (``docs/findings/sixdof.md``).
 
     Parameters
     ----------

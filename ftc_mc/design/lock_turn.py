@@ -70,7 +70,7 @@ with the locked elevon's command its lock position.
    its own discrete matrices,
    the held offset entering through the locked elevon's actuator and command
    columns.  On ``x8-pyfly`` its trimmable set is -4.87 to +5.68 deg (left),
-   against -29 to +2.25 deg for the equations (``docs/airframes.md``).
+   against -29 to +2.25 deg for the equations (``docs/findings/sixdof-lock-turn.md``).
 """
 
 from __future__ import annotations
@@ -162,7 +162,7 @@ def envelope_box(airspeed, alpha_deg, bank_deg, margin: float = 0.5,
     the envelope may still hold one: on ``x8-pyfly`` the steady turns closest
     to the nominal glide of locks from about -29 to -10 deg of trim lie at
     12.5-16.5 m/s and 58-60 deg of bank (``scripts/studies/study_recoverable.py``,
-    docs/airframes.md); with 10 deg of room below the bank bound, those of
+    docs/findings/sixdof-rocking-guard.md); with 10 deg of room below the bank bound, those of
     -15 to -11 deg at 12.5-14.7 m/s and 50 deg.  The air-path
     angle may then lie from -45 to +30 deg; the throttle, elevon and
     sideslip bounds are the design box's.

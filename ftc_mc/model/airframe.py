@@ -4,7 +4,7 @@
 ``ftc_mc/model/dynamics.py`` and, optionally (:data:`LATERAL_FIELDS`), the
 lateral-directional data of the 6-DOF model (``ftc_mc/model/sixdof.py``).  The cited, full-precision copies of the two public
 X8 parameter files are the presets of ``ftc_mc/model/presets.py``
-(``x8-gryte2018``, ``x8-pyfly``; ``docs/airframes.md`` compares them); a user's
+(``x8-gryte2018``, ``x8-pyfly``; ``docs/reference/airframes.md`` compares them); a user's
 own aircraft comes from a YAML file (``ftc_mc/model/airframe_files.py``).
 
 :data:`X8` (the defaults of :class:`Airframe`) is the airframe the tool has flown
@@ -15,7 +15,7 @@ results of ``tests/test_golden.py`` pin it; its trim at 20 m/s, -3 deg differs
 from the preset's in the fourth digit of alpha (1.0737 against 1.0731 deg).
 
 Choices that are ours, not the parameter files' (the same in ``X8`` and both
-presets; ``docs/airframes.md``):
+presets; ``docs/reference/airframes.md``):
 
 * actuator time constants: engine 0.3 s (same order as the short-period mode,
   paper section 2.4), elevons 0.05 s;

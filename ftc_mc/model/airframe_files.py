@@ -1,6 +1,6 @@
 """A user's own aircraft from files: airframe YAML and linear models (.npz, .mat).
 
-Airframe YAML (``docs/airframes.md``): a flat mapping with every field of
+Airframe YAML (``docs/reference/airframes.md``): a flat mapping with every field of
 :class:`~ftc_mc.model.airframe.Airframe`, SI units, angles in rad.  Every
 longitudinal field is required and unknown fields are refused, so a typo cannot
 silently fall back to a default; the lateral-directional fields are optional
@@ -142,7 +142,7 @@ def export_airframe(airframe: Airframe, path_or_stream, name: str = "",
     Numbers are written so that :func:`load_airframe_yaml` reads back an equal
     :class:`Airframe` (every float to the bit).
     """
-    lines = ["# Airframe for ftc-mc (docs/airframes.md): every field is required,",
+    lines = ["# Airframe for ftc-mc (docs/reference/airframes.md): every field is required,",
              "# SI units, angles in rad; unknown fields are refused."]
     for label, text in (("name", name), ("source", source)):
         for i, part in enumerate(str(text).splitlines() if text else []):

@@ -1,7 +1,7 @@
 """Airframe presets: each a faithful copy of one cited parameter file.
 
 Two public parameter files of the Skywalker X8 exist, both from the NTNU group
-(``docs/airframes.md`` compares them):
+(``docs/reference/airframes.md`` compares them):
 
 * ``x8-gryte2018``: ``x8_param.mat`` of the authors' simulator for K. Gryte,
   R. Hann, M. Alam, J. Rohac, T. A. Johansen, T. I. Fossen, "Aerodynamic modeling

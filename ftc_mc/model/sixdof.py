@@ -14,7 +14,7 @@ lateral unknowns: solve ``d(u, v, w, p, q, r)/dt = 0``, air-path angle
 elevator and aileron (``scipy.optimize.root``).  With no propeller torque the
 solution is wings level (``beta = phi = psi = aileron = 0``) and equals the
 longitudinal trim; PyFly's file has a propeller torque (``k_T_P``), which the
-trim balances with a small aileron, sideslip and bank (``docs/airframes.md``).
+trim balances with a small aileron, sideslip and bank (``docs/reference/airframes.md``).
 
 Linearisation (:func:`build_sixdof_plant`): scipy's adaptive finite differences
 of the kernels at the trim (``ftc_mc.model.linear.jacobian``), then the
@@ -62,7 +62,7 @@ def require_lateral(airframe: Airframe, where: str = "airframe") -> None:
     if missing:
         raise UserError(f"{where}: the 6-DOF model needs the lateral-directional "
                         f"field{'s' if len(missing) > 1 else ''} {', '.join(missing)}, "
-                        "missing in this airframe (docs/airframes.md lists them; "
+                        "missing in this airframe (docs/reference/airframes.md lists them; "
                         "`ftc-mc model --airframe x8-pyfly --export FILE.yaml` writes "
                         "a complete file)")
 
@@ -595,7 +595,7 @@ def save_sixdof_npz(plant: SixDofPlant, f, source: str = "", suffix: str = ".npz
     ``.npz`` is read back by :func:`load_sixdof_model`).
 
     Variables: :data:`SIXDOF_MODEL_VARIABLES` and ``airframe_<field>`` for every
-    airframe field (``docs/airframes.md``); :func:`load_sixdof_model` reads it
+    airframe field (``docs/reference/airframes.md``); :func:`load_sixdof_model` reads it
     back to an equal model.
 
     Parameters

@@ -5,12 +5,12 @@
 * a preset name (:data:`ftc_mc.model.presets.PRESETS`): its equations are flown
   by the nonlinear truth plant and trimmed and linearised for the filter;
 * the path of an airframe YAML file (``ftc-mc model --airframe NAME --export``
-  writes one; ``docs/airframes.md`` lists its fields): the same;
+  writes one; ``docs/reference/airframes.md`` lists its fields): the same;
 * the path of a linear model (``.npz`` as written by ``ftc-mc model --save``, or
   a MATLAB ``.mat`` with the same variables): its own trim, matrices and gust
   input matrices; it has no equations, so it flies only the linear truth plant.
 
-The default is :data:`DEFAULT_AIRFRAME`; ``docs/airframes.md`` gives the
+The default is :data:`DEFAULT_AIRFRAME`; ``docs/reference/airframes.md`` gives the
 measurements it was chosen on.
 """
 

@@ -92,7 +92,7 @@ def save_npz(plant: LinearPlant, f, suffix: str = ".npz") -> None:
 
     :func:`ftc_mc.model.airframe_files.load_linear_model` reads it back to a
     :class:`LinearPlant` whose arrays equal these to the bit.  Variables (all
-    float64; ``docs/airframes.md`` has the same table):
+    float64; ``docs/reference/airframes.md`` has the same table):
 
     ======== ======== ===========================================================
     name     shape    meaning [unit]

@@ -365,7 +365,7 @@ def lock_turn_table(six, u0: np.ndarray, offsets=(), airframe=None,
         print(f"ftc-mc: note: the lock-turn table ends in a steady flight of the {model} "
               f"({', '.join(ends)}); locks beyond an end fly its design, which does not "
               "hold them: monitor.turn_offsets_deg should reach past the steady band "
-              "(docs/airframes.md)", file=sys.stderr, flush=True)
+              "(docs/findings/sixdof-lock-turn.md)", file=sys.stderr, flush=True)
     idx = np.array([[STATE[n] for n in turn_states(side)] for side in SIDES])
     x = np.stack([d.x[s][:, idx[s]] - six.trim.x0[idx[s]] for s in range(2)])
     c = np.ascontiguousarray

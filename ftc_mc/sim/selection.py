@@ -26,7 +26,7 @@ keeps the paper's belief and selection, read on the 6-DOF model:
   longer hold finite (the aircraft departed) costs as much as the most
   expensive finite flight of the table.  The elevon locks are :data:`SIXDOF_ELEVON_OFFSETS_DEG`
   from the 6-DOF trim, where a controller can fly on
-  (``docs/airframes.md``, "Which locks can be flown steadily"); the engine's
+  (``docs/findings/sixdof-survival.md``, "Which locks can be flown steadily"); the engine's
   locks and every loss are the paper's.
 """
 

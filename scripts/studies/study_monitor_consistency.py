@@ -40,7 +40,7 @@ Usage::
     .venv/bin/python scripts/studies/study_monitor_consistency.py [--lanes 7] [--steps 50]
         [--seeds 2] [--skip 20] [--gust-scale 1] [--state-noise-scale 1]
 
-The figures in docs/airframes.md: ``--steps 35 --skip 15 --seeds 4``, with
+The figures in docs/findings/sixdof-side-monitor.md: ``--steps 35 --skip 15 --seeds 4``, with
 ``--gust-scale 0.3`` and ``--state-noise-scale 10`` or ``100`` beside.
 """
 

@@ -64,7 +64,7 @@ trimmable set are the linear model's (``ftc_mc.model.trimmable.LinearSteady``).
 
 ``--delay`` holds the trim commands for that long before every history (the
 detection's delay; the side monitor names the side a median 0.1 s after the
-lock, ``docs/airframes.md``).
+lock, ``docs/findings/sixdof-side-monitor.md``).
 
 A lock is **recoverable** when question 2 flies the 60 s.  Otherwise the
 longest stay any search found (question 4's, or the horizon of question 1

@@ -5,7 +5,7 @@ the 6-DOF model layer (:mod:`ftc_mc.model.sixdof`) and of their tests comes from
 :data:`LAYOUT` (or the module constants derived from it below, which Numba
 freezes into the kernels at compile time).  Nothing here is longitudinal: the
 longitudinal family keeps :mod:`ftc_mc.conventions`, and no longitudinal module
-imports this package (``docs/airframes.md``, "Six degrees of freedom").
+imports this package (``docs/reference/airframes.md``, "Six degrees of freedom").
 
 State (15): the 12 rigid-body states of the authors' simulator (krisgry/x8
 ``dynamics.m``: position, Euler angles, body velocity, body rates) followed by
@@ -30,7 +30,7 @@ the three first-order actuators::
 Positions are measured from a reference point that flies the straight glide
 path north at ``V0`` and ``gamma0`` (as the longitudinal ``x``, ``z``).
 Commands (3): absolute throttle [-], left and right elevon [rad].  Elevon
-mixing as in PyFly (``docs/airframes.md``): elevator = (left + right)/2,
+mixing as in PyFly (``docs/reference/airframes.md``): elevator = (left + right)/2,
 aileron = (left - right)/2.
 
 Outputs (19): the 12 rigid-body states, then the specific forces ``n_x``,

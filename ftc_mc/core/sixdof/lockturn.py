@@ -53,7 +53,7 @@ not finite), the trim commands are held, as without the law.  With no steady
 flight the lock rolls the wing at about 2.8 deg/s per degree of offset; the
 histories that last swing it: roll with the lock while pitching up, then
 mirror the lock with the healthy elevon and dive back to wings level, trading
-height for time (``docs/airframes.md``).
+height for time (``docs/findings/sixdof-rocking-guard.md``).
 
 **Rollout guard** (``turn_beyond: guarded``, :func:`guarded_law`).  The
 table is then designed with a wide box as well
@@ -81,7 +81,7 @@ read from its sensor where one measures it and ``monitor.turn_feedback`` is
 ``measured`` (``LockTurnTable.meas``), else from the monitor's estimate (its
 rows ``LockTurnTable.rows``; the actuators always).  The monitor's model is
 linear about wings-level flight, and in the steep turns of locks far from
-trim its estimate drifts from the truth (``docs/airframes.md``)::
+trim its estimate drifts from the truth (``docs/findings/sixdof-lock-turn.md``)::
 
     [throttle, healthy] = u* - K (x_hat - x*) - k,   clipped to the command limits
 
@@ -111,7 +111,7 @@ is below ``hand_back`` by at least ``hand_back_sd`` of its standard deviations
 (the monitor's covariance) hands back: its ``mside`` turns negative, and from
 that step it flies the paper's reconfiguring loop and lateral autopilot again,
 for the rest of the flight (the monitor names no elevon after it).  In gusts
-the probe hardly moves ``b1`` (``docs/airframes.md``); its spread then keeps
+the probe hardly moves ``b1`` (``docs/findings/sixdof-selection.md``); its spread then keeps
 the lane turning.
 
 **Which block the paper's filter resets** (:func:`side_blocks`).  In a

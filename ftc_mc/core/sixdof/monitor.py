@@ -1,7 +1,7 @@
 """The 6-DOF side monitor: which elevon failed, read from roll and pitch.
 
 On the 6-DOF plant the paper's scheme keeps its longitudinal filter, which sees
-a locked elevon only through pitch (``docs/airframes.md``).  Beside it, the
+a locked elevon only through pitch (``docs/findings/sixdof-side-monitor.md``).  Beside it, the
 flight computer runs this monitor on the sensors it has: an augmented Kalman
 filter of the 6-DOF model (linear, or the airframe's equations) with a fault
 of each actuator, and a windowed GLR test per fault direction that names the
@@ -48,7 +48,7 @@ stay linear), and each innovation is ``z_r - h_r(x_pred) - c_r (x - x_pred)``
 with ``h`` the airframe's outputs (:func:`nonlinear_offsets`): the linear
 model misses the propeller's torque, quadratic in the throttle, and the
 moments off the trim airspeed, and reads them as a differential elevon
-(``docs/airframes.md``).  ``F``, ``C`` and the directions stay the trim's.
+(``docs/findings/sixdof-side-monitor.md``).  ``F``, ``C`` and the directions stay the trim's.
 
 **Extended filter** (``monitor.prediction: extended``, the default on the
 nonlinear plant with gust states; :func:`extended_filter`).  As the nonlinear

@@ -1,7 +1,7 @@
 """The nonlinear 6-DOF X8 with wind: forces, derivative, outputs, RK4.
 
 The equations of the authors' simulator (krisgry/x8 ``forces.m`` and
-``dynamics.m``; ``docs/airframes.md``, "Six degrees of freedom"), written as
+``dynamics.m``; ``docs/reference/airframes.md``, "Six degrees of freedom"), written as
 allocation-free scalar Numba code on float64 arrays.  Sizes and indices come
 from :mod:`ftc_mc.core.sixdof.layout`; parameters come packed by
 :func:`ftc_mc.model.sixdof.pack_parameters`.  The plain-NumPy twin, written in
