@@ -246,6 +246,7 @@ def fly(law, setup, K, draws, record=False):
     exit_kind = np.zeros(L, dtype=int)      # 1 airspeed low, 2 high, 3 alpha
     at_limit = np.zeros(L)
     dz2 = np.zeros(L)
+    va_lo = np.full(L, np.inf)
     alive = np.ones(L, dtype=bool)
     hist = {k: np.full((n, L), np.nan) for k in
             ("va", "alpha", "thr", "elev", "theta", "ug", "wg", "x", "z", "u")} if record else None
@@ -286,6 +287,7 @@ def fly(law, setup, K, draws, record=False):
                             ("u", xn[IU])):
                 hist[key][k] = np.where(alive, v_, np.nan)
         dz2 += np.where(alive, (xn[IZ] - tp.x0[IZ]) ** 2, 0.0)
+        va_lo = np.where(alive, np.minimum(va_lo, va), va_lo)
         bad = alive & ~((va >= va_min) & (va <= val.va_max)
                         & (al >= val.alpha_min) & (al <= val.alpha_max))
         exit_kind[bad] = np.where(va[bad] < va_min, 1,
@@ -296,7 +298,7 @@ def fly(law, setup, K, draws, record=False):
     steps_flown = np.where(exit_step < 0, n, exit_step)
     return dict(exit_step=exit_step, exit_kind=exit_kind,
                 thr_limit_share=float(at_limit.sum() / steps_flown.sum()),
-                z_ms=float(dz2.sum() / steps_flown.sum()), hist=hist)
+                z_ms=float(dz2.sum() / steps_flown.sum()), va_min=va_lo, hist=hist)
 
 
 def wilson_ci(k, n, z=1.959963984540054):
@@ -432,7 +434,7 @@ def pyfly_flights(setup, draws, lanes, warm_s=20.0):
                 break
         va_min.append(lo)
         t_exit.append(te)
-        print(f"  PyFly flight {lane}: lowest airspeed {lo:.2f} m/s, exit {te}", flush=True)
+        print(f"  PyFly lane {lane}: lowest airspeed {lo:.2f} m/s, exit {te}", flush=True)
     return np.array(va_min), np.array(t_exit)
 
 
@@ -557,8 +559,9 @@ def main(argv=None):
     ap.add_argument("--batch", type=int, default=500)
     ap.add_argument("--out", default="/tmp/envelope/study")
     ap.add_argument("--figures", action="store_true")
-    ap.add_argument("--pyfly", type=int, default=0,
-                    help="also fly this many flights on PyFly's own X8 (about 3 min each)")
+    ap.add_argument("--pyfly", default=None,
+                    help="comma-separated flight ids to fly also on PyFly's own X8 "
+                         "(about 3 min each)")
     ap.add_argument("--figures-from", default=None,
                     help="comma-separated exits.npz files: only draw the figures from them")
     a = ap.parse_args(argv)
@@ -583,13 +586,14 @@ def main(argv=None):
         figures(a.figures_from.split(","), setup, K)
         return
     laws = [] if a.laws == "none" else a.laws.split(",")
-    res = {law: dict(exit_step=[], exit_kind=[], thr=[], z=[], hist=[]) for law in laws}
+    res = {law: dict(exit_step=[], exit_kind=[], va_min=[], thr=[], z=[], hist=[])
+           for law in laws}
     ids = np.arange(a.flights)
     for b0 in range(0, a.flights, a.batch):
         draws = draw_lanes(setup, ids[b0:b0 + a.batch], a.seed, FLIGHT_FAULT_RANGE)
         for law in laws:
-            r = fly(law, setup, K, draws, record=(law == "c0"))
-            for key in ("exit_step", "exit_kind"):
+            r = fly(law, setup, K, draws, record=(law == "c0" and a.flights <= 2000))
+            for key in ("exit_step", "exit_kind", "va_min"):
                 res[law][key].append(r[key])
             res[law]["thr"].append(r["thr_limit_share"])
             res[law]["z"].append(r["z_ms"])
@@ -599,30 +603,36 @@ def main(argv=None):
               flush=True)
     print(f"\nexits per 1,000 fault-free 50 s flights, seed {a.seed}, flights 0..{a.flights - 1}")
     print("| law | exits | per 1,000 [95 % Wilson] | by airspeed low | high | by alpha "
-          "| steps with throttle at a limit | RMS height error [m] |")
-    print("|---|---|---|---|---|---|---|---|")
+          "| steps with throttle at a limit | RMS height error [m] "
+          "| lowest airspeed of a flight: 1 % / 10 % quantile [m/s] |")
+    print("|---|---|---|---|---|---|---|---|---|")
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
     save = {}
     for law in laws:
         es = np.concatenate(res[law]["exit_step"])
         ek = np.concatenate(res[law]["exit_kind"])
+        vm = np.concatenate(res[law]["va_min"])  # an exit flight's lowest before it stops
+        save[f"{law}_va_min"] = vm
         n_ex = int((es >= 0).sum())
         lo, hi = wilson_ci(n_ex, a.flights)
         print(f"| {law} | {n_ex} | {1000 * n_ex / a.flights:.1f} [{1000 * lo:.1f}, "
               f"{1000 * hi:.1f}] | {(ek == 1).sum()} | {(ek == 2).sum()} | {(ek == 3).sum()} "
-              f"| {100 * np.mean(res[law]['thr']):.1f} % | {math.sqrt(np.mean(res[law]['z'])):.2f} |")
+              f"| {100 * np.mean(res[law]['thr']):.1f} % | {math.sqrt(np.mean(res[law]['z'])):.2f} "
+              f"| {np.quantile(vm, 0.01):.1f} / {np.quantile(vm, 0.1):.1f} |")
         save[f"{law}_exit_step"] = es
         save[f"{law}_exit_kind"] = ek
-    if "c0" in laws:
+    if "c0" in laws and res["c0"]["hist"]:
         for key in res["c0"]["hist"][0]:
             save[f"c0_hist_{key}"] = np.concatenate([h[key] for h in res["c0"]["hist"]], axis=1)
     if a.pyfly:
-        draws = draw_lanes(setup, ids[:a.pyfly], a.seed, FLIGHT_FAULT_RANGE)
-        va_min, t_exit = pyfly_flights(setup, draws, range(a.pyfly))
-        save["pyfly_va_min"], save["pyfly_t_exit"] = va_min, t_exit
-        print(f"PyFly X8 + its PID, flights 0..{a.pyfly - 1}: {np.isfinite(t_exit).sum()} exits; "
-              f"lowest airspeed per flight: median {np.median(va_min):.2f}, min {va_min.min():.2f} m/s")
+        pids = [int(i) for i in a.pyfly.split(",")]
+        draws = draw_lanes(setup, pids, a.seed, FLIGHT_FAULT_RANGE)
+        va_min, t_exit = pyfly_flights(setup, draws, range(len(pids)))
+        save["pyfly_ids"], save["pyfly_va_min"], save["pyfly_t_exit"] = pids, va_min, t_exit
+        print(f"PyFly X8 + its PID, flights {a.pyfly}: {np.isfinite(t_exit).sum()} exits; "
+              f"lowest airspeed per flight: median {np.median(va_min):.2f}, "
+              f"min {va_min.min():.2f} m/s")
     np.savez_compressed(out / "exits.npz", **save)
     print(f"wrote {out / 'exits.npz'}; {time.time() - t0:.0f} s")
 
