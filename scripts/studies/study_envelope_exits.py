@@ -32,16 +32,27 @@ Candidates (``--laws``, comma-separated keys of :data:`LAWS`):
   along-track position, fed air-relative u, w;
 * ``bryson_unsat``: the same with the command limits lifted;
 * ``bryson_ground``: Bryson's weights but fed inertial u, w (airspeed weight on
-  the ground-relative speed).
+  the ground-relative speed);
+* ``bryson_va1``, ``bryson_va4``, ``bryson_z1``: Bryson's rule with 1 or 4 m/s
+  on the airspeed, or 1 m on the height;
+* ``c0_va10``: c0 judged against an airspeed floor of 10 m/s instead of 12;
+* ``pyfly_pid``: PyFly's ``PIDController`` (airspeed PI by throttle, pitch PID)
+  on this X8, at PyFly's 100 Hz; ``pid_height``: the same with a height loop
+  setting the pitch reference.
 
-Prints a table of exits per 1,000 flights with 95 % Wilson intervals, the
-exits by airspeed and by angle of attack, the share of steps with the
-throttle at a limit, and writes ``--out``/exits.npz with the exit flights'
-time histories of ``c0`` and the linear closed-loop analysis (``--figures``
-writes the figures to docs/figures/).
+Prints, per law, the exits per 1,000 flights with 95 % Wilson intervals, by
+airspeed and by angle of attack, the share of steps with the throttle at a
+limit, the RMS height error and the lowest airspeed of a flight (1 % and 10 %
+quantiles), and writes ``--out``/exits.npz (with c0's time histories when at
+most 2,000 flights are flown).  ``--pyfly IDS`` also flies those flights on
+PyFly's own X8 with its own PID; ``--figures-from`` draws the figures of
+docs/findings/turbulence-envelope.md into docs/figures/ from saved runs.
 
     .venv/bin/python scripts/studies/study_envelope_exits.py --flights 2000 \
-        --seed 777 [--laws c0,c0_unsat,...] [--figures]
+        --seed 777 [--laws c0,c0_unsat,...|none] [--turbulence severe] \
+        [--pyfly 20,37] [--out DIR]
+    .venv/bin/python scripts/studies/study_envelope_exits.py \
+        --figures-from DIR/exits.npz
 """
 
 from __future__ import annotations
@@ -55,7 +66,7 @@ import ftc_mc  # noqa: F401 -- the package first (its numba settings)
 import numpy as np
 import scipy.linalg
 
-from ftc_mc.config.load import load_config
+from ftc_mc.config.load import load_config, with_overrides
 from ftc_mc.conventions import LONGITUDINAL, OUT_ALPHA, OUT_VA
 from ftc_mc.core.longitudinal import nonlinear as nl
 from ftc_mc.design.lqr import discounted_lqr, paper_q_lqr
@@ -562,18 +573,20 @@ def main(argv=None):
     ap.add_argument("--pyfly", default=None,
                     help="comma-separated flight ids to fly also on PyFly's own X8 "
                          "(about 3 min each)")
+    ap.add_argument("--turbulence", default="moderate", choices=("light", "moderate", "severe"),
+                    help="Dryden level (the figures are drawn for moderate)")
     ap.add_argument("--figures-from", default=None,
                     help="comma-separated exits.npz files: only draw the figures from them")
     a = ap.parse_args(argv)
     t0 = time.time()
-    cfg = load_config(CONFIG)
+    cfg = with_overrides(load_config(CONFIG), plant={"turbulence": a.turbulence})
     setup = build_setup(cfg)
     plant = setup.plant
     K = gains(plant)
     print(f"setup {time.time() - t0:.1f} s; lane twin vs kernel, max |dx| = "
           f"{check_against_kernel(plant, np.random.default_rng(0)):.2e}")
     gm = setup.gust
-    print(f"Dryden moderate: sigma_u {gm.sigma_u:.2f} m/s, sigma_w {gm.sigma_w:.2f} m/s, "
+    print(f"Dryden {a.turbulence}: sigma_u {gm.sigma_u:.2f} m/s, sigma_w {gm.sigma_w:.2f} m/s, "
           f"L_u {gm.L_u:.0f} m, L_w {gm.L_w:.0f} m; trim throttle {plant.trim.u0[0]:.3f}, "
           f"limits {plant.u_lower} .. {plant.u_upper}")
     for name, k in K.items():
@@ -601,7 +614,8 @@ def main(argv=None):
                 res[law]["hist"].append(r["hist"])
         print(f"  flights {b0 + len(draws.fault)} of {a.flights}, {time.time() - t0:.0f} s",
               flush=True)
-    print(f"\nexits per 1,000 fault-free 50 s flights, seed {a.seed}, flights 0..{a.flights - 1}")
+    print(f"\nexits per 1,000 fault-free 50 s flights, {a.turbulence} turbulence, seed {a.seed}, "
+          f"flights 0..{a.flights - 1}")
     print("| law | exits | per 1,000 [95 % Wilson] | by airspeed low | high | by alpha "
           "| steps with throttle at a limit | RMS height error [m] "
           "| lowest airspeed of a flight: 1 % / 10 % quantile [m/s] |")
