@@ -38,7 +38,8 @@ Candidates (``--laws``, comma-separated keys of :data:`LAWS`):
 * ``c0_va10``: c0 judged against an airspeed floor of 10 m/s instead of 12;
 * ``pyfly_pid``: PyFly's ``PIDController`` (airspeed PI by throttle, pitch PID)
   on this X8, at PyFly's 100 Hz; ``pid_height``: the same with a height loop
-  setting the pitch reference.
+  setting the pitch reference;
+* ``tecs``: a TECS-like energy law (:data:`TECS_GAINS`).
 
 Prints, per law, the exits per 1,000 flights with 95 % Wilson intervals, by
 airspeed and by angle of attack, the share of steps with the throttle at a
@@ -205,6 +206,7 @@ LAWS = {
     "c0_va10": ("paper", "inertial", True, "nonlinear", False),
     "pyfly_pid": ("pyfly_pid", "air", True, "nonlinear", False),
     "pid_height": ("pid_height", "air", True, "nonlinear", False),
+    "tecs": ("tecs", "air", True, "nonlinear", False),
 }
 
 PID_GAINS = dict(kp_v=0.5, ki_v=0.1, kp_th=4.0, ki_th=0.75, kd_th=0.1, kp_h=0.03, ki_h=0.005)
@@ -215,8 +217,49 @@ height loop that sets the pitch reference (PI, 0.03 rad/m, 0.005 rad/(m s)),
 successive loop closure as in Beard and McLain ch. 6."""
 
 
+TECS_GAINS = dict(k_h=0.01, k_v=0.33, k_tp=1.0, k_ti=0.3, k_bp=0.0, k_bi=0.2, s_t=0.258,
+                  th_lim=0.26)
+"""A TECS-like law (Lambregts' total energy control, as PX4 and ArduPilot fly it):
+flight-path demand from the height error (0.01 rad/m: 5 s at 20 m/s),
+acceleration demand from the air-relative airspeed error (1/3 per s); the
+throttle closes the total energy rate error (PI, scaled by the throttle's
+effect on V'/g at trim, 0.258 per unit), the pitch reference the energy
+balance rate error (integral only, limited to +-15 deg: a proportional path
+feeds the angle of attack back into the pitch and oscillates) through PyFly's
+pitch PID, at 100 Hz.  Flight-path angle and V' from the true state and the
+equations.  Gains set by hand on one still-air step, not tuned further."""
+
+
+def tecs_command(x, wind, tp, st, dt):
+    """Commands of the TECS-like law on every lane (``st``: integrators, last command)."""
+    g = TECS_GAINS
+    grav = tp.params[nl.P_G]
+    va, _ = air(x, wind)
+    dx = derivatives(x, st["cmd"], tp.params, wind)
+    v_in = np.sqrt(x[IU] ** 2 + x[IW] ** 2)
+    vdot = (x[IU] * dx[IU] + x[IW] * dx[IW]) / v_in  # inertial speed rate
+    gamma = x[ITH] - np.arctan2(x[IW], x[IU])       # inertial flight path
+    h_err = x[IZ] - tp.x0[IZ]  # z is down: below the path, climb
+    gamma_c = tp.gamma0 + np.clip(g["k_h"] * h_err, -0.2, 0.2)
+    vdot_c = g["k_v"] * (tp.V0 - va)
+    e_g, e_v = gamma_c - gamma, (vdot_c - vdot) / grav
+    e_t, e_b = e_g + e_v, e_g - e_v
+    st["it"] += dt * e_t
+    st["ib"] += dt * e_b
+    thr = tp.u0[0] + (g["k_tp"] * e_t + g["k_ti"] * st["it"]) / g["s_t"]
+    th_ref = tp.x0[ITH] + np.clip(g["k_bp"] * e_b + g["k_bi"] * st["ib"], -g["th_lim"], g["th_lim"])
+    e_th = x[ITH] - th_ref
+    st["ith"] += dt * e_th
+    pg = PID_GAINS
+    de = tp.u0[1] + pg["kp_th"] * e_th + pg["ki_th"] * st["ith"] + pg["kd_th"] * x[IQ]
+    cmd = np.stack([thr, de, de])
+    return cmd
+
+
 def pid_command(gain, x, wind, tp, st, dt):
     """Commands of the PID laws on every lane; ``st`` holds their integrators."""
+    if gain == "tecs":
+        return tecs_command(x, wind, tp, st, dt)
     g = PID_GAINS
     va, _ = air(x, wind)
     e_v = va - tp.V0
@@ -237,7 +280,7 @@ def pid_command(gain, x, wind, tp, st, dt):
 def fly(law, setup, K, draws, record=False):
     """Fly every lane of ``draws`` under ``law``; exits and statistics."""
     gain, feed, saturated, kind, measured = LAWS[law]
-    pid = gain in ("pyfly_pid", "pid_height")
+    pid = gain in ("pyfly_pid", "pid_height", "tecs")
     K = None if pid else K[gain]
     plant = setup.plant
     tp = plant.trim
@@ -252,7 +295,8 @@ def fly(law, setup, K, draws, record=False):
     x = np.repeat(tp.x0[:, None], L, axis=1)  # absolute (nonlinear) state
     dxl = np.zeros((9, L))                  # deviation (linear plant)
     s = draws.g0.copy()
-    pst = {"iv": np.zeros(L), "ith": np.zeros(L), "iz": np.zeros(L)}
+    pst = {"iv": np.zeros(L), "ith": np.zeros(L), "iz": np.zeros(L), "it": np.zeros(L),
+           "ib": np.zeros(L), "cmd": np.repeat(tp.u0[:, None], L, axis=1)}
     exit_step = np.full(L, -1)
     exit_kind = np.zeros(L, dtype=int)      # 1 airspeed low, 2 high, 3 alpha
     at_limit = np.zeros(L)
@@ -275,6 +319,7 @@ def fly(law, setup, K, draws, record=False):
             xs = x if kind == "nonlinear" else tp.x0[:, None] + dxl
             for _ in range(10):
                 cmd = np.clip(pid_command(gain, xs, wind, tp, pst, 0.1 * plant.dt), lo, hi)
+                pst["cmd"] = cmd
                 xs = propagate(xs, cmd, tp.params, wind, 0.1 * plant.dt, 1)
         else:
             cmd = np.clip(tp.u0[:, None] + (-K @ dev), lo, hi)
