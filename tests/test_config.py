@@ -10,7 +10,7 @@ from ftc_mc.config import Config, load_config, load_scenario, parse_config
 from ftc_mc.errors import UserError
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "scripts"))
+sys.path.insert(0, str(ROOT / "scripts" / "maintenance"))
 from make_configs import campaign_configs  # noqa: E402
 
 
