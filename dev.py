@@ -15,7 +15,7 @@ pip runs with ``-qq``: its errors are shown, its warnings are not (setuptools
 boxes every editable install with a warning meant for package authors).  pip
 installs with ``--no-compile``, and the packages' bytecode is then compiled on
 every core by :mod:`compileall` (pip compiles on one: 32 s of install -> 15 s
-plus 8 s here, measured stop 39).  The bytecode is needed before the first
+plus 8 s here, measured on 2 cores).  The bytecode is needed before the first
 run: where ``PYTHONDONTWRITEBYTECODE`` is set, as in this project's CI, Python
 would otherwise compile every imported module again in every process (the test
 suite took 245 s instead of 180 s).

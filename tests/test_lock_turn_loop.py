@@ -6,6 +6,7 @@ paper's loop does not, and the configs that cannot fly it."""
 from __future__ import annotations
 
 import math
+from collections import namedtuple
 
 import numpy as np
 import pandas as pd
@@ -128,14 +129,18 @@ def test_side_blocks_match_their_twin():
             ] == [RESET_THRUST, RESET_ELEVONS, RESET_ELEVONS]
 
 
+Mon = namedtuple("Mon", ["states", "u0"])
+Pl = namedtuple("Pl", ["kind", "p", "x0", "dt", "A", "B", "Bw", "C", "Dw", "y0", "u0", "monitor"])
+"""The truth plant fields the laws read (:func:`rocking_setup`), one class for
+every test, so that each law's twin is compiled once for all of them."""
+
+
 def rocking_setup(measured, kind="nonlinear"):
     """A table with the rocking law's candidates (0.6 s horizon, switches at 0.1
     and 0.3 s, 2 RK4 sub-steps, the trials' envelope) on the default 6-DOF
     model, and the truth plant fields it reads (``kind``, the equations' ``p``
     and ``dt``, the linear model's ``A``, ``B``, ``Bw``, ``C``, ``Dw``, ``y0``, ``u0``, the
     trim ``x0``, ``monitor.states``, ``monitor.u0``) of a ``kind`` plant."""
-    from collections import namedtuple
-
     from ftc_mc.core.sixdof.layout import (MONITOR_STATES, SIXDOF_LINEAR, SIXDOF_NONLINEAR,
                                            STATE)
     from ftc_mc.model.sixdof import build_sixdof_plant
@@ -147,9 +152,6 @@ def rocking_setup(measured, kind="nonlinear"):
     tab = build_empty_table(measured)._replace(
         hold=six.u0 - u0,
         **rocking_table(lo, hi, 6, (1, 3), 2, (12.0, 30.0, -8.0, 12.0, 60.0)))
-    Mon = namedtuple("Mon", ["states", "u0"])
-    Pl = namedtuple("Pl", ["kind", "p", "x0", "dt", "A", "B", "Bw", "C", "Dw", "y0", "u0",
-                           "monitor"])
     pl = Pl(kind=SIXDOF_LINEAR if kind == "linear" else SIXDOF_NONLINEAR,
             p=six.trim.params, x0=six.trim.x0, dt=0.1, A=six.A, B=six.B, Bw=six.Bw, C=six.C,
             Dw=six.Dw, y0=six.trim.y0, u0=six.u0,

@@ -84,6 +84,13 @@ def test_markers_are_distinct_values_and_types():
         takes(numba.float64, "filter", PAPER_FILTER)
 
 
+SMALL_TABLE = {"monitor": {"turn_offsets_deg": [-6.0, 2.0], "turn_step_deg": 2.0}}
+"""The 6-DOF configs' lock-turn tables cut to 5 lock positions per elevon (those
+of ``tests/test_lock_turn_loop.py``, whose designs the suite computes anyway):
+a path does not depend on the table's size, and the shipped 23 positions take
+minutes to design on an empty cache."""
+
+
 @pytest.mark.parametrize("config, overrides, want", [
     ("paper_tables.yaml", {}, {"paper": (LINEAR_PLANT, PAPER_FILTER, ONE_STEP_TEST,
                                          RECONFIGURING)}),
@@ -98,18 +105,16 @@ def test_markers_are_distinct_values_and_types():
                                               RECONFIGURING)}),
     ("sensor_aware.yaml", {}, {"sensor_aware": (LINEAR_PLANT, DENSE_FILTER, ONE_STEP_TEST,
                                                 RECONFIGURING)}),
-    ("sixdof_tables.yaml", {}, {"paper": (SIXDOF_PLANT, PAPER_FILTER, ONE_STEP_TEST,
-                                          RECONFIGURING)}),
+    ("sixdof_tables.yaml", SMALL_TABLE, {"paper": (SIXDOF_PLANT, PAPER_FILTER, ONE_STEP_TEST,
+                                                   RECONFIGURING)}),
     # the extended side monitor (gust states on the nonlinear plant) is a path of its own
-    ("sixdof_moderate.yaml", {}, {"paper": (SIXDOF_EXTENDED_PLANT, PAPER_FILTER, ONE_STEP_TEST,
-                                            RECONFIGURING),
-                                  "sixdof_robust": (SIXDOF_EXTENDED_PLANT, EXTENDED_FILTER,
-                                                    GLR_TEST, RECONFIGURING)}),
+    ("sixdof_moderate.yaml", SMALL_TABLE, {
+        "paper": (SIXDOF_EXTENDED_PLANT, PAPER_FILTER, ONE_STEP_TEST, RECONFIGURING),
+        "sixdof_robust": (SIXDOF_EXTENDED_PLANT, EXTENDED_FILTER, GLR_TEST, RECONFIGURING)}),
     # the selection among four 6-DOF controllers is a controller path of its own
-    ("sixdof_survival.yaml", {}, {"sixdof": (SIXDOF_PLANT, PAPER_FILTER, ONE_STEP_TEST,
-                                             RECONFIGURING),
-                                  "sixdof_selected": (SIXDOF_PLANT, PAPER_FILTER, ONE_STEP_TEST,
-                                                      SELECT_FOUR)}),
+    ("sixdof_survival.yaml", SMALL_TABLE, {
+        "sixdof": (SIXDOF_PLANT, PAPER_FILTER, ONE_STEP_TEST, RECONFIGURING),
+        "sixdof_selected": (SIXDOF_PLANT, PAPER_FILTER, ONE_STEP_TEST, SELECT_FOUR)}),
 ])
 def test_path_of_the_shipped_designs(config, overrides, want):
     cfg = load_config(CONFIGS / config)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from collections import namedtuple
 from pathlib import Path
 
 import numpy as np
@@ -69,14 +70,17 @@ def test_sensor_names_and_partial_ranges():
 
 
 # ------------------------------------------------------------------ kernel vs twin
+Inp = namedtuple("Inp", "sensor_out sensor_kind sensor_size sensor_k")
+"""The trial inputs the kernel reads: one class for every kind, so that the
+kernel is compiled once for all of them."""
+
+
 @pytest.mark.parametrize("kind", SENSOR_FAULT_KINDS)
 def test_sensor_fault_kernel_matches_twin(kind):
     """Each kind, before, at and after the onset, on every output, against
     ``naive.sensor_fault_ref`` (exact: the same few operations)."""
-    from collections import namedtuple
     rng = np.random.default_rng(7)
     L, n, dt, ks = 24, 12, 0.1, 5
-    Inp = namedtuple("Inp", "sensor_out sensor_kind sensor_size sensor_k")
     out = np.arange(L) % 12
     out[-2:] = NO_SENSOR_FAULT
     size = rng.uniform(0.0, 3.0, L) if kind == "noise" else rng.uniform(-1.0, 1.0, L)
