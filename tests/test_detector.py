@@ -130,6 +130,20 @@ def test_cusum_example(recorded, tmp_path, monkeypatch):
     assert len(s) == 3 * 2 and s["trials"].sum() > 0
 
 
+def test_learned_example(recorded, tmp_path, monkeypatch):
+    """The classifier trained on one seed's recorded flights, scored on another's."""
+    pytest.importorskip("sklearn")
+    monkeypatch.syspath_prepend(str(ROOT))
+    from examples.learned import detector_of, train
+    cfg = {**CFG, "campaign": {**CFG["campaign"], "seed": 7, "signature": "paper"}}
+    ftc_mc.run_campaign(cfg, out=tmp_path / "other", record="signals", jobs=1, progress=False)
+    res = ftc_mc.score_detector(tmp_path / "other", detector_of(train(recorded)),
+                                name="learned", out=tmp_path / "l")
+    s = res["summary"]
+    assert list(s["variant"].unique()) == ["learned@paper"]
+    assert s["trials"].sum() > 0 and s["correct"].sum() > 0
+
+
 BAD = '''
 import numpy as np
 def raises(s, names, dt):
@@ -173,3 +187,21 @@ def test_run_without_signals(tmp_path):
     assert r.exit_code == 2 and "without signals" in r.output
     assert len(r.output.strip().splitlines()) == 1
     assert _digest(tmp_path / "plain") == before
+
+
+def test_endurance_records_and_scores(tmp_path):
+    """Fault-free flights recorded: a detector's false alarms per flight hour."""
+    cfg = {k: v for k, v in CFG.items() if k != "timing"}
+    cfg["campaign"] = {**CFG["campaign"], "signature": "paper"}
+    ftc_mc.run_endurance(cfg, 0.02, flight_s=15.0, out=tmp_path / "end", record="signals",
+                         jobs=1, progress=False)
+    assert signal_files(tmp_path / "end")
+    res = ftc_mc.score_detector(tmp_path / "end", table1_detector("paper"))
+    s = res["summary"].iloc[0]
+    flights = pd.read_parquet(tmp_path / "end" / "flights.parquet")
+    assert s["variant"] == "table1_paper@paper" and s["flights"] == flights["judged"].sum()
+    # Table 1 offline alarms in exactly the flights where the loop reset
+    np.testing.assert_array_equal(res["flights"]["false_resets"].to_numpy() > 0,
+                                  flights["false_resets"].to_numpy() > 0)
+    assert s["per_hour_ci_high"] > 0
+    assert (tmp_path / "end" / "detectors" / "table1_paper" / "endurance.parquet").exists()
