@@ -121,6 +121,20 @@ def test_scores_beside_the_designs(recorded, tmp_path):
     assert "table1_paper@paper" in md
 
 
+def test_correct_side_of_a_detector_naming_actuators(recorded, tmp_path):
+    t1 = table1_detector("paper")
+
+    def sided(signals, names, dt):
+        alarm, block = t1(signals, names, dt)
+        return alarm, np.where(block == "elevons", "left_elevon", block)
+
+    sided.columns = t1.columns
+    t = ftc_mc.score_detector(recorded, sided, out=tmp_path / "s")["trials"]
+    lock = t[(t["transition"] == "elevon_lock") & t["judged"]]
+    np.testing.assert_array_equal(lock["correct_side"], lock["correct"].astype(float))
+    assert t.loc[t["transition"] == "engine_loss", "correct_side"].isna().all()
+
+
 def test_cusum_example(recorded, tmp_path, monkeypatch):
     monkeypatch.chdir(ROOT)
     r = CliRunner().invoke(cli, ["score", str(recorded), "--detector", "examples.cusum:cusum",

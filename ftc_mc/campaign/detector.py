@@ -26,7 +26,8 @@ when it names the other block; no alarm in the window is *no alarm*
 false alarm (``false_resets = 1``), and then its window holds no alarm (only
 the first alarm is known).  The other columns (``judged``, ``status``, the
 costs) are the flown trial's, so the detector is judged on the same trials as
-the design.  Its rows take the variant name ``<detector>@<design>``; the summary
+the design; ``correct_side`` (6-DOF runs) is whether the alarm in the window
+named the faulty elevon (``left_elevon`` or ``right_elevon``).  Its rows take the variant name ``<detector>@<design>``; the summary
 rows are :func:`ftc_mc.campaign.summary.summary_row`'s, Tables 2-3 and the ALFA
 scores alike.
 
@@ -99,8 +100,15 @@ def run_meta(run_dir) -> dict:
                     "(no trials.parquet or flights.parquet)")
 
 
+BATCH_VALUES = 1 << 24
+"""Signal values (trials x steps x signals) of one call of a detector, at most:
+consecutive chunk files of a transition are joined up to it (fewer, larger
+calls; 64 MB of float32, whatever the run's size)."""
+
+
 def batches(run_dir, columns=None):
-    """The recorded signals of a run, one batch per signals file and design.
+    """The recorded signals of a run, in batches of one transition and design
+    (consecutive chunk files joined up to :data:`BATCH_VALUES` values).
 
     Yields
     ------
@@ -117,6 +125,7 @@ def batches(run_dir, columns=None):
     if not files:
         raise UserError(f"{run_dir}: recorded without signals (run it with "
                         "--record signals)")
+    group, group_name, values = [], None, 0
     for f in files:
         have = pq.read_schema(f).names
         names = tuple(c for c in have if c not in KEYS) if columns is None \
@@ -125,31 +134,52 @@ def batches(run_dir, columns=None):
         if missing:
             raise UserError(f"{f}: no signal columns {missing}")
         table = pq.read_table(f, columns=[*KEYS, *names])
-        # float64 when a column is (the decision statistics: thresholds compare exactly)
-        wide = any(pa.types.is_float64(table.schema.field(c).type) for c in names)
         name = table["transition"][0].as_py()
-        for design in pc.unique(table["variant"]).to_pylist():
-            t = table.filter(pc.equal(table["variant"], design))
-            ids = t["trial_id"].to_numpy()
-            step = t["step"].to_numpy().astype(np.int64)
-            uid, lane = np.unique(ids, return_inverse=True)
-            n_steps = int(step.max())
-            out = np.full((len(uid), n_steps, len(names)), np.nan,
-                          dtype=np.float64 if wide else np.float32)
-            for j, c in enumerate(names):
-                col = t[c]
-                if c == "mode":  # the mode's code (conventions.MODE_NAMES)
-                    d = col.combine_chunks()
+        size = table.num_rows * len(names)
+        if group and (name != group_name or values + size > BATCH_VALUES):
+            yield from _split(pa.concat_tables(group), group_name, names)
+            group, values = [], 0
+        group.append(table)
+        group_name = name
+        values += size
+    if group:
+        yield from _split(pa.concat_tables(group), group_name, names)
+
+
+def _split(table, name: str, names):
+    """The batches of one joined table, one per design (:func:`batches`)."""
+    # float64 when a column is (the decision statistics: thresholds compare exactly)
+    wide = any(pa.types.is_float64(table.schema.field(c).type) for c in names)
+    variant = table["variant"].combine_chunks()
+    if isinstance(variant, pa.DictionaryArray):
+        variant = variant.cast(pa.string())
+    for design in pc.unique(variant).to_pylist():
+        t = table.filter(pc.equal(variant, design))
+        ids = t["trial_id"].to_numpy()
+        step = t["step"].to_numpy().astype(np.int64)
+        uid, lane = np.unique(ids, return_inverse=True)
+        n_steps = int(step.max())
+        out = np.full((len(uid), n_steps, len(names)), np.nan,
+                      dtype=np.float64 if wide else np.float32)
+        for j, c in enumerate(names):
+            col = t[c]
+            if c == "mode":  # the mode's code (conventions.MODE_NAMES)
+                d = col.combine_chunks()
+                if isinstance(d, pa.DictionaryArray):
                     codes = np.array([MODE_NAMES.index(m) for m in d.dictionary.to_pylist()])
                     v = codes[d.indices.to_numpy()].astype(np.float32)
                 else:
-                    v = col.to_numpy()
-                out[lane, step - 1, j] = v
-            yield name, design, uid, out, names
+                    v = np.array([MODE_NAMES.index(m) for m in d.to_pylist()],
+                                 dtype=np.float32)
+            else:
+                v = col.to_numpy()
+            out[lane, step - 1, j] = v
+        yield name, design, uid, out, names
 
 
 def _check_output(res, n: int, where: str):
-    """The alarm times and block codes of a detector's return, or a UserError."""
+    """The alarm times, and the block codes and actuator names of a detector's
+    return, or a UserError."""
     block = None
     if isinstance(res, tuple):
         if len(res) != 2:
@@ -166,6 +196,7 @@ def _check_output(res, n: int, where: str):
     if np.isinf(alarm).any():
         raise UserError(f"detector: {where}: alarm times must be finite or NaN (none)")
     codes = np.full(n, -1, dtype=np.int64)  # -1: no block named
+    sides = np.full(n, "", dtype=object)  # the actuator named, if one was
     if block is not None:
         block = np.asarray(block, dtype=object)
         if block.shape != (n,):
@@ -173,7 +204,9 @@ def _check_output(res, n: int, where: str):
                             f"{block.shape}")
         for i, b in enumerate(block):
             codes[i] = _block_code(b, where)
-    return alarm, codes
+            if isinstance(b, str) and b in LAY.actuators:
+                sides[i] = b
+    return alarm, (codes, sides)
 
 
 def _block_code(b, where: str) -> int:
@@ -199,9 +232,13 @@ def call_detector(detector, signals, names, dt: float, where: str):
     return _check_output(res, signals.shape[0], where)
 
 
-def _trial_rows(flown: pd.DataFrame, alarm, codes, cfg: dict, name: str) -> pd.DataFrame:
+def _trial_rows(flown: pd.DataFrame, alarm, named_by, cfg: dict, name: str) -> pd.DataFrame:
     """The design's trial rows ``flown`` with its detection columns replaced by
-    the detector's (module docstring)."""
+    the detector's (module docstring).  ``correct_side``: where the design's
+    applies (a judged elevon trial whose final mode is an elevon's), 1.0 when
+    the detector's alarm in the window named the faulty elevon, else 0.0; NaN
+    throughout when the detector names no actuator in any trial."""
+    codes, sides = named_by
     dt = cfg["model"]["dt_s"]
     kf = round(cfg["timing"]["fault_time_s"] / dt)
     win = round(cfg["timing"]["window_s"] / dt)
@@ -229,9 +266,15 @@ def _trial_rows(flown: pd.DataFrame, alarm, codes, cfg: dict, name: str) -> pd.D
     g["resets_truncated"] = False
     g["detected"] = False  # the belief's detection is the design's, not the detector's
     g["detection_s"] = np.nan
-    g["correct_side"] = np.nan
+    applies = np.isfinite(g["correct_side"].to_numpy(dtype=float))
+    if (sides != "").any():
+        g["correct_side"] = np.where(applies, (in_win & (sides == g["mode_post"].to_numpy()))
+                                     .astype(float), np.nan)
+    else:
+        g["correct_side"] = np.nan
     g["alarm_s"] = alarm
     g["alarm_block"] = np.array([LAY.blocks[c] if c >= 0 else "" for c in codes], dtype=object)
+    g["alarm_actuator"] = sides
     return g
 
 
@@ -280,16 +323,16 @@ def score_detector(run_dir, detector, out=None, name: str | None = None) -> dict
     table = run_dir / ("flights.parquet" if endurance else "trials.parquet")
     key = "flight_id" if endurance else "trial_id"
     flown_all = pd.read_parquet(table)
+    by = ["variant"] if endurance else ["transition", "variant"]
+    flown_of = {k if isinstance(k, tuple) else (k,): g.set_index(key)
+                for k, g in flown_all.groupby(by if len(by) > 1 else by[0], sort=False)}
     parts = []
     for tr, design, ids, sig, names in batches(run_dir, getattr(detector, "columns", None)):
         if not endurance and is_sensor(tr):
             continue
         where = f"{tr} trials {ids[0]}-{ids[-1]} of {design}"
         alarm, codes = call_detector(detector, sig, names, dt, where)
-        sel = flown_all["variant"] == design
-        if not endurance:
-            sel &= flown_all["transition"] == tr
-        flown = flown_all[sel].set_index(key).loc[ids].reset_index()
+        flown = flown_of[(design,) if endurance else (tr, design)].loc[ids].reset_index()
         if endurance:
             g = flown.copy()
             ok = np.isfinite(alarm) & (alarm <= g["flown_s"].to_numpy() + 1e-9)

@@ -12,7 +12,8 @@ recording.
 (wall time on an idle machine; CPU time, user + system, on a shared one: pass
 ``--cpu``); ``score_s_per_100k`` is the CUSUM's scoring time scaled to 100,000
 recorded trials of 50 s (a trial flown by one design; the run holds
-``N x 8 transitions x 2 designs`` of them).  The memory of a recorded run is
+``N x 8 transitions x 2 designs`` of them; the scoring timed alone, after the
+child's imports).  The memory of a recorded run is
 bounded by a chunk (``campaign.chunk_size`` trials) per worker, not by the run:
 compare two ``--trials`` values to see it flat.
 
@@ -52,14 +53,30 @@ def measured(cmd, cwd=None):
     return wall, usage.ru_utime + usage.ru_stime, usage.ru_maxrss / 1024.0
 
 
-TABLE1 = """
+SCORE = """
 import sys, time
+sys.path.insert(0, ".")
+import scipy.stats  # noqa: F401 -- imports before the clock starts
 import ftc_mc
 from ftc_mc.campaign.detector import table1_detector
-t0 = time.perf_counter()
-ftc_mc.score_detector(sys.argv[1], table1_detector("paper"), out=sys.argv[2])
-print(time.perf_counter() - t0)
+from examples.cusum import cusum
+det = cusum if sys.argv[3] == "cusum" else table1_detector("paper")
+t0, c0 = time.perf_counter(), time.process_time()
+ftc_mc.score_detector(sys.argv[1], det, out=sys.argv[2])
+print(time.perf_counter() - t0, time.process_time() - c0)
 """
+
+
+def scored(run_dir, out, which):
+    """Score ``which`` in a child: wall and CPU time of the scoring alone (the
+    imports before the clock), and the child's peak RSS [MB]."""
+    p = subprocess.Popen([sys.executable, "-c", SCORE, str(run_dir), str(out), which],
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, cwd=ROOT)
+    _, status, usage = os.wait4(p.pid, 0)
+    if os.waitstatus_to_exitcode(status) != 0:
+        sys.exit(p.stderr.read().decode())
+    wall, cpu = map(float, p.stdout.read().split())
+    return wall, cpu, usage.ru_maxrss / 1024.0
 
 
 def main() -> None:
@@ -87,9 +104,8 @@ def main() -> None:
         import pyarrow.parquet as pq
         rows = sum(pq.read_metadata(f).num_rows for f in files)
         flights = a.trials * 8 * 2
-        score = measured([*FTC_MC, "score", str(rec_dir), "--detector", "examples.cusum:cusum",
-                          "-o", str(tmp / "cusum")], cwd=ROOT)
-        t1 = measured([sys.executable, "-c", TABLE1, str(rec_dir), str(tmp / "t1")], cwd=ROOT)
+        score = scored(rec_dir, tmp / "cusum", "cusum")
+        t1 = scored(rec_dir, tmp / "t1", "table1")
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
     k = 1 if a.cpu else 0
@@ -101,7 +117,7 @@ def main() -> None:
     print(f"signals: {len(files)} files, {rows} rows, {size / 1e6:.1f} MB, "
           f"{size / rows:.1f} bytes per trial step and design")
     print(f"score CUSUM:     wall {score[0]:.1f} s  CPU {score[1]:.1f} s  peak RSS "
-          f"{score[2]:.0f} MB (process start included)")
+          f"{score[2]:.0f} MB (imports excluded)")
     print(f"score Table 1:   wall {t1[0]:.1f} s  CPU {t1[1]:.1f} s  peak RSS {t1[2]:.0f} MB")
     overhead = rec[k] / plain[k]
     per_100k = score[k] * 100_000 / flights
