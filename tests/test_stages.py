@@ -682,13 +682,13 @@ def test_record_step(linear):
     for k in (0, 7, linear.tim.n_steps):  # the last is beyond the history: nothing written
         st = random_lanes(linear, rng, k)
         work = new_trial_work(L, N_AUG)
-        for a in (work.u, work.res, work.exc, work.wind):
+        for a in (work.u, work.res, work.exc, work.wind, work.z, work.innov):
             a[:] = rng.standard_normal(a.shape)
         work.block[:] = rng.integers(0, 3, L)
         rec = new_rec(linear.tim)
         hist = {f: getattr(rec, f) for f in rec._fields if f.startswith("hist_")}
         want = naive.record_step_ref(k, st, work.u, work.res, work.exc, work.wind,
-                                     work.block, hist)
+                                     work.block, hist, work.z, work.innov)
         stages.record_step(k, st, work, rec)
         for f, v in want.items():
             assert np.array_equal(getattr(rec, f), v), f

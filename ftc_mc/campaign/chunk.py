@@ -687,9 +687,11 @@ def _signals(spec: ChunkSpec, name: str, runs, trial_ids, inp, recs) -> pd.DataF
     (:func:`ftc_mc.campaign.signals.signals_frame`)."""
     from .signals import signals_frame
     tim = spec.setup.tim
-    return pd.concat([signals_frame(name, v, trial_ids, inp, rec, tim.k_fault,
-                                    tim.reconf_every)
-                      for (_, _, v, _), rec in zip(runs, recs)], ignore_index=True)
+    df = pd.concat([signals_frame(name, v, trial_ids, inp, rec, tim.k_fault,
+                                  tim.reconf_every)
+                    for (_, _, v, _), rec in zip(runs, recs)], ignore_index=True)
+    df["variant"] = pd.Categorical(df["variant"], categories=[r[2] for r in runs])
+    return df
 
 
 def warm_up(spec: ChunkSpec, tr_name: str) -> None:

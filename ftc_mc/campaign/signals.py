@@ -97,8 +97,9 @@ def signals_frame(tr_name: str, variant: str, trial_ids, inp, rec, k_fault: int,
     keep = (stop[:, None] < 0) | (kn[None, :] < stop[:, None])  # (L, n)
     lane, k = np.nonzero(keep)
     f4 = np.float32
-    cols = {"transition": pd.Categorical(np.full(len(lane), tr_name)),
-            "variant": pd.Categorical(np.full(len(lane), variant)),
+    same = np.zeros(len(lane), dtype=np.int8)
+    cols = {"transition": pd.Categorical.from_codes(same, [tr_name]),
+            "variant": pd.Categorical.from_codes(same, [variant]),
             "trial_id": np.asarray(trial_ids, dtype=np.int64)[lane],
             "step": (k + 1).astype(np.int32)}
     names = signal_columns(rec.hist_z.shape[1])
