@@ -580,8 +580,8 @@ def score(run_dir, detector, out, name):
         if len(acts):
             click.echo(terminal_table(acts))
     else:
-        from .campaign.detector import _plain
-        click.echo(_plain(res["summary"]))
+        from .report.endurance import endurance_table
+        click.echo(endurance_table(res["summary"]))
     click.echo(f"\nwrote {res['out']}/")
 
 

@@ -213,9 +213,13 @@ def test_endurance_records_and_scores(tmp_path):
     res = ftc_mc.score_detector(tmp_path / "end", table1_detector("paper"))
     s = res["summary"].iloc[0]
     flights = pd.read_parquet(tmp_path / "end" / "flights.parquet")
-    assert s["variant"] == "table1_paper@paper" and s["flights"] == flights["judged"].sum()
+    assert s["variant"] == "table1_paper@paper" and s["judged"] == flights["judged"].sum()
     # Table 1 offline alarms in exactly the flights where the loop reset
     np.testing.assert_array_equal(res["flights"]["false_resets"].to_numpy() > 0,
                                   flights["false_resets"].to_numpy() > 0)
-    assert s["per_hour_ci_high"] > 0
+    built_in = pd.read_parquet(tmp_path / "end" / "endurance.parquet").iloc[0]
+    for c in ("flight_hours", "false_resets_per_hour_ci_high", "false_resets_per_hour_upper95"):
+        assert s[c] == built_in[c], c  # first alarm = first reset: the same flights
     assert (tmp_path / "end" / "detectors" / "table1_paper" / "endurance.parquet").exists()
+    md = ftc_mc.build_report([str(tmp_path / "end")], tmp_path / "r.md").read_text()
+    assert "table1_paper@paper" in md

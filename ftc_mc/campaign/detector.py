@@ -32,8 +32,9 @@ rows are :func:`ftc_mc.campaign.summary.summary_row`'s, Tables 2-3 and the ALFA
 scores alike.
 
 Fault-free flights of ``ftc-mc endurance --record signals``: every alarm is a
-false alarm; flights with an alarm per flight hour, with Poisson bounds
-(:func:`ftc_mc.stats.poisson_ci`).
+false alarm, summarised as the designs' false resets are
+(:func:`ftc_mc.campaign.endurance.summarize_endurance`: per flight hour with
+exact Poisson intervals; at most one per flight, its first alarm).
 """
 
 from __future__ import annotations
@@ -346,7 +347,7 @@ def score_detector(run_dir, detector, out=None, name: str | None = None) -> dict
         parts.append(g)
     rows = pd.concat(parts, ignore_index=True) if parts else pd.DataFrame()
     if endurance:
-        summary = _endurance_summary(rows)
+        summary = _endurance_summary(rows, cfg)
     else:
         variants = list(dict.fromkeys(rows["variant"])) if len(rows) else []
         transitions = list(dict.fromkeys(rows["transition"])) if len(rows) else []
@@ -360,20 +361,18 @@ def score_detector(run_dir, detector, out=None, name: str | None = None) -> dict
     return {"summary": summary, ("flights" if endurance else "trials"): rows, "out": folder}
 
 
-def _endurance_summary(flights: pd.DataFrame) -> pd.DataFrame:
-    """Per design: judged flights, hours, flights with an alarm and their rate per
-    flight hour with its 95 % Poisson interval (:func:`ftc_mc.stats.poisson_ci`)."""
-    from ..stats import poisson_ci
-    rows = []
-    for v, g in flights.groupby("variant", sort=False):
-        ok = g[g["judged"]]
-        hours = float(ok["flown_s"].sum()) / 3600.0
-        k = int(ok["false_resets"].sum())
-        lo, hi = poisson_ci(k, hours) if hours > 0 else (np.nan, np.nan)
-        rows.append({"variant": v, "flights": len(ok), "hours": hours,
-                     "false_alarms": k, "per_hour": k / hours if hours > 0 else np.nan,
-                     "per_hour_ci_low": lo, "per_hour_ci_high": hi})
-    return pd.DataFrame(rows)
+def _endurance_summary(flights: pd.DataFrame, cfg: dict) -> pd.DataFrame:
+    """The endurance summary of the detector's alarms, with the built-in designs'
+    columns and definitions (:func:`ftc_mc.campaign.endurance.summarize_endurance`:
+    rates per flight hour with exact Poisson intervals, the one-sided bound, the
+    hours that would show the target); each alarm is a false reset."""
+    from ..config import parse_config
+    from .endurance import summarize_endurance
+    ok = flights["false_resets"].to_numpy() > 0
+    resets = pd.DataFrame({"variant": flights["variant"][ok], "flight_id":
+                           flights["flight_id"][ok], "time_s": flights["alarm_s"][ok]})
+    return summarize_endurance(flights, resets, parse_config(cfg),
+                               list(dict.fromkeys(flights["variant"])))
 
 
 def _write(folder: Path, rows, summary, endurance: bool, meta: dict) -> None:
@@ -385,7 +384,11 @@ def _write(folder: Path, rows, summary, endurance: bool, meta: dict) -> None:
     write_parquet(rows, folder / ("flights.parquet" if endurance else "trials.parquet"), meta)
     write_parquet(summary, folder / ("endurance.parquet" if endurance else "summary.parquet"),
                   meta)
-    md = _plain(summary) if endurance else markdown_table(summary)
+    if endurance:
+        from ..report.endurance import endurance_table
+        md = endurance_table(summary)
+    else:
+        md = markdown_table(summary)
     write_text(folder / "summary.md", f"# detector {meta['detector']}\n\n{md}\n")
 
 

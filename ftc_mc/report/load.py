@@ -163,6 +163,11 @@ def load_result_dir(path) -> ResultDir:
     tables = {f[:-len(".parquet")]: _read(path / f) for f in needed}
     if kind == "run":
         tables["summary"] = _with_detectors(path, tables["summary"])
+    elif kind == "endurance":  # detectors scored on recorded flights (ftc-mc score)
+        extra = [pd.read_parquet(f)
+                 for f in sorted((path / "detectors").glob("*/endurance.parquet"))]
+        if extra:
+            tables["endurance"] = pd.concat([tables["endurance"], *extra], ignore_index=True)
     return ResultDir(path=path, kind=kind, meta=file_meta[needed[-1]],
                      file_meta=file_meta, tables=tables)
 
