@@ -9,8 +9,13 @@ Score it on a run recorded with ``--record signals``::
 Two-sided CUSUM (Page 1954) of each innovation ``x`` (unit variance when the
 filter's model holds): ``g+ = max(0, g+ + x - k)``, ``g- = max(0, g- - x - k)``;
 an alarm when either exceeds ``h``.  The channel that fires names the block the
-way Table 1 does: ``n_x`` the thrust, ``q`` the elevons.  Its score on a small
-run is printed in docs/guides/your-detector.md.
+way Table 1 does: ``n_x`` the thrust, ``q`` the elevons.
+
+Its score (``configs/paper_tables.yaml``, 100 trials per row, seed 2026, the
+paper design's loop; docs/guides/your-detector.md): correct 100 % of the elevon
+and engine locks (the paper's design: 24 % of elevon locks by its first reset),
+82 % of elevon losses, 94 % of engine losses, 76-77 % of the recoveries, no
+inappropriate alarm and no false alarm; mean delay 0.1-0.4 s.
 """
 
 import numpy as np

@@ -11,7 +11,11 @@ judging window, ``none`` before.  The features are the last second's mean and
 mean square of the three normalised innovations.  The detector alarms at the
 first step (after the filter's start-up) where the classifier gives a block a
 probability above :data:`P_ALARM` for :data:`HOLD` steps, and names that block.
-Its score is printed in docs/guides/your-detector.md.
+
+Its score (trained on seed 2026, scored on seed 7, 100 trials per row of
+``configs/paper_tables.yaml``; docs/guides/your-detector.md): correct 97-99 % of
+the locks and unlocks, 86 % of elevon losses, 78 % of engine losses, 59-84 % of
+the recoveries; ALFA precision 98-100 %, mean delay 0.3-0.6 s.
 """
 
 import sys
