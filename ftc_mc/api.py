@@ -433,6 +433,9 @@ def run_sweep(config, thresholds=None, *, tq=None, tnx=None, transitions=None,
     cfg = campaign_config(config, trials=trials, seed=seed, signature=signature,
                           transitions=transitions, plant=plant, turbulence=turbulence, dof=dof,
                           airframe=airframe, design=design)
+    if cfg.campaign.record != "none":
+        raise UserError("campaign.record: a sweep does not record signals; record a run "
+                        "(ftc-mc run --record signals) and score thresholds offline on it")
     points = threshold_points(_spec(thresholds, "--thresholds"), _spec(tq, "--tq"),
                               _spec(tnx, "--tnx"))
     if flights is not None and flights < 1:

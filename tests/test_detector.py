@@ -223,3 +223,10 @@ def test_endurance_records_and_scores(tmp_path):
     assert (tmp_path / "end" / "detectors" / "table1_paper" / "endurance.parquet").exists()
     md = ftc_mc.build_report([str(tmp_path / "end")], tmp_path / "r.md").read_text()
     assert "table1_paper@paper" in md
+
+
+def test_a_sweep_does_not_record(tmp_path):
+    cfg = {**CFG, "campaign": {**CFG["campaign"], "record": "signals"}}
+    with pytest.raises(ftc_mc.errors.UserError, match="does not record"):
+        ftc_mc.run_sweep(cfg, thresholds="20,30", out=tmp_path / "s")
+    assert not (tmp_path / "s").exists()

@@ -745,7 +745,7 @@ class CampaignConfig(_Strict):
     reset_log: str = "all"
     """Resets written to resets.parquet: all, none or first-N (per trial and design)."""
     record: Literal["none", "signals"] = "none"
-    """Per-step signals of every trial and design written to signals/ beside trials.parquet: none or signals."""
+    """none, or signals: ftc-mc run and endurance write every step of every trial and design to signals/."""
 
     @field_validator("reset_log")
     @classmethod
