@@ -101,10 +101,10 @@ def run_meta(run_dir) -> dict:
                     "(no trials.parquet or flights.parquet)")
 
 
-BATCH_VALUES = 1 << 24
+BATCH_VALUES = 1 << 22
 """Signal values (trials x steps x signals) of one call of a detector, at most:
 consecutive chunk files of a transition are joined up to it (fewer, larger
-calls; 64 MB of float32, whatever the run's size)."""
+calls; 16 MB of float32, whatever the run's size)."""
 
 
 def batches(run_dir, columns=None):
