@@ -14,7 +14,7 @@ from .blas import pin_openblas
 pin_openblas()  # before numpy loads OpenBLAS (ftc_mc/blas.py)
 
 from .api import (build_report, load_config, run_campaign, run_endurance,  # noqa: E402
-                  run_scenario, run_sweep)
+                  run_scenario, run_sweep, score_detector)
 
 __all__ = ["run_campaign", "run_sweep", "run_endurance", "run_scenario", "build_report",
-           "load_config"]
+           "load_config", "score_detector"]

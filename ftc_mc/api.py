@@ -115,7 +115,7 @@ def _design_override(cfg, design, signature) -> dict | None:
 
 def campaign_config(config, *, trials=None, seed=None, signature=None, transitions=None,
                     controller=None, plant=None, turbulence=None, dof=None, airframe=None,
-                    design=None, reset_log=None):
+                    design=None, reset_log=None, record=None):
     """A validated campaign :class:`~ftc_mc.config.Config` with overrides.
 
     Parameters
@@ -140,6 +140,9 @@ def campaign_config(config, *, trials=None, seed=None, signature=None, transitio
         and ``campaign.designs`` (the built-in designs run first).
     reset_log : str, optional
         ``campaign.reset_log``: ``all``, ``none`` or ``first-N``.
+    record : {"none", "signals"}, optional
+        ``campaign.record``: write every step's signals to ``signals/``
+        (``docs/reference/outputs.md``).
     """
     from .config import Config, ScenarioConfig, load_config as load_campaign
     from .config import parse_config, with_overrides
@@ -154,7 +157,8 @@ def campaign_config(config, *, trials=None, seed=None, signature=None, transitio
     else:
         cfg = load_campaign(config)
     over = {"campaign": {"trials": trials, "seed": seed, "signature": signature,
-                         "transitions": _listed(transitions), "reset_log": reset_log},
+                         "transitions": _listed(transitions), "reset_log": reset_log,
+                         "record": record},
             "controller": {"kind": controller},
             "plant": {"kind": plant, "turbulence": turbulence, "dof": dof},
             "model": {"airframe": None if airframe is None else str(airframe)}}
@@ -235,6 +239,8 @@ def _open_chunks(out_dir: Path, identity_json: str, overwrite: bool, resume: boo
     store = ChunkStore(out_dir, identity_json)
     if overwrite:
         store.remove()
+        import shutil
+        shutil.rmtree(out_dir / "signals", ignore_errors=True)  # an older run's recording
     elif resume and not store.exists():
         raise UserError(f"--resume: {out_dir} holds no interrupted run")
     store.open(resume)
@@ -283,7 +289,7 @@ def _finished(out_dir: Path, kind: str, files, identity: dict) -> bool:
 
 def run_campaign(config, *, trials=None, seed=None, signature=None, controller=None,
                  plant=None, turbulence=None, dof=None, airframe=None, design=None,
-                 reset_log=None,
+                 reset_log=None, record=None,
                  jobs: int = 1,
                  progress: bool = True,
                  backend: str = "threads", scheduler: str | None = None, out=None,
@@ -295,8 +301,9 @@ def run_campaign(config, *, trials=None, seed=None, signature=None, controller=N
     ----------
     config : str, Path, dict or Config
         YAML path, parsed mapping or validated configuration.
-    trials, seed, signature, controller, plant, turbulence, airframe, design, reset_log : optional
-        Overrides of the config (:func:`campaign_config`).
+    trials, seed, signature, controller, plant, turbulence, airframe, design, reset_log, record : optional
+        Overrides of the config (:func:`campaign_config`); ``record="signals"``
+        writes every step of every trial to ``out/signals/``.
     jobs : int
         Workers (``backend``); 1 runs here alone, -1 uses every core (or, on
         worker processes, this process alone for a small run).  The results do
@@ -344,7 +351,8 @@ def run_campaign(config, *, trials=None, seed=None, signature=None, controller=N
     _check_jobs(jobs)
     cfg = campaign_config(config, trials=trials, seed=seed, signature=signature,
                           controller=controller, plant=plant, turbulence=turbulence, dof=dof,
-                          airframe=airframe, design=design, reset_log=reset_log)
+                          airframe=airframe, design=design, reset_log=reset_log,
+                          record=record)
     kw = dict(jobs=jobs, progress=progress, backend=backend, scheduler=scheduler)
     out_dir = _check_out(out, resume)
     if out_dir is None:
@@ -425,6 +433,9 @@ def run_sweep(config, thresholds=None, *, tq=None, tnx=None, transitions=None,
     cfg = campaign_config(config, trials=trials, seed=seed, signature=signature,
                           transitions=transitions, plant=plant, turbulence=turbulence, dof=dof,
                           airframe=airframe, design=design)
+    if cfg.campaign.record != "none":
+        raise UserError("campaign.record: a sweep does not record signals; record a run "
+                        "(ftc-mc run --record signals) and score thresholds offline on it")
     points = threshold_points(_spec(thresholds, "--thresholds"), _spec(tq, "--tq"),
                               _spec(tnx, "--tnx"))
     if flights is not None and flights < 1:
@@ -462,7 +473,7 @@ def run_sweep(config, thresholds=None, *, tq=None, tnx=None, transitions=None,
 
 def run_endurance(config, hours, *, flight_s: float | None = None, seed=None,
                   signature=None, plant=None, turbulence=None, dof=None, airframe=None,
-                  design=None,
+                  design=None, record=None,
                   jobs: int = 1, progress: bool = True, backend: str = "threads",
                   scheduler: str | None = None, out=None, overwrite: bool = False,
                   resume: bool = False, command: str | None = None):
@@ -477,9 +488,10 @@ def run_endurance(config, hours, *, flight_s: float | None = None, seed=None,
         Length of each flight [s] (default ``timing.duration_s``); it must be
         longer than the filters' start-up
         (:func:`ftc_mc.campaign.endurance.startup_s`).
-    seed, signature, plant, turbulence, airframe, design : optional
+    seed, signature, plant, turbulence, airframe, design, record : optional
         Overrides of the config (:func:`campaign_config`); every design flies
-        the same flights.
+        the same flights; ``record="signals"`` writes every step of every
+        flight to ``out/signals/`` (false alarms of a user's detector).
     jobs, progress, backend, scheduler, out, overwrite, resume, command
         As in :func:`run_campaign`; ``out`` receives ``endurance.parquet`` (one
         row per design), ``flights.parquet``, ``false_resets.parquet`` and
@@ -498,7 +510,8 @@ def run_endurance(config, hours, *, flight_s: float | None = None, seed=None,
     from .io.results import prepare_output_dir, provenance, write_parquet
 
     cfg = campaign_config(config, seed=seed, signature=signature, plant=plant,
-                          turbulence=turbulence, dof=dof, airframe=airframe, design=design)
+                          turbulence=turbulence, dof=dof, airframe=airframe, design=design,
+                          record=record)
     hours = check_hours(hours)
     cfg = endurance_config(cfg, flight_s)
     _check_jobs(jobs)
@@ -600,3 +613,40 @@ def build_report(dirs, out="report.md", *, allow_mixed: bool = False) -> Path:
     if isinstance(dirs, (str, Path)):
         dirs = [dirs]
     return build([Path(d) for d in dirs], Path(out), allow_mixed=allow_mixed)
+
+
+def score_detector(run_dir, detector, *, out=None, name=None):
+    """Score a detector of your own on a run's recorded signals (``ftc-mc score``).
+
+    Parameters
+    ----------
+    run_dir : str or Path
+        A directory of ``ftc-mc run --record signals`` (Tables 2-3 and the ALFA
+        scores, beside the built-in designs) or ``ftc-mc endurance --record
+        signals`` (false alarms per flight hour).
+    detector : callable or str
+        ``detector(signals, names, dt)`` returning per trial the first alarm
+        time [s] (NaN: none), optionally with the block or actuator it names;
+        or ``"module:function"`` (:mod:`ftc_mc.campaign.detector`).
+    out : str or Path, optional
+        Folder of the detector's tables (default ``run_dir/detectors/<name>/``,
+        which ``ftc-mc report`` reads).
+    name : str, optional
+        The detector's name in the tables (default its function name).
+
+    Returns
+    -------
+    dict
+        ``summary``, ``trials`` (or ``flights``) and ``out``.
+
+    Raises
+    ------
+    UserError
+        A module that cannot be imported, a run recorded without signals, a
+        detector that raises or returns the wrong shape or infinite alarm
+        times; nothing is written then.
+    """
+    from .campaign.detector import score_detector as score
+
+    return score(run_dir, detector, out=out, name=name)
+

@@ -367,11 +367,15 @@ def terminal_table(summary) -> str:
               help="Resets written to resets.parquet: all (the default), none, or the "
               "first N of each trial; trials.parquet and the summary do not depend on "
               "it (overrides campaign.reset_log).")
+@click.option("--record", type=click.Choice(["none", "signals"]),
+              help="signals: write every step of every trial and design to signals/ "
+              "beside the tables, for scoring your own detector (ftc-mc score) "
+              "(overrides campaign.record).")
 @plant_options
 @parallel_options
 @user_errors
 def run(config, trials, seed, jobs, out, signature, design, controller, overwrite, resume,
-        reset_log, backend, scheduler, quiet, plant, turbulence, dof, airframe):
+        reset_log, record, backend, scheduler, quiet, plant, turbulence, dof, airframe):
     """Run a Monte Carlo campaign (the paper's Tables 2-3) from CONFIG."""
     from pathlib import Path
 
@@ -380,7 +384,7 @@ def run(config, trials, seed, jobs, out, signature, design, controller, overwrit
     cfg = api.campaign_config(config, trials=trials, seed=seed, signature=signature,
                               controller=controller, plant=plant, turbulence=turbulence, dof=dof,
                               airframe=airframe, design=list(design) or None,
-                              reset_log=reset_log)
+                              reset_log=reset_log, record=record)
     if resume and not out:
         raise UserError("--resume: name the run's directory with --out")
     out_dir = Path(out) if out else _default_out(config, cfg)
@@ -401,7 +405,8 @@ def run(config, trials, seed, jobs, out, signature, design, controller, overwrit
         click.echo(("\n" if len(acts) else "") + "Sensor faults: what the FTC scheme "
                    "does with them (% of judged trials)\n" + sensor)
     click.echo(f"\nwrote {out_dir}/: trials.parquet, resets.parquet, summary.parquet, "
-               "summary.md (the full table)")
+               "summary.md (the full table)"
+               + (", signals/" if result.config.campaign.record == "signals" else ""))
 
 
 @cli.command()
@@ -498,11 +503,15 @@ def sweep(config, thresholds, tq, tnx, transitions, signature, design, trials, f
 @click.option("--resume", is_flag=True,
               help="Continue an interrupted endurance run in --out, skipping its finished "
               "chunks.")
+@click.option("--record", type=click.Choice(["none", "signals"]),
+              help="signals: write every step of every flight and design to signals/ "
+              "beside the tables, for scoring your own detector (ftc-mc score) "
+              "(overrides campaign.record).")
 @plant_options
 @parallel_options
 @user_errors
 def endurance(config, hours, flight_s, seed, signature, design, jobs, out, overwrite, resume,
-              backend, scheduler, quiet, plant, turbulence, dof, airframe):
+              record, backend, scheduler, quiet, plant, turbulence, dof, airframe):
     """Fly every design fault-free for H flight hours: false resets per flight hour."""
     from pathlib import Path
 
@@ -517,7 +526,7 @@ def endurance(config, hours, flight_s, seed, signature, design, jobs, out, overw
             raise UserError(f"--flight-s: expected seconds, got {flight_s!r}") from None
     cfg = api.campaign_config(config, seed=seed, signature=signature, plant=plant,
                               turbulence=turbulence, dof=dof, airframe=airframe,
-                              design=list(design) or None)
+                              design=list(design) or None, record=record)
     cfg = endurance_config(cfg, flight_s)
     if resume and not out:
         raise UserError("--resume: name the run's directory with --out")
@@ -554,6 +563,35 @@ def report(dirs, output, allow_mixed):
 
     out = api.build_report(list(dirs), output, allow_mixed=allow_mixed)
     click.echo(f"wrote {out}")
+
+
+@cli.command()
+@click.argument("run_dir", metavar="RUN_DIR", type=click.Path())
+@click.option("--detector", required=True, metavar="MODULE:FUNCTION",
+              help="Your detector: a NumPy function (signals, names, dt) -> alarm times "
+              "[s] per trial (NaN: none), optionally with the block it names "
+              "(docs/guides/your-detector.md).")
+@click.option("-o", "--out", type=click.Path(file_okay=False),
+              help="Folder of the detector's tables [default: RUN_DIR/detectors/<function>/, "
+              "which ftc-mc report reads].")
+@click.option("--name", help="The detector's name in the tables [default: its function name].")
+@user_errors
+def score(run_dir, detector, out, name):
+    """Score your own detector on RUN_DIR's recorded signals (ftc-mc run or endurance
+    --record signals) by the built-in designs' definitions: Tables 2-3 and the ALFA
+    scores, or false alarms per flight hour."""
+    from . import api
+
+    res = api.score_detector(run_dir, detector, out=out, name=name)
+    if "trials" in res:
+        from .campaign.summary import actuator_rows
+        acts = actuator_rows(res["summary"])
+        if len(acts):
+            click.echo(terminal_table(acts))
+    else:
+        from .report.endurance import endurance_table
+        click.echo(endurance_table(res["summary"]))
+    click.echo(f"\nwrote {res['out']}/")
 
 
 @cli.group("config")

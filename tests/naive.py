@@ -815,14 +815,15 @@ def sensor_fault_ref(z, v, zhold, k, dt, out, kind, size, k_onset):
     return z, zhold
 
 
-def filter_update_ref(scheme, st, u, z, k=0, relinearised_already=False):
+def filter_update_ref(scheme, st, u, z, k=0, relinearised_already=False, with_innov=False):
     """Every lane's filter step (:func:`filter_step_ref`) and the running maxima
     of the decision statistics of ``r_q``, ``r_nx``; with the GLR test the
     window (``st.ebuf`` row ``k % W``, ``st.ecount``) takes this step's
     innovations and a reset empties it.  With ``relin > 0`` each lane's step
     uses its Jacobians (:func:`lane_jacobians_ref`, or ``st``'s as they are
     with ``relinearised_already``).  Returns ``xa, P, res, block, rmax,
-    ebuf, ecount, last_k, last_block``."""
+    ebuf, ecount, last_k, last_block`` and, ``with_innov``, the signed normalised
+    innovations (3, L)."""
     model = ref_of(scheme)
     jac = ({f: getattr(st, f) for f in JACOBIANS} if relinearised_already
            else lane_jacobians_ref(scheme, st, u, k))
@@ -831,6 +832,7 @@ def filter_update_ref(scheme, st, u, z, k=0, relinearised_already=False):
     ebuf, ecount = st.ebuf.copy(), st.ecount.copy()
     last_k, last_block = st.last_k.copy(), st.last_block.copy()
     res, block = np.zeros((3, L)), np.zeros(L, dtype=np.int64)
+    innov = np.zeros((3, L))
     W = ebuf.shape[0]
     for l in range(L):
         stat = None
@@ -846,7 +848,7 @@ def filter_update_ref(scheme, st, u, z, k=0, relinearised_already=False):
                 if k < model.startup:
                     return 0
                 return 0 if (b and last_block[l] and b != last_block[l] and recent) else b
-        xa[:, l], P[:, :, l], block[l], res[:, l], _ = filter_step_ref(
+        xa[:, l], P[:, :, l], block[l], res[:, l], innov[:, l] = filter_step_ref(
             st.xa[:, l], st.P[:, :, l], u[:, l], z[:, l], relinearised(model, jac, l), stat,
             gate)
         if model.test == "glr" and block[l] or k < model.startup:
@@ -854,6 +856,8 @@ def filter_update_ref(scheme, st, u, z, k=0, relinearised_already=False):
         if model.settle > 0 and block[l]:
             last_k[l], last_block[l] = k, block[l]
     rmax = np.maximum(st.rmax, res[:2])
+    if with_innov:
+        return xa, P, res, block, rmax, ebuf, ecount, last_k, last_block, innov
     return xa, P, res, block, rmax, ebuf, ecount, last_k, last_block
 
 
@@ -974,7 +978,7 @@ def record_cost_ref(track, k_switch, kn, x, u, alive, cost, marks):
     return cost, marks
 
 
-def record_step_ref(k, st, u, res, exc, wind, block, hist):
+def record_step_ref(k, st, u, res, exc, wind, block, hist, z, innov):
     """The history row ``k`` (only while ``k`` is below the history length)."""
     hist = {f: v.copy() for f, v in hist.items()}
     if k < hist["hist_x"].shape[0]:
@@ -986,6 +990,8 @@ def record_step_ref(k, st, u, res, exc, wind, block, hist):
         hist["hist_exc"][k] = exc
         hist["hist_wind"][k] = wind
         hist["hist_block"][k] = block
+        hist["hist_z"][k] = z
+        hist["hist_innov"][k] = innov
     return hist
 
 
@@ -1033,8 +1039,8 @@ def advance_ref(scheme, flight, inp, rec, st, k0, k1):
             rec.z_switch_last)
         for f, J in lane_jacobians_ref(scheme, st, u, k).items():
             getattr(st, f)[:] = J
-        xa, P, res, block, rmax, ebuf, ecount, last_k, last_block = filter_update_ref(
-            scheme, st, u, tr["z"], k, relinearised_already=True)
+        xa, P, res, block, rmax, ebuf, ecount, last_k, last_block, innov = filter_update_ref(
+            scheme, st, u, tr["z"], k, relinearised_already=True, with_innov=True)
         st.xa[:], st.P[:], st.rmax[:] = xa, P, rmax
         st.ebuf[:], st.ecount[:] = ebuf, ecount
         st.last_k[:], st.last_block[:] = last_k, last_block
@@ -1049,7 +1055,7 @@ def advance_ref(scheme, flight, inp, rec, st, k0, k1):
             getattr(rec, f)[:] = out[f]
         hist = record_step_ref(k, st, u, res, exc, tr["wind"], block,
                                {f: getattr(rec, f) for f in rec._fields
-                                if f.startswith("hist_")})
+                                if f.startswith("hist_")}, tr["z"], innov)
         for f, v in hist.items():
             getattr(rec, f)[:] = v
         if kn % every == 0:

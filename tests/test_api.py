@@ -48,7 +48,8 @@ def test_import_is_cheap_and_exports_the_api():
                          check=True, cwd=ROOT)
     assert out.stdout.strip() == "[]"
     assert set(ftc_mc.__all__) == {"run_campaign", "run_sweep", "run_endurance",
-                                   "run_scenario", "build_report", "load_config"}
+                                   "run_scenario", "build_report", "load_config",
+                                   "score_detector"}
     assert all(callable(getattr(ftc_mc, name)) for name in ftc_mc.__all__)
 
 

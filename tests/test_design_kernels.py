@@ -102,7 +102,7 @@ def compare_steps(scheme, st, rng, scales, k0, n, tol_res=1e-11, tol=1e-9, tol_j
         xa, P, res, block, rmax, ebuf, ecount, last_k, last_block = naive.filter_update_ref(
             scheme, st, work.u, work.z, k)
         jac = naive.lane_jacobians_ref(scheme, st, work.u, k) if tol_jac else None
-        stages.filter_update(path_of(scheme), scheme, st, k, work)
+        stages.filter_update(path_of(scheme), scheme, st, k, work, False)
         if tol_jac:
             for f, J in jac.items():
                 for l in range(L):
@@ -341,7 +341,7 @@ def test_extended_equals_linear_small_signal(nonlinear_gusts):
             work = new_trial_work(L, N)
             work.u[:], work.z[:] = u, z
             scheme = nonlinear_gusts.scheme("paper", det)._replace(filter=fm)
-            stages.filter_update(path_of(scheme), scheme, st, 10, work)
+            stages.filter_update(path_of(scheme), scheme, st, 10, work, False)
             out.append(st.xa.copy())
         diffs.append(rel(out[1] - xa, out[0] - xa))
     assert diffs[0] > 10 * diffs[2] and diffs[-1] < 1e-3, diffs
@@ -350,7 +350,7 @@ def test_extended_equals_linear_small_signal(nonlinear_gusts):
                  ._replace(xa=np.zeros((N, L))))
     work = new_trial_work(L, N)
     scheme = nonlinear_gusts.scheme("paper", det)._replace(filter=fm_n)
-    stages.filter_update(path_of(scheme), scheme, st, 10, work)
+    stages.filter_update(path_of(scheme), scheme, st, 10, work, False)
     assert np.abs(work.fwork[N + 5]).max() < 1e-9  # the prediction, before the update
 
 

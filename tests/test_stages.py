@@ -211,6 +211,7 @@ def new_rec(tim, L=L, max_resets=4, history=True):
         hist_pdiag=np.zeros((n_hist, 5, L)), hist_u=np.zeros((n_hist, 3, L)),
         hist_res=np.zeros((n_hist, 3, L)), hist_exc=np.zeros((n_hist, 4, L)),
         hist_block=np.zeros((n_hist, L), i8), hist_wind=np.zeros((n_hist, 3, L)),
+        hist_z=np.zeros((n_hist, 12, L)), hist_innov=np.zeros((n_hist, 3, L)),
         sq_lat=np.zeros((2, L)), cost=np.zeros((N_COST, L)), z_switch_last=np.zeros((2, L)),
         side_k=np.full(L, -1, i8), side_block=np.zeros(L, i8), side_pre=np.zeros(L, i8),
         side_n=np.zeros(L, i8), mon_b=np.zeros((0, L)))
@@ -482,7 +483,7 @@ def test_filter_update(linear, variant):
             work.z[:, l] = -mu0 + scale[l] * np.sqrt(np.diag(S)) * rng.standard_normal(12)
         xa, P, res, block, rmax, *_ = naive.filter_update_ref(scheme, st, work.u, work.z)
         Pk = st.P.copy()
-        stages.filter_update(path_of(scheme), scheme, st, 10, work)
+        stages.filter_update(path_of(scheme), scheme, st, 10, work, False)
         assert np.array_equal(work.block, block)
         assert_lanes(work.res, res, 1e-12, "residuals")
         assert rel(st.rmax, rmax) <= 1e-12
@@ -681,13 +682,13 @@ def test_record_step(linear):
     for k in (0, 7, linear.tim.n_steps):  # the last is beyond the history: nothing written
         st = random_lanes(linear, rng, k)
         work = new_trial_work(L, N_AUG)
-        for a in (work.u, work.res, work.exc, work.wind):
+        for a in (work.u, work.res, work.exc, work.wind, work.z, work.innov):
             a[:] = rng.standard_normal(a.shape)
         work.block[:] = rng.integers(0, 3, L)
         rec = new_rec(linear.tim)
         hist = {f: getattr(rec, f) for f in rec._fields if f.startswith("hist_")}
         want = naive.record_step_ref(k, st, work.u, work.res, work.exc, work.wind,
-                                     work.block, hist)
+                                     work.block, hist, work.z, work.innov)
         stages.record_step(k, st, work, rec)
         for f, v in want.items():
             assert np.array_equal(getattr(rec, f), v), f

@@ -69,6 +69,9 @@ class ChunkSpec:
         Resets of each trial and design kept in the ``resets`` table
         (``campaign.reset_log``; the first ones in time); None: all.  Only the
         table is cut: the trials' columns are classified from every stored reset.
+    record : bool
+        Keep every step and return the ``signals`` table too
+        (``campaign.record``, :mod:`ftc_mc.campaign.signals`).
     """
 
     setup: SimSetup
@@ -81,11 +84,14 @@ class ChunkSpec:
     points: tuple | None = None
     sensor_ranges: dict = dataclasses.field(default_factory=dict)
     resets_kept: int | None = None
+    record: bool = False
 
     @property
     def tables(self) -> tuple:
         """Names of the tables :func:`run_chunk` returns (``trials`` first)."""
-        return ("trials", "resets") if self.points is None else ("trials", "steps")
+        if self.points is not None:
+            return ("trials", "steps")
+        return ("trials", "resets", "signals") if self.record else ("trials", "resets")
 
 
 def chunk_spec(cfg: Config, setup: SimSetup | None = None, points=None) -> ChunkSpec:
@@ -111,7 +117,8 @@ def chunk_spec(cfg: Config, setup: SimSetup | None = None, points=None) -> Chunk
                      sensor_ranges={name: cfg.sensor_draws.size_range(tr.kind, tr.output)
                                     for name in cfg.campaign.transitions if is_sensor(name)
                                     for tr in [transition_of(name)]},
-                     resets_kept=cfg.campaign.resets_kept())
+                     resets_kept=cfg.campaign.resets_kept(),
+                     record=cfg.campaign.record == "signals" and points is None)
 
 
 def trial_inputs(spec: ChunkSpec, tr_name: str, trial_ids):
@@ -629,14 +636,18 @@ def run_chunk(spec: ChunkSpec, name: str, trial_ids) -> dict:
     L, n = len(trial_ids), setup.tim.n_steps
     if name == ENDURANCE:  # every design alone on the same flights (no threshold points)
         inp = flight_inputs(setup, trial_ids, spec.seed)
-        recs, _ = simulate(setup, inp, [r[2:] for r in runs], spec.max_resets)
+        recs, _ = simulate(setup, inp, [r[2:] for r in runs], spec.max_resets,
+                           history=spec.record)
         parts = [classify_flights(v, trial_ids, rec, setup.plant.dt, n * setup.plant.dt)
                  for (_, _, v, _), rec in zip(runs, recs)]
         if setup.dof == 6:
             for (t, _), rec in zip(parts, recs):
                 t.update(lateral_columns(rec, n))
-        return {"trials": pd.DataFrame(_columns([p[0] for p in parts])),
-                "resets": pd.DataFrame(_columns([p[1] for p in parts]))}
+        out = {"trials": pd.DataFrame(_columns([p[0] for p in parts])),
+               "resets": pd.DataFrame(_columns([p[1] for p in parts]))}
+        if spec.record:
+            out["signals"] = _signals(spec, name, runs, trial_ids, inp, recs)
+        return out
     if name == FLIGHT:
         assert spec.points is not None
         inp = flight_inputs(setup, trial_ids, spec.seed)
@@ -647,7 +658,8 @@ def run_chunk(spec: ChunkSpec, name: str, trial_ids) -> dict:
                 "steps": pd.DataFrame({"simulated": [simulated], "alone": [L * n * len(runs)]})}
     inp, values = trial_inputs(spec, name, trial_ids)
     share = None if spec.points is None else setup.tim.k_fault
-    recs, simulated = simulate(setup, inp, [r[2:] for r in runs], spec.max_resets, share)
+    recs, simulated = simulate(setup, inp, [r[2:] for r in runs], spec.max_resets, share,
+                               history=spec.record)
     trials, resets = [], []
     for (tq, tnx, v, _), rec in zip(runs, recs):
         t, r = classify(spec, name, v, trial_ids, values, inp, rec)
@@ -661,10 +673,25 @@ def run_chunk(spec: ChunkSpec, name: str, trial_ids) -> dict:
         trials.append(t)
         resets.append(first_resets(r, spec.resets_kept))
     if spec.points is None:
-        return {"trials": pd.DataFrame(_columns(trials)),
-                "resets": pd.DataFrame(_columns(resets))}
+        out = {"trials": pd.DataFrame(_columns(trials)),
+               "resets": pd.DataFrame(_columns(resets))}
+        if spec.record:
+            out["signals"] = _signals(spec, name, runs, trial_ids, inp, recs)
+        return out
     return {"trials": pd.DataFrame(_columns(trials)),
             "steps": pd.DataFrame({"simulated": [simulated], "alone": [L * n * len(runs)]})}
+
+
+def _signals(spec: ChunkSpec, name: str, runs, trial_ids, inp, recs) -> pd.DataFrame:
+    """The chunk's recorded signals, design by design
+    (:func:`ftc_mc.campaign.signals.signals_frame`)."""
+    from .signals import signals_frame
+    tim = spec.setup.tim
+    df = pd.concat([signals_frame(name, v, trial_ids, inp, rec, tim.k_fault,
+                                  tim.reconf_every)
+                    for (_, _, v, _), rec in zip(runs, recs)], ignore_index=True)
+    df["variant"] = pd.Categorical(df["variant"], categories=[r[2] for r in runs])
+    return df
 
 
 def warm_up(spec: ChunkSpec, tr_name: str) -> None:
@@ -683,4 +710,4 @@ def warm_up(spec: ChunkSpec, tr_name: str) -> None:
         seen.add(path)
         with compiled_once(advance, path):
             run_chunk(dataclasses.replace(spec, variants=(v,), max_resets=4, window=1,
-                                          points=None), tr_name, np.arange(1))
+                                          points=None, record=False), tr_name, np.arange(1))

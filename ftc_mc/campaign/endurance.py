@@ -39,6 +39,7 @@ from ..errors import UserError
 from ..stats import hours_to_show, poisson_rate, poisson_upper
 from .chunk import ENDURANCE, chunk_spec
 from .parallel import run_chunks
+from .signals import move_signals
 from .runner import sort_rows
 from .summary import lateral_summary
 
@@ -255,8 +256,11 @@ def run_endurance(cfg: Config, hours, *, flight_s: float | None = None, jobs: in
     out = run_chunks(spec, units, n_jobs=n_jobs, backend_name=backend, scheduler=scheduler,
                      progress=progress, chunks=chunks, desc="flights")
     if chunks is not None:  # stored chunk by chunk: read back in chunk order (small tables)
-        out = [dict(zip(spec.tables, chunks.read(name, int(ids[0]), spec.tables)))
+        tables = ("trials", "resets")  # recorded signals stay on disk
+        out = [dict(zip(tables, chunks.read(name, int(ids[0]), tables)))
                for name, ids in units]
+        if spec.record:
+            move_signals(chunks, units, chunks.folder.parent)
     flights = pd.concat([o["trials"] for o in out], ignore_index=True)
     resets = pd.concat([o["resets"] for o in out], ignore_index=True)
     flights = _sorted(flights, spec.variants, ["flight_id"])

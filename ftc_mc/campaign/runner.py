@@ -22,6 +22,7 @@ from ..config.schema import Config
 from .assemble import write_run_tables
 from .chunk import chunk_spec
 from .parallel import run_chunks
+from .signals import move_signals
 from .summary import markdown_table, summarize
 from .side import SIDE_COLUMNS, side_markdown, side_table
 from .survival import (survival_markdown, survival_table, trimmable_markdown,
@@ -53,6 +54,7 @@ class CampaignResult:
         self.summary, self.config = summary, config
         self.out = None if out is None else Path(out)
         self._sets = None
+        self.signals = None  # recorded signals of a run kept in memory (no out)
 
     @property
     def trials(self) -> pd.DataFrame:
@@ -247,6 +249,8 @@ def run_campaign(config, *, trials=None, seed=None, signature=None, jobs: int = 
                      scheduler=scheduler, progress=progress, chunks=chunks, desc="trials")
     if chunks is not None and out_dir is not None:
         summary = write_run_tables(chunks, units, spec.variants, Path(out_dir), meta or {})
+        if spec.record:
+            move_signals(chunks, units, out_dir)
         return CampaignResult(summary=summary, config=cfg, out=out_dir)
     if chunks is not None:
         out = [dict(zip(spec.tables, chunks.read(n, int(ids[0]), spec.tables)))
@@ -255,5 +259,8 @@ def run_campaign(config, *, trials=None, seed=None, signature=None, jobs: int = 
                           c.transitions, spec.variants, ["trial_id"])
     resets_df = sort_rows(pd.concat([o["resets"] for o in out], ignore_index=True),
                           c.transitions, spec.variants, ["trial_id", "time_s"])
-    return CampaignResult(trials=trials_df, resets=resets_df,
-                          summary=summarize(trials_df), config=cfg)
+    result = CampaignResult(trials=trials_df, resets=resets_df,
+                            summary=summarize(trials_df), config=cfg)
+    if spec.record:  # in memory: the whole run's signals (small runs only)
+        result.signals = pd.concat([o["signals"] for o in out], ignore_index=True)
+    return result

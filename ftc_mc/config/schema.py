@@ -744,6 +744,8 @@ class CampaignConfig(_Strict):
     """Resets stored per trial (more are counted, not stored); null: one per step, all."""
     reset_log: str = "all"
     """Resets written to resets.parquet: all, none or first-N (per trial and design)."""
+    record: Literal["none", "signals"] = "none"
+    """none, or signals: ftc-mc run and endurance write every step of every trial and design to signals/."""
 
     @field_validator("reset_log")
     @classmethod

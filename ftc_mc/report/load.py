@@ -10,6 +10,7 @@ from __future__ import annotations
 import dataclasses
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 import pyarrow.parquet as pq
 
@@ -106,6 +107,19 @@ def _read(file: Path) -> pd.DataFrame:
                                           if c in set(TRIAL_COLUMNS)])
 
 
+def _with_detectors(path: Path, summary: pd.DataFrame) -> pd.DataFrame:
+    """A run's summary with the rows of the detectors scored on its recorded
+    signals (``ftc-mc score``: ``detectors/<name>/summary.parquet``), each after
+    the built-in designs' rows of its transition."""
+    extra = [pd.read_parquet(f) for f in sorted((path / "detectors").glob("*/summary.parquet"))]
+    if not extra:
+        return summary
+    both = pd.concat([summary, *extra], ignore_index=True)
+    order = {t: i for i, t in enumerate(dict.fromkeys(summary["transition"]))}
+    key = both["transition"].map(order).fillna(len(order)).to_numpy()
+    return both.iloc[np.argsort(key, kind="stable")].reset_index(drop=True)
+
+
 def load_result_dir(path) -> ResultDir:
     """Read one run, scenario or sweep directory.
 
@@ -147,6 +161,13 @@ def load_result_dir(path) -> ResultDir:
         raise UserError(f"{path}: metadata kind {sorted(map(str, kinds))} does not match "
                         f"the {kind} files it holds")
     tables = {f[:-len(".parquet")]: _read(path / f) for f in needed}
+    if kind == "run":
+        tables["summary"] = _with_detectors(path, tables["summary"])
+    elif kind == "endurance":  # detectors scored on recorded flights (ftc-mc score)
+        extra = [pd.read_parquet(f)
+                 for f in sorted((path / "detectors").glob("*/endurance.parquet"))]
+        if extra:
+            tables["endurance"] = pd.concat([tables["endurance"], *extra], ignore_index=True)
     return ResultDir(path=path, kind=kind, meta=file_meta[needed[-1]],
                      file_meta=file_meta, tables=tables)
 

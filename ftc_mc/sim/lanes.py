@@ -102,6 +102,7 @@ def new_record(setup, L: int, max_resets: int, history: bool = False,
         hist_res=np.zeros((n_hist, n_res, L)), hist_exc=np.zeros((n_hist, N_EXC, L)),
         hist_block=np.zeros((n_hist, L), dtype=np.int64),
         hist_wind=np.zeros((n_hist, N_WIND, L)),
+        hist_z=np.zeros((n_hist, LAY.n_z, L)), hist_innov=np.zeros((n_hist, n_res, L)),
         xa_end=np.zeros((n_est, L)), sq_lat=np.zeros((N_SQ_LAT, L)),
         cost=np.zeros((N_COST, L)), z_switch_last=np.zeros((2, L)),
         side_k=np.zeros(L, dtype=np.int64), side_block=np.zeros(L, dtype=np.int64),
@@ -129,7 +130,8 @@ def _copy(nt):
     return type(nt)(**{f: v.copy() for f, v in nt._asdict().items()})
 
 
-def simulate(setup, inp: TrialInputs, runs, max_resets: int, k_share: int | None = None):
+def simulate(setup, inp: TrialInputs, runs, max_resets: int, k_share: int | None = None,
+             history: bool = False):
     """Records of the lanes of ``inp`` under each run of ``runs``.
 
     Parameters
@@ -145,6 +147,9 @@ def simulate(setup, inp: TrialInputs, runs, max_resets: int, k_share: int | None
         ``None``: every run from the start, alone.  Else the step up to which the
         runs of one design key share the lanes' start (module docstring),
         ``0 < k_share <= n_steps``.
+    history : bool
+        Keep every step (:func:`new_record`; recorded signals); only with
+        ``k_share`` None.
 
     Returns
     -------
@@ -155,8 +160,9 @@ def simulate(setup, inp: TrialInputs, runs, max_resets: int, k_share: int | None
     """
     L, n = inp.w.shape[2], setup.tim.n_steps
     if k_share is None:
-        return [run_alone(setup, v, det, inp, max_resets) for v, det in runs], L * n * len(runs)
-    assert 0 < k_share <= n
+        return ([run_alone(setup, v, det, inp, max_resets, history) for v, det in runs],
+                L * n * len(runs))
+    assert 0 < k_share <= n and not history
     groups = {}
     for i, (name, _) in enumerate(runs):
         groups.setdefault(setup.designs[name].key, []).append(i)

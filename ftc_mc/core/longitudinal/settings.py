@@ -216,6 +216,8 @@ TrialRecord = namedtuple("TrialRecord", [
                     #      then 1.0 where each signal started at that step
     "hist_block",   # (n_hist, L) int64 block reset at each step
     "hist_wind",    # (n_hist, 3, L) gust u_g, w_g [m/s], q_g [rad/s] held over each step
+    "hist_z",       # (n_hist, 12, L) measurements z_{k+1} (deviations from the trim outputs)
+    "hist_innov",   # (n_hist, 3, L) signed normalised innovations of r_q, r_nx, r_nz's outputs
     "sq_lat",       # (2, L) sums over the valid steps of the squared bank and heading
                     #      deviations [rad^2] (6-DOF plant; zeros otherwise)
     "cost",         # (N_COST, L) over the valid steps (conventions.COST_NAMES): sum of

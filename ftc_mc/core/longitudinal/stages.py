@@ -258,6 +258,12 @@ def innovations(path, scheme, st, work):
     """The paper filter's innovations on the GLR test's path."""
 
 
+@on_path("test", {ONE_STEP_TEST: paper_innovations_on}, passes="path")
+def innovations_kept(path, scheme, st, work):
+    """The paper filter's innovations on the one-step test's path, which does not
+    read them: computed only while a history is kept (recorded signals)."""
+
+
 @kernel(internal=True)
 def paper_correct(fkind, scheme, st, work):
     """Reset, update and projection of the paper's filter
@@ -308,7 +314,7 @@ def side_blocks(path, scheme, st, block):
 
 
 @kernel(inline="always")
-def filter_update(path, scheme, st, k, work):
+def filter_update(path, scheme, st, k, work, keep_innov):
     """Stage 3: one step of every lane's augmented filter (eqs. 5-11, Table 1).
 
     Predict with ``u_k`` and the residuals on ``z_{k+1}``
@@ -343,11 +349,16 @@ def filter_update(path, scheme, st, k, work):
         Reads ``u``, ``z``; writes ``res`` (the decision statistics: one-step
         residuals or GLR), ``block`` and, for the GLR test or the general
         filter, ``innov``; filter work ``phi``, ``T``, ``fwork``, ``crow``.
+    keep_innov : bool
+        Write ``innov`` on every path (a kept history records it); the paper's
+        one-step test does not read it, so it is skipped otherwise.
     """
     det = scheme.detection
     res = work.res
     predict(path, scheme, st, k, work)
     innovations(path, scheme, st, work)
+    if keep_innov:
+        innovations_kept(path, scheme, st, work)
     decision_statistics(path, det, st, k, work)
     signature_lanes(res, det, work.block)
     side_blocks(path, scheme, st, work.block)
@@ -613,10 +624,12 @@ def record_step(k, st, work, rec):
     st : LaneState
         Reads ``x`` (true state after the step), ``xa``, ``P``.
     work : TrialWork
-        Reads ``u``, ``res``, ``exc``, ``wind``, ``block``.
+        Reads ``u``, ``res``, ``exc``, ``wind``, ``block``, ``z``, ``innov``.
     rec : TrialRecord
         ``hist_*`` rows ``k`` written: true state, estimate, fault-parameter
-        variances, commands, residuals, excitation, gust, block.
+        variances, commands, residuals, excitation, gust, block, measurements
+        and normalised innovations (written on every path while a history is
+        kept, :func:`filter_update`).
     """
     if k >= rec.hist_x.shape[0]:
         return
@@ -639,6 +652,10 @@ def record_step(k, st, work, rec):
         for i in range(work.wind.shape[0]):
             rec.hist_wind[k, i, l] = work.wind[i, l]
         rec.hist_block[k, l] = work.block[l]
+        for i in range(rec.hist_z.shape[1]):
+            rec.hist_z[k, i, l] = work.z[i, l]
+        for i in range(work.innov.shape[0]):
+            rec.hist_innov[k, i, l] = work.innov[i, l]
 
 
 # ------------------------------------------------------------------ 7. reconfigure

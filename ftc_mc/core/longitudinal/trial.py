@@ -154,7 +154,7 @@ def trial_steps(path, scheme, flight, inp, k0, k1, st, work, rec):
         truth(path, scheme, flight, inp, k, st, work, rec)
         record_cost(flight.track, flight.timing.k_fault, st, kn, work, rec)
         side_monitor(path, scheme, flight, k, st, work, rec)
-        filter_update(path, scheme, st, k, work)
+        filter_update(path, scheme, st, k, work, rec.hist_innov.shape[0] > 0)
         check_validity(flight.validity, st, kn, work, rec)
         handle_resets(scheme.excitation, st, kn, work, rec)
         record_step(k, st, work, rec)

@@ -1,0 +1,1 @@
+"""Examples of detectors of your own (docs/guides/your-detector.md)."""

@@ -1,0 +1,167 @@
+"""Recorded signals: every step of every trial, as a user's detector reads them.
+
+``ftc-mc run --record signals`` (``campaign.record``) keeps each trial's per-step
+history (the kernels' history mode, :func:`ftc_mc.sim.lanes.new_record` with
+``history=True``, the one a scenario uses) and writes it, chunk by chunk, to
+``signals/<transition>-<first trial id>.parquet`` beside ``trials.parquet``: one
+row per trial, design and step, keyed by ``(transition, variant, trial_id)`` as
+``trials.parquet`` is.  The columns (:func:`signal_columns`) are documented in
+``docs/reference/outputs.md``.
+
+A row ``step = k`` holds what the loop of its design saw and did on the step
+that reached sample ``k`` (time ``k dt``): the measurements ``z_k``, the
+commands applied during the step, the truth's fault parameters and mode during
+it, the excitation, the filter's normalised innovations, the decision
+statistics Table 1 (or the GLR) compared at ``k``, the block reset at ``k``, and
+the belief after the last reconfiguration period ending at or before ``k``.
+Rows stop at the last step after which the trial was still valid (its
+``stop_s``, ``trials.parquet``): a trial that left the envelope has fewer rows.
+
+Measured signals, commands, innovations, fault values and the belief are
+``float32``: their noise (measurement noise at least 1e-3 of their scale, the
+innovations unit-variance) is far above float32's 6e-8 relative rounding.  The
+decision statistics ``r_q, r_nx, r_nz`` stay ``float64``, so that Table 1
+re-run offline on them compares with the same thresholds bit for bit
+(:func:`ftc_mc.detectors.table1_offline`).
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from ..conventions import LONGITUDINAL as LAY
+from ..conventions import MODE_NAMES
+from ..core.longitudinal.workspace import EXC_3211, EXC_DOUBLET
+
+FOLDER = "signals"
+"""The folder of a run's recorded signals, beside ``trials.parquet``."""
+
+KEYS = ("transition", "variant", "trial_id", "step")
+"""The key columns of a signals row."""
+
+
+def innovation_names() -> tuple:
+    """``innov_q, innov_nx, innov_nz``: one per Table 1 residual channel."""
+    return tuple("innov_" + r.partition("_")[2] for r in LAY.residuals)
+
+
+def signal_columns(n_z: int = LAY.n_z) -> tuple:
+    """Names of the signal columns of a signals row (after :data:`KEYS`), in file
+    order (``docs/reference/outputs.md``)."""
+    outs = LAY.outputs if n_z == LAY.n_z else tuple(str(i) for i in range(n_z))
+    return (tuple(f"z_{o}" for o in outs) + tuple(f"u_{i}" for i in LAY.inputs)
+            + ("mode",) + tuple(f"b0_{a}" for a in LAY.actuators)
+            + tuple(f"b1_{a}" for a in LAY.actuators) + ("exc_doublet", "exc_3211")
+            + innovation_names() + tuple(LAY.residuals) + ("reset",)
+            + tuple(f"belief_{m}" for m in MODE_NAMES))
+
+
+def _rows(a: np.ndarray, keep: np.ndarray) -> np.ndarray:
+    """``a`` laid out (steps, [channels,] lanes) as rows (lane-major, then step) of
+    the kept (lane, step) pairs: shape (rows,) or (rows, channels)."""
+    if a.ndim == 2:
+        return a.T[keep]
+    return np.moveaxis(a, 2, 0)[keep]
+
+
+def signals_frame(tr_name: str, variant: str, trial_ids, inp, rec, k_fault: int,
+                  every: int) -> pd.DataFrame:
+    """The signals rows of one design's record of a chunk.
+
+    Parameters
+    ----------
+    tr_name, variant : str
+        Transition (or chunk name) and design.
+    trial_ids : ndarray of int, shape (L,)
+    inp : TrialInputs
+        The chunk's inputs (``k_switch``, ``b0``, ``b1``, ``mode_pre``, ``mode_post``).
+    rec : TrialRecord
+        Recorded with its history (``history=True``).
+    k_fault : int
+        Step of the switch to the final mode.
+    every : int
+        Steps per reconfiguration period.
+
+    Returns
+    -------
+    DataFrame
+        :data:`KEYS` then :func:`signal_columns`, rows by trial then step.
+    """
+    n, L = rec.hist_block.shape
+    kn = np.arange(1, n + 1)
+    stop = np.asarray(rec.stop_k)
+    keep = (stop[:, None] < 0) | (kn[None, :] < stop[:, None])  # (L, n)
+    lane, k = np.nonzero(keep)
+    f4 = np.float32
+    same = np.zeros(len(lane), dtype=np.int8)
+    cols = {"transition": pd.Categorical.from_codes(same, [tr_name]),
+            "variant": pd.Categorical.from_codes(same, [variant]),
+            "trial_id": np.asarray(trial_ids, dtype=np.int64)[lane],
+            "step": (k + 1).astype(np.int32)}
+    names = signal_columns(rec.hist_z.shape[1])
+    z = _rows(rec.hist_z, keep).astype(f4)
+    u = _rows(rec.hist_u, keep).astype(f4)
+    i = 0
+    for j in range(z.shape[1]):
+        cols[names[i]] = z[:, j]
+        i += 1
+    for j in range(u.shape[1]):
+        cols[names[i]] = u[:, j]
+        i += 1
+    # the truth during the step k -> k+1 (row step = k+1)
+    mode = np.where(k >= k_fault, np.asarray(inp.mode_post)[lane], np.asarray(inp.mode_pre)[lane])
+    cols["mode"] = pd.Categorical.from_codes(mode, categories=list(MODE_NAMES))
+    e = np.searchsorted(np.asarray(inp.k_switch), k, side="right") - 1
+    for name, arr in (("b0", inp.b0), ("b1", inp.b1)):
+        for a, act in enumerate(LAY.actuators):
+            cols[f"{name}_{act}"] = np.asarray(arr)[e, a, lane].astype(f4)
+    exc = _rows(rec.hist_exc, keep)
+    cols["exc_doublet"] = exc[:, EXC_DOUBLET].astype(f4)
+    cols["exc_3211"] = exc[:, EXC_3211].astype(f4)
+    innov = _rows(rec.hist_innov, keep).astype(f4)
+    for j, nm in enumerate(innovation_names()):
+        cols[nm] = innov[:, j]
+    res = _rows(rec.hist_res, keep)
+    for j, nm in enumerate(LAY.residuals):
+        cols[nm] = np.ascontiguousarray(res[:, j], dtype=np.float64)
+    cols["reset"] = _rows(rec.hist_block, keep).astype(np.int8)
+    # the belief after the last period ending at or before the row's step
+    p = (k + 1) // every - 1
+    init = np.zeros((len(MODE_NAMES), L))
+    init[np.asarray(inp.mode_pre), np.arange(L)] = 1.0
+    bel = np.concatenate([init[None], rec.belief], axis=0)  # row 0: before any update
+    for m, nm in enumerate(MODE_NAMES):
+        cols[f"belief_{nm}"] = bel[p + 1, m, lane].astype(f4)
+    return pd.DataFrame(cols)
+
+
+def chunk_file(out_dir, name: str, start: int) -> Path:
+    """The signals file of the chunk ``(name, start)`` in a run directory."""
+    return Path(out_dir) / FOLDER / f"{name}-{start:09d}.parquet"
+
+
+def move_signals(store, units, out_dir) -> None:
+    """Move every chunk's signals from the chunk store to ``out_dir/signals/``
+    (a rename each: nothing is read or copied; idempotent, so a run resumed
+    after a partial move finishes it)."""
+    folder = Path(out_dir) / FOLDER
+    folder.mkdir(exist_ok=True)
+    for name, ids in units:
+        start = int(ids[0])
+        src = store._path(name, start, "signals")
+        if src.exists():
+            os.replace(src, chunk_file(out_dir, name, start))
+
+
+def signal_files(run_dir) -> list:
+    """The signals files of a run directory, in name order (empty when the run
+    was recorded without signals)."""
+    folder = Path(run_dir) / FOLDER
+    if not folder.is_dir():
+        return []
+    return sorted(p for p in folder.iterdir()
+                  if p.suffix == ".parquet" and not p.name.startswith("."))
