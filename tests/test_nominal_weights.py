@@ -76,6 +76,7 @@ def test_config_selects_the_weights(plant):
     Q, R = controller_weights(air, plant.trim.gamma0)
     assert np.array_equal(Q, bryson_q_lqr(2.0, 3.0, 10.0, 30.0))
     assert np.array_equal(R, bryson_r_lqr(0.5, 0.1))
+    assert np.array_equal(controller_weights(Config.model_validate({"controller": {"weights": "airspeed"}}).controller, 0.0)[1], bryson_r_lqr(1.0, 0.1))
 
 
 @pytest.mark.parametrize("text, field", [
@@ -130,3 +131,22 @@ def test_c1_and_terminal_costs_use_the_same_weights():
 def test_shipped_robust_moderate_defaults_to_the_paper_weights():
     cfg = load_any(Path(__file__).resolve().parents[1] / "configs" / "robust_moderate.yaml")
     assert cfg.controller.weights == "paper"
+
+
+def test_the_airspeed_weights_fly_moderate_turbulence():
+    """Flights 0-23 of the endurance seed 777 with the shipped robust design:
+    the paper's c0 leaves the envelope below 12 m/s on flight 20, the airspeed
+    weights keep all 24 inside (docs/findings/turbulence-envelope.md)."""
+    from ftc_mc import run_endurance
+
+    base = load_any(Path(__file__).resolve().parents[1] / "configs" / "robust_moderate.yaml")
+    data = base.model_dump()
+    data["controller"]["weights"] = "airspeed"
+    air = Config.model_validate(data)
+    hours = 24 * 50.0 / 3600
+    kw = dict(seed=777, design=("robust",), jobs=1, progress=False)
+    f_paper = run_endurance(base, hours, **kw).flights.set_index("flight_id")
+    f_air = run_endurance(air, hours, **kw).flights.set_index("flight_id")
+    assert len(f_air) == len(f_paper) == 24
+    assert f_paper.loc[20, "status"] == "airspeed_out_of_bounds"
+    assert (f_air.status == "ok").all() and (f_air.flown_s == 50.0).all()
