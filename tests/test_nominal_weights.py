@@ -76,12 +76,14 @@ def test_config_selects_the_weights(plant):
     Q, R = controller_weights(air, plant.trim.gamma0)
     assert np.array_equal(Q, bryson_q_lqr(2.0, 3.0, 10.0, 30.0))
     assert np.array_equal(R, bryson_r_lqr(0.5, 0.1))
-    assert np.array_equal(controller_weights(Config.model_validate({"controller": {"weights": "airspeed"}}).controller, 0.0)[1], bryson_r_lqr(1.0, 0.1))
+    default = Config.model_validate({"controller": {"weights": "airspeed"}}).controller
+    assert np.array_equal(controller_weights(default, 0.0)[1], bryson_r_lqr(3.0, 0.1))
 
 
 @pytest.mark.parametrize("text, field", [
     ("controller:\n  weights: bryson\n", "controller.weights"),
-    ("controller:\n  weights: airspeed\n  airspeed_scale_mps: 0\n", "controller.airspeed_scale_mps"),
+    ("controller:\n  weights: airspeed\n  airspeed_scale_mps: 0\n",
+     "controller.airspeed_scale_mps"),
     ("controller:\n  height_scale_m: -1\n", "controller.height_scale_m"),
     ("controller:\n  elevon_scale_rad: .nan\n", "controller.elevon_scale_rad"),
     ("controller:\n  throttle_scale: yes\n", "controller.throttle_scale"),

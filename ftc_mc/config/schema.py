@@ -292,7 +292,7 @@ class ControllerConfig(_Strict):
     """airspeed weights: largest accepted pitch deviation [deg]."""
     pitch_rate_scale_dps: Pos = 30.0
     """airspeed weights: largest accepted pitch rate [deg/s]."""
-    throttle_scale: Pos = 1.0
+    throttle_scale: Pos = 3.0
     """airspeed weights: largest accepted throttle command deviation [-]."""
     elevon_scale_rad: Pos = 0.1
     """airspeed weights: largest accepted elevon command deviation [rad]."""

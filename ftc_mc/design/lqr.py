@@ -61,7 +61,7 @@ def bryson_q_lqr(airspeed_mps: float = 2.0, height_m: float = 1.0, pitch_deg: fl
     return np.diag(q)
 
 
-def bryson_r_lqr(throttle: float = 1.0, elevon_rad: float = 0.1) -> np.ndarray:
+def bryson_r_lqr(throttle: float = 3.0, elevon_rad: float = 0.1) -> np.ndarray:
     """Diagonal ``R_lqr`` by Bryson's rule: ``diag(1/throttle^2, 1/elevon^2, 1/elevon^2)``
     (commands throttle, left and right elevon)."""
     return np.diag([1.0 / throttle ** 2, 1.0 / elevon_rad ** 2, 1.0 / elevon_rad ** 2])
