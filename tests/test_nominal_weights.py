@@ -87,6 +87,7 @@ def test_config_selects_the_weights(plant):
     ("controller:\n  height_scale_m: -1\n", "controller.height_scale_m"),
     ("controller:\n  elevon_scale_rad: .nan\n", "controller.elevon_scale_rad"),
     ("controller:\n  throttle_scale: yes\n", "controller.throttle_scale"),
+    ("controller:\n  weights: airspeed\n  coupling: coupled\n", "coupling: separate only"),
 ])
 def test_bad_weights_name_the_field(text, field):
     with pytest.raises(UserError) as exc:

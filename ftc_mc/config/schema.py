@@ -297,6 +297,13 @@ class ControllerConfig(_Strict):
     elevon_scale_rad: Pos = 0.1
     """airspeed weights: largest accepted elevon command deviation [rad]."""
 
+    @model_validator(mode="after")
+    def _weights_and_coupling(self):
+        if self.weights == "airspeed" and self.coupling == "coupled":
+            raise ValueError("weights: airspeed flies with coupling: separate only (the coupled "
+                             "6-DOF LQR sums the paper's weights with the lateral loop's)")
+        return self
+
     @model_serializer(mode="wrap")
     def _drop_added_defaults(self, handler, info: SerializationInfo):
         """With the paper's weights, leave the weight fields out of a dump while at
