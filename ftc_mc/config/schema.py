@@ -20,7 +20,7 @@ import re
 from typing import Annotated, Literal
 
 from pydantic import (AfterValidator, BaseModel, BeforeValidator, ConfigDict, Field,
-                      field_validator, model_validator)
+                      SerializationInfo, field_validator, model_serializer, model_validator)
 
 from ..conventions import (ACTUATOR_NAMES, BIASED_OUTPUTS, EXCITATION_POLICIES, OUTPUT_NAMES,
                            PLANT_KINDS, S3211_UNITS, SENSOR_FAULT_KINDS, SENSOR_PREFIX,
@@ -282,6 +282,46 @@ class ControllerConfig(_Strict):
     """Simulated rest of the mission for the terminal costs J^N (eq. 46) [s] (100: the paper's mission)."""
     coupling: Literal["separate", "coupled"] = "separate"
     """6-DOF c0 and c1: separate (the paper's laws and a lateral LQR) or coupled (6-DOF LQRs) (docs/reference/config.md#controllers)."""
+    weights: Literal["paper", "airspeed"] = "paper"
+    """LQR weights of c0-c2 and J^N: paper (section 5.1) or airspeed (Bryson's rule on the scales below) (docs/reference/config.md#controllers)."""
+    airspeed_scale_mps: Pos = 2.0
+    """airspeed weights: largest accepted deviation of the body velocity u, the airspeed's proxy [m/s]."""
+    height_scale_m: Pos = 1.0
+    """airspeed weights: largest accepted height deviation (the state z) [m]."""
+    pitch_scale_deg: Pos = 10.0
+    """airspeed weights: largest accepted pitch deviation [deg]."""
+    pitch_rate_scale_dps: Pos = 30.0
+    """airspeed weights: largest accepted pitch rate [deg/s]."""
+    throttle_scale: Pos = 3.0
+    """airspeed weights: largest accepted throttle command deviation [-]."""
+    elevon_scale_rad: Pos = 0.1
+    """airspeed weights: largest accepted elevon command deviation [rad]."""
+
+    @model_validator(mode="after")
+    def _weights_and_coupling(self):
+        if self.weights == "airspeed" and self.coupling == "coupled":
+            raise ValueError("weights: airspeed flies with coupling: separate only (the coupled "
+                             "6-DOF LQR sums the paper's weights with the lateral loop's)")
+        return self
+
+    @model_serializer(mode="wrap")
+    def _drop_added_defaults(self, handler, info: SerializationInfo):
+        """With the paper's weights, leave the weight fields out of a dump while at
+        their defaults, so configs and result folders recorded before they existed
+        resolve unchanged; ``context={"full": True}`` keeps them (``ftc-mc config
+        show``, the config reference)."""
+        data = handler(self)
+        if (info.context or {}).get("full") or self.weights != "paper":
+            return data
+        for name in WEIGHT_FIELDS:
+            if name in data and getattr(self, name) == type(self).model_fields[name].default:
+                del data[name]
+        return data
+
+
+WEIGHT_FIELDS = ("weights", "airspeed_scale_mps", "height_scale_m", "pitch_scale_deg",
+                 "pitch_rate_scale_dps", "throttle_scale", "elevon_scale_rad")
+"""``ControllerConfig`` fields left out of a dump at their defaults."""
 
 
 class ExcitationConfig(_Strict):

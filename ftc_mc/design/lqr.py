@@ -32,6 +32,56 @@ def paper_q_lqr(gamma0: float, n: int = LONGITUDINAL.n_x) -> np.ndarray:
     return np.diag(q)
 
 
+def bryson_q_lqr(airspeed_mps: float = 2.0, height_m: float = 1.0, pitch_deg: float = 10.0,
+                 pitch_rate_dps: float = 30.0, n: int = LONGITUDINAL.n_x) -> np.ndarray:
+    """Diagonal ``Q_lqr`` by Bryson's rule, for flight in turbulence.
+
+    Each weight is one over the square of the largest deviation accepted: on
+    the body velocity ``u`` (the airspeed's proxy in the linear model; ``u`` is
+    inertial, so the loop holds the ground-referenced speed, not the airspeed),
+    the height ``z``, the pitch ``theta`` and the pitch rate ``q``; no weight on
+    the along-track position ``x``.  The paper's :func:`paper_q_lqr` holds a
+    point moving at the trim ground speed and pays a tailwind back in airspeed
+    (docs/findings/turbulence-envelope.md).
+
+    Parameters
+    ----------
+    airspeed_mps, height_m : float
+        Largest accepted deviations of ``u`` [m/s] and ``z`` [m].
+    pitch_deg, pitch_rate_dps : float
+        Largest accepted pitch [deg] and pitch rate [deg/s] deviations.
+    n : int
+        State dimension (9).
+    """
+    q = np.zeros(n)
+    q[LONGITUDINAL.state("u")] = 1.0 / airspeed_mps ** 2
+    q[LONGITUDINAL.state("z")] = 1.0 / height_m ** 2
+    q[LONGITUDINAL.state("theta")] = 1.0 / math.radians(pitch_deg) ** 2
+    q[LONGITUDINAL.state("q")] = 1.0 / math.radians(pitch_rate_dps) ** 2
+    return np.diag(q)
+
+
+def bryson_r_lqr(throttle: float = 3.0, elevon_rad: float = 0.1) -> np.ndarray:
+    """Diagonal ``R_lqr`` by Bryson's rule: ``diag(1/throttle^2, 1/elevon^2, 1/elevon^2)``
+    (commands throttle, left and right elevon)."""
+    return np.diag([1.0 / throttle ** 2, 1.0 / elevon_rad ** 2, 1.0 / elevon_rad ** 2])
+
+
+def controller_weights(c, gamma0: float):
+    """``(Q_lqr, R_lqr)`` of a validated ``controller`` config section.
+
+    ``weights: paper``: :func:`paper_q_lqr` and ``r_lqr I_3`` (section 5.1);
+    ``weights: airspeed``: :func:`bryson_q_lqr` and :func:`bryson_r_lqr` on the
+    section's scales.  c0's gain, Theorem 4.1's tables (c1), the terminal costs
+    and the selection's prediction all use these weights.
+    """
+    if c.weights == "airspeed":
+        return (bryson_q_lqr(c.airspeed_scale_mps, c.height_scale_m, c.pitch_scale_deg,
+                             c.pitch_rate_scale_dps),
+                bryson_r_lqr(c.throttle_scale, c.elevon_scale_rad))
+    return paper_q_lqr(gamma0), c.r_lqr * np.eye(3)
+
+
 def discounted_lqr(A, B, Q, R, alpha):
     """Gain and cost matrix of the discounted LQR.
 

@@ -28,7 +28,7 @@ from ..core.shared.interp import EngineTables
 from ..core.longitudinal.settings import (Belief, Controller, Detection, Excitation, FilterModel,
                                           Flight, Reconfig, Scheme, Timing, Track, TruthPlant,
                                           Validity)
-from ..design.lqr import discounted_lqr, paper_q_lqr
+from ..design.lqr import controller_weights, discounted_lqr
 from ..design.terminal import terminal_costs
 from ..model.linear import LinearPlant
 from ..model.source import load_plant
@@ -232,8 +232,7 @@ def build_setup(cfg: Config | ScenarioConfig) -> SimSetup:
     designs = build_designs(runs, cfg.designs, plant, cfg.estimator, cfg.plant.altitude_m)
     bs = belief_settings(plant, est)
     c = cfg.controller
-    Q = paper_q_lqr(plant.trim.gamma0)
-    R = c.r_lqr * np.eye(3)
+    Q, R = controller_weights(c, plant.trim.gamma0)
     K, _ = discounted_lqr(plant.A, plant.B, Q, R, c.discount)
     ctl = Controller(K=np.ascontiguousarray(K), lo_dev=plant.u_lower - plant.u0,
                      hi_dev=plant.u_upper - plant.u0)
