@@ -385,8 +385,8 @@ def _write(folder: Path, rows, summary, endurance: bool, meta: dict) -> None:
     write_parquet(summary, folder / ("endurance.parquet" if endurance else "summary.parquet"),
                   meta)
     if endurance:
-        from ..report.endurance import endurance_table
-        md = endurance_table(summary)
+        from .endurance import endurance_markdown
+        md = endurance_markdown(summary)
     else:
         md = markdown_table(summary)
     write_text(folder / "summary.md", f"# detector {meta['detector']}\n\n{md}\n")
