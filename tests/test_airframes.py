@@ -589,8 +589,8 @@ def test_trim_refuses_what_the_airframe_cannot_fly(af, V0, gamma, alpha_range, w
     with pytest.raises(UserError) as exc:
         trim(af, V0, gamma, alpha_range)
     text = str(exc.value)
-    assert text.startswith(f"model.airspeed_mps={V0:g}, model.gamma_deg={gamma:g}: "
-                           "the airframe cannot fly this condition:")
+    assert text.startswith(f"model.airspeed_mps: the airframe cannot fly this condition "
+                           f"({V0:g} m/s, model.gamma_deg {gamma:g}):")
     assert what in text and "\n" not in text
 
 

@@ -124,8 +124,8 @@ def trim(airframe: Airframe = X8, V0: float = 20.0, gamma0_deg: float = -3.0,
     # flag is not used, since with tol=1e-14 it reports "not making good
     # progress" at residuals of 1e-15 for some airframes.
     res = np.max(np.abs(residual(sol.x))) if np.all(np.isfinite(sol.x)) else math.inf
-    where = (f"model.airspeed_mps={V0:g}, model.gamma_deg={gamma0_deg:g}: "
-             "the airframe cannot fly this condition:")
+    where = (f"model.airspeed_mps: the airframe cannot fly this condition ({V0:g} m/s, "
+             f"model.gamma_deg {gamma0_deg:g}):")
     if not (math.isfinite(res) and res <= 1e-9):
         raise UserError(f"{where} no equilibrium found (residual {res:.2g}; "
                         f"solver: {' '.join(sol.message.split())})")

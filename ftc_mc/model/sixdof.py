@@ -238,8 +238,8 @@ def trim6(airframe: Airframe, V0: float = 20.0, gamma0_deg: float = -3.0,
         return np.concatenate((dx[rows], [y[i_gamma] - gamma0, dx[i_east]]))
 
     guess = np.array([0.02, 0.0, 0.0, 0.02 + gamma0, 0.0, 0.1, 0.05, 0.0])
-    where_c = (f"model.airspeed_mps={V0:g}, model.gamma_deg={gamma0_deg:g}: "
-               "the airframe cannot fly this condition (6-DOF):")
+    where_c = (f"model.airspeed_mps: the airframe cannot fly this condition ({V0:g} m/s, "
+               f"model.gamma_deg {gamma0_deg:g}, 6-DOF):")
     if locked is None:
         sol = scipy.optimize.root(residual, guess, tol=1e-14)
         v = sol.x
