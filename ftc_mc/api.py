@@ -232,6 +232,27 @@ def _check_out(out, resume: bool) -> Path | None:
     return Path(out)
 
 
+def _current(config: dict) -> dict:
+    """A configuration recorded in a result folder, as the current schema resolves
+    it: fields added since it was recorded take their defaults, so an identity
+    check compares meanings, not the schema's age.  Unreadable: returned as is
+    (it then differs)."""
+    from .config.schema import Config
+
+    try:
+        return Config.model_validate(config).model_dump(mode="json")
+    except Exception:  # noqa: BLE001 -- not ours: the comparison fails
+        return config
+
+
+def _current_identity(identity):
+    """:func:`_current` on the ``config`` an identity holds (a run's identity is
+    its configuration, a sweep's or an endurance run's a mapping with one)."""
+    if isinstance(identity, dict) and isinstance(identity.get("config"), dict):
+        return {**identity, "config": _current(identity["config"])}
+    return _current(identity) if isinstance(identity, dict) else identity
+
+
 def _open_chunks(out_dir: Path, identity_json: str, overwrite: bool, resume: bool):
     """The chunk store of a run or sweep directory, new or resumed."""
     from .io.chunks import ChunkStore
@@ -243,7 +264,7 @@ def _open_chunks(out_dir: Path, identity_json: str, overwrite: bool, resume: boo
         shutil.rmtree(out_dir / "signals", ignore_errors=True)  # an older run's recording
     elif resume and not store.exists():
         raise UserError(f"--resume: {out_dir} holds no interrupted run")
-    store.open(resume)
+    store.open(resume, resolve=_current_identity)
     return store
 
 
@@ -278,7 +299,8 @@ def _finished(out_dir: Path, kind: str, files, identity: dict) -> bool:
         return False
     if meta.get("kind") != kind:
         return False
-    if any(meta.get(k) != v for k, v in identity.items()):
+    recorded = _current_identity({k: meta.get(k) for k in identity})
+    if any(recorded[k] != v for k, v in identity.items()):
         raise UserError(f"--resume: {out_dir} holds a finished {kind} of another "
                         "configuration (or other options)")
     ChunkStore(out_dir, "").remove()  # left if the process died just after the last file

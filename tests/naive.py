@@ -725,17 +725,17 @@ def commands_ref(scheme, st, k):
             U = controller_command_ref(int(st.cur[l]), X, ctl.K, scheme.engine, fm.u0)
         sd, A_d = 0.0, 0.0
         if running_ref(k, st.d_start[l], d_len):
-            sd = doublet_ref(k - st.d_start[l], exc.doublet_half, exc.doublet_amp)
-            A_d = exc.doublet_amp
+            sd = doublet_ref(k - st.d_start[l], exc.doublet_half, st.d_amp[l])
+            A_d = st.d_amp[l]
         s, A_s = 0.0, 0.0
         if running_ref(k, st.s_start[l], s_len):
-            s = signal_3211_ref(k - st.s_start[l], exc.s3211_unit, exc.s3211_amp)
+            s = signal_3211_ref(k - st.s_start[l], exc.s3211_unit, st.s_amp[l])
             if st.cur[l] == C2:  # eq. 23, with the design's floor
                 g = 1.0 - X[B1_L]
                 if exc.s3211_floor > 0.0:
                     g = max(g, exc.s3211_floor)
                 s = g * s
-            A_s = exc.s3211_amp
+            A_s = st.s_amp[l]
         sig, amp = (sd, s, -s), (A_d, A_s, A_s)
         for i in range(3):
             u[i, l] = saturate_ref(U[i], sig[i], amp[i], ctl.lo_dev[i], ctl.hi_dev[i])
@@ -891,8 +891,10 @@ def check_validity_ref(validity, st, kn, va, alpha, status, stop_k):
 
 def handle_resets_ref(exc, st, kn, block, res, reset_k, reset_block, reset_res, n_resets):
     """Reset records and excitation requests (sections 3.2.3, 4.1.1).  Returns a
-    dict of the updated ``d_start``, ``s_start``, ``recheck`` and record arrays."""
+    dict of the updated ``d_start``, ``s_start``, ``d_amp``, ``s_amp``, ``recheck``
+    and record arrays."""
     out = dict(d_start=st.d_start.copy(), s_start=st.s_start.copy(),
+               d_amp=st.d_amp.copy(), s_amp=st.s_amp.copy(),
                recheck=st.recheck.copy(), reset_k=reset_k.copy(),
                reset_block=reset_block.copy(), reset_res=reset_res.copy(),
                n_resets=n_resets.copy())
@@ -907,17 +909,17 @@ def handle_resets_ref(exc, st, kn, block, res, reset_k, reset_block, reset_res, 
             out["n_resets"][l] = m + 1
             if block[l] == RESET_THRUST:
                 if not running_ref(kn, out["d_start"][l], d_len):
-                    out["d_start"][l] = kn
+                    out["d_start"][l], out["d_amp"][l] = kn, exc.doublet_amp
                 out["recheck"][l] = kn + exc.resend_delay
             elif not running_ref(kn, out["s_start"][l], s_len):
-                out["s_start"][l] = kn
+                out["s_start"][l], out["s_amp"][l] = kn, exc.s3211_amp
         if out["recheck"][l] == kn:
             out["recheck"][l] = -1
             if st.xa[B1_T, l] > exc.resend_b1 and not running_ref(kn, out["d_start"][l],
                                                                   d_len):
-                out["d_start"][l] = kn
+                out["d_start"][l], out["d_amp"][l] = kn, exc.doublet_amp
     if exc.policy != POLICY_NONE:
-        policy_signals_ref(exc, st, kn, res, out["d_start"], out["s_start"])
+        policy_signals_ref(exc, st, kn, res, out)
     return out
 
 
@@ -925,36 +927,43 @@ POLICY_NONE, POLICY_PERIODIC, POLICY_AMBIGUOUS = 0, 1, 2
 """``Excitation.policy`` codes."""
 
 
-def policy_signals_ref(exc, st, kn, res, d_start, s_start):
-    """The design's excitation policy at step ``kn``, in place on ``d_start`` and
-    ``s_start`` (those after the reset requests of the step).
+def policy_signals_ref(exc, st, kn, res, out):
+    """The design's excitation policy at step ``kn``, in place on ``out``'s
+    ``d_start``, ``s_start``, ``d_amp`` and ``s_amp`` (those after the reset
+    requests of the step), each signal at the policy's amplitude.
 
-    On a live lane with no signal on: periodic, the doublet when ``kn`` is the
+    On a live lane with no signal on, whose belief gives no fault mode
+    (every mode but the first) ``pause_belief`` or more: periodic, the doublet when ``kn`` is the
     phase plus whole periods, the 3211 when it is half a period (rounded down)
     after such a step; ambiguous, when the last start of either signal lies at
     least a period back and the most probable mode is below ``belief_max`` or
     ``r_q`` or ``r_nx`` is at least ``suspect``: the 3211 after a doublet, else
     the doublet."""
     d_len, s_len = 2 * exc.doublet_half, 7 * exc.s3211_unit
+    d_start, s_start = out["d_start"], out["s_start"]
+
+    def send(signal, l):
+        if signal == "d":
+            d_start[l], out["d_amp"][l] = kn, exc.policy_doublet_amp
+        else:
+            s_start[l], out["s_amp"][l] = kn, exc.policy_s3211_amp
+
     for l in range(len(d_start)):
         on = running_ref(kn, d_start[l], d_len) or running_ref(kn, s_start[l], s_len)
-        if not st.alive[l] or on:
+        if not st.alive[l] or on or st.belief[1:, l].max() >= exc.pause_belief:
             continue
         if exc.policy == POLICY_PERIODIC:
             since = kn - exc.phase
             if since % exc.period == 0:
-                d_start[l] = kn
+                send("d", l)
             elif (since - exc.period // 2) % exc.period == 0:
-                s_start[l] = kn
+                send("s", l)
         elif exc.policy == POLICY_AMBIGUOUS:
             last = max(d_start[l], s_start[l])
             unsure = st.belief[:, l].max() < exc.belief_max
             high = res[0, l] >= exc.suspect or res[1, l] >= exc.suspect
             if kn - last >= exc.period and (unsure or high):
-                if d_start[l] > s_start[l]:
-                    s_start[l] = kn
-                else:
-                    d_start[l] = kn
+                send("s" if d_start[l] > s_start[l] else "d", l)
 
 
 def record_cost_ref(track, k_switch, kn, x, u, alive, cost, marks):
@@ -1049,8 +1058,8 @@ def advance_ref(scheme, flight, inp, rec, st, k0, k1):
         st.alive[:], rec.status[:], rec.stop_k[:] = alive, status, stop_k
         out = handle_resets_ref(scheme.excitation, st, kn, block, res, rec.reset_k,
                                 rec.reset_block, rec.reset_res, rec.n_resets)
-        st.d_start[:], st.s_start[:], st.recheck[:] = (out["d_start"], out["s_start"],
-                                                       out["recheck"])
+        for f in ("d_start", "s_start", "d_amp", "s_amp", "recheck"):
+            getattr(st, f)[:] = out[f]
         for f in ("reset_k", "reset_block", "reset_res", "n_resets"):
             getattr(rec, f)[:] = out[f]
         hist = record_step_ref(k, st, u, res, exc, tr["wind"], block,

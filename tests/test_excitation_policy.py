@@ -58,6 +58,10 @@ def config(transitions=("elevon_loss",), trials=8, **over):
     ({"doublet_amplitude": 0.0}, "designs.x.doublet_amplitude"),
     ({"doublet_amplitude": 0.6}, "designs.x.doublet_amplitude"),
     ({"s3211_amplitude_rad": 0.4}, "designs.x.s3211_amplitude_rad"),
+    ({"policy_s3211_amplitude_rad": 0.1}, "designs.x.policy_s3211_amplitude_rad: only with"),
+    ({"excitation_pause_belief": 0.5}, "designs.x.excitation_pause_belief: only with"),
+    ({**PERIODIC, "excitation_pause_belief": 1.0}, "designs.x.excitation_pause_belief"),
+    ({**PERIODIC, "policy_doublet_amplitude": 0.7}, "designs.x.policy_doublet_amplitude"),
     ({"s3211_amplitude_rad": float("nan")}, "designs.x.s3211_amplitude_rad"),
 ])
 def test_bad_policies_are_one_line(design, needle):
@@ -118,7 +122,7 @@ def test_a_design_s_own_amplitudes_reach_the_kernels_and_fly():
     per, same_x, big_x, sw = (setup.scheme(n).excitation for n in ("per", "same", "big",
                                                                    "swapped"))
     assert per._asdict() == same_x._asdict()
-    assert big_x._asdict() == {**per._asdict(), "s3211_amp": 0.15}
+    assert big_x._asdict() == {**per._asdict(), "s3211_amp": 0.15, "policy_s3211_amp": 0.15}
     assert (sw.doublet_amp, sw.s3211_amp) == (0.1, 0.05)
     assert [type(v) for v in big_x] == [type(v) for v in sw]
     assert len({setup.designs[n].key for n in ("per", "same", "big")}) == 3
@@ -129,6 +133,33 @@ def test_a_design_s_own_amplitudes_reach_the_kernels_and_fly():
                                       err_msg=f)
     left = COST_U2 + LONGITUDINAL.inputs.index("elevon_left")
     assert recs["big"].cost[left].sum() > recs["per"].cost[left].sum()
+
+
+def test_the_policy_s_own_amplitudes_and_its_pause_reach_the_kernels_and_fly():
+    """``policy_*_amplitude`` set the policy's signals only (a reset's stay the
+    design's); ``excitation_pause_belief`` reaches the kernels as a float (inf
+    when unset). On the elevon-unlock row the belief starts on the locked
+    elevon, so a design paused at 0.5 sends no periodic 3211 while it holds:
+    less elevon energy than the same policy unpaused, as much as one with
+    policy amplitudes of the section's values."""
+    small = {**PERIODIC, "policy_s3211_amplitude_rad": 0.2}
+    paused = {**small, "excitation_pause_belief": 0.5}
+    cfg = config(transitions=("elevon_unlock",),
+                 designs={"per": PERIODIC, "small": small, "paused": paused},
+                 campaign={"transitions": ["elevon_unlock"], "trials": 8, "chunk_size": 8,
+                           "signature": "swapped", "designs": ["per", "small", "paused"]})
+    spec = chunk_spec(cfg)
+    setup = spec.setup
+    per, sm, pa = (setup.scheme(n).excitation for n in ("per", "small", "paused"))
+    assert (sm.s3211_amp, sm.policy_s3211_amp, sm.doublet_amp, sm.policy_doublet_amp) == (
+        0.05, 0.2, 0.1, 0.1)
+    assert per.pause_belief == sm.pause_belief == math.inf and pa.pause_belief == 0.5
+    assert pa._asdict() == {**sm._asdict(), "pause_belief": 0.5}
+    inp, _ = trial_inputs(spec, "elevon_unlock", np.arange(8))
+    right = COST_U2 + LONGITUDINAL.inputs.index("elevon_right")
+    energy = {n: run_alone(setup, n, setup.det[n], inp, 64).cost[right].sum()
+              for n in ("per", "small", "paused")}
+    assert energy["small"] > energy["per"] > energy["paused"], energy
 
 
 def test_shared_start_with_a_policy_equals_running_alone():

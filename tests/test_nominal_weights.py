@@ -2,21 +2,22 @@
 
 The gain is the discounted LQR of Bryson's diagonal weights (checked against
 scipy's and python-control's Riccati solvers on the scaled pair), the config
-field is validated and left out of a dump at the paper's default (shipped
-configs resolve unchanged), c1's tables and the terminal costs are built from
+field is validated (a result folder recorded before it existed still resumes),
+a design may set its own, c1's tables and the terminal costs are built from
 the same weights, and the nonlinear X8 flies moderate turbulence with them.
 """
 
+import json
 import math
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 import pytest
 import scipy.linalg
 import yaml
 
 from ftc_mc.config import Config, load_any, parse_config
-from ftc_mc.config.schema import WEIGHT_FIELDS
 from ftc_mc.conventions import LONGITUDINAL
 from ftc_mc.design.lqr import (bryson_q_lqr, bryson_r_lqr, controller_weights, discounted_lqr,
                                paper_q_lqr)
@@ -88,6 +89,12 @@ def test_config_selects_the_weights(plant):
     ("controller:\n  elevon_scale_rad: .nan\n", "controller.elevon_scale_rad"),
     ("controller:\n  throttle_scale: yes\n", "controller.throttle_scale"),
     ("controller:\n  weights: airspeed\n  coupling: coupled\n", "coupling: separate only"),
+    ("designs:\n  a: {weights: bryson}\n", "designs.a.weights"),
+    ("plant: {dof: 6}\ncontroller: {coupling: coupled}\ncampaign: {designs: [a]}\n"
+     "designs:\n  a: {weights: airspeed}\n", "designs.a.weights: airspeed flies with"),
+    ("plant: {dof: 6}\ncampaign: {designs: [a]}\n"
+     "designs:\n  a: {weights: airspeed, controller: lock_turn_selected}\n",
+     "designs.a.weights: a lock_turn_selected design"),
 ])
 def test_bad_weights_name_the_field(text, field):
     with pytest.raises(UserError) as exc:
@@ -95,18 +102,28 @@ def test_bad_weights_name_the_field(text, field):
     assert field in str(exc.value)
 
 
-def test_paper_weights_leave_the_dump_unchanged():
-    dump = Config().model_dump(mode="json")["controller"]
-    assert not set(WEIGHT_FIELDS) & set(dump)
-    full = Config().model_dump(mode="json", context={"full": True})["controller"]
-    assert set(WEIGHT_FIELDS) <= set(full)
-    for data in ({"controller": {"weights": "airspeed"}},
-                 {"controller": {"height_scale_m": 3.0}}):
-        cfg = Config.model_validate(data)
-        dump = cfg.model_dump(mode="json")
-        assert Config.model_validate(dump) == cfg
-    air = Config.model_validate({"controller": {"weights": "airspeed"}})
-    assert set(WEIGHT_FIELDS) <= set(air.model_dump(mode="json")["controller"])
+def test_a_folder_recorded_before_a_field_existed_still_resumes(tmp_path):
+    """Resuming compares what the recorded configuration means under the current
+    schema: fields added since then (here the weights, a design's weights and the
+    campaign's record) take their defaults; a changed value still refuses."""
+    from ftc_mc.api import _open_chunks
+
+    cfg = load_any("configs/robust_moderate.yaml")
+    ours = cfg.model_dump(mode="json")
+    old = json.loads(json.dumps(ours))
+    for name in ("weights", "airspeed_scale_mps", "height_scale_m", "throttle_scale"):
+        del old["controller"][name]
+    for d in old["designs"].values():
+        del d["weights"]
+    del old["campaign"]["record"]
+    store = tmp_path / ".chunks"
+    store.mkdir()
+    (store / "manifest.json").write_text(json.dumps({"config": old}))
+    _open_chunks(tmp_path, json.dumps(ours, sort_keys=True), False, True)  # resumes
+    old["controller"]["height_scale_m"] = 3.0
+    (store / "manifest.json").write_text(json.dumps({"config": old}))
+    with pytest.raises(UserError, match="another configuration"):
+        _open_chunks(tmp_path, json.dumps(ours, sort_keys=True), False, True)
 
 
 def test_c1_and_terminal_costs_use_the_same_weights():
@@ -139,17 +156,27 @@ def test_shipped_robust_moderate_defaults_to_the_paper_weights():
 def test_the_airspeed_weights_fly_moderate_turbulence():
     """Flights 0-23 of the endurance seed 777 with the shipped robust design:
     the paper's c0 leaves the envelope below 12 m/s on flight 20, the airspeed
-    weights keep all 24 inside (docs/findings/turbulence-envelope.md)."""
+    weights keep all 24 inside (docs/findings/turbulence-envelope.md). A
+    design's own weights fly as the controller section's would, beside a
+    design on c0 in the same run."""
     from ftc_mc import run_endurance
 
     base = load_any(Path(__file__).resolve().parents[1] / "configs" / "robust_moderate.yaml")
     data = base.model_dump()
     data["controller"]["weights"] = "airspeed"
     air = Config.model_validate(data)
+    data = base.model_dump()
+    data["designs"]["robust_air"] = {**data["designs"]["robust"], "weights": "airspeed"}
+    both = Config.model_validate(data)
     hours = 24 * 50.0 / 3600
-    kw = dict(seed=777, design=("robust",), jobs=1, progress=False)
-    f_paper = run_endurance(base, hours, **kw).flights.set_index("flight_id")
-    f_air = run_endurance(air, hours, **kw).flights.set_index("flight_id")
-    assert len(f_air) == len(f_paper) == 24
+    kw = dict(seed=777, jobs=1, progress=False)
+    f_air = run_endurance(air, hours, design=("robust",), **kw).flights
+    f_both = run_endurance(both, hours, design=("robust", "robust_air"), **kw).flights
+    f_paper = f_both[f_both.variant == "robust"].set_index("flight_id")
+    f_own = f_both[f_both.variant == "robust_air"].set_index("flight_id")
+    assert len(f_own) == len(f_paper) == 24
     assert f_paper.loc[20, "status"] == "airspeed_out_of_bounds"
-    assert (f_air.status == "ok").all() and (f_air.flown_s == 50.0).all()
+    assert (f_own.status == "ok").all() and (f_own.flown_s == 50.0).all()
+    pd.testing.assert_frame_equal(f_own.drop(columns="variant"),
+                                  f_air.set_index("flight_id").drop(columns="variant"),
+                                  check_exact=True)

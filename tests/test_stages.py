@@ -131,7 +131,10 @@ def random_lanes(setup, rng, k, L=L):
     alive = np.ones(L, dtype=bool)
     alive[-1] = False
     return LaneState(x=x, xa=xa, P=np.ascontiguousarray(P), d_start=d_start.astype(np.int64),
-                     s_start=s_start.astype(np.int64), recheck=recheck.astype(np.int64),
+                     s_start=s_start.astype(np.int64),
+                     d_amp=rng.choice([exc.doublet_amp, 2.5 * exc.doublet_amp], L),
+                     s_amp=rng.choice([exc.s3211_amp, 3.0 * exc.s3211_amp], L),
+                     recheck=recheck.astype(np.int64),
                      belief=np.ascontiguousarray(rng.dirichlet(np.ones(4), L).T),
                      alive=alive, cur=(np.arange(L) % N_CONTROLLERS).astype(np.int64),
                      rmax=rng.uniform(0.0, 50.0, (2, L)), gust=gust,
@@ -419,7 +422,7 @@ def test_commands_s3211_floor(linear, floor):
     u_n, exc_n = naive.commands_ref(scheme, st, k)
     assert np.array_equal(work.exc, exc_n)
     assert_lanes(work.u, u_n, 1e-12, "u")
-    sig = np.array([naive.signal_3211_ref(k - st.s_start[l], exc.s3211_unit, exc.s3211_amp)
+    sig = np.array([naive.signal_3211_ref(k - st.s_start[l], exc.s3211_unit, st.s_amp[l])
                     for l in range(L)])
     assert np.all(sig != 0.0)
     want = floor * sig
@@ -540,6 +543,10 @@ POLICIES = {
     # tests and the 25-step loop cross several starts
     "periodic": {"policy": EXCITE_PERIODIC, "period": 16, "phase": 3, "doublet_half": 2,
                  "s3211_unit": 1},
+    # the policy's own amplitudes, paused while a fault mode reaches 0.5
+    "paused": {"policy": EXCITE_PERIODIC, "period": 16, "phase": 3, "doublet_half": 2,
+               "s3211_unit": 1, "policy_doublet_amp": 0.3, "policy_s3211_amp": 0.15,
+               "pause_belief": 0.5},
     # a period longer than the doublet (20 steps), so the wait shows
     "ambiguous": {"policy": EXCITE_AMBIGUOUS, "period": 30, "belief_max": 0.6,
                   "suspect": 60.0},
@@ -582,7 +589,7 @@ def test_handle_resets(linear, policy):
         d0 = st.d_start.copy()
         st0 = copy_nt(st)
         stages.handle_resets(exc, st, kn, work, rec)
-        for f in ("d_start", "s_start", "recheck"):
+        for f in ("d_start", "s_start", "d_amp", "s_amp", "recheck"):
             assert np.array_equal(getattr(st, f), want[f]), f
         for f in ("reset_k", "reset_block", "reset_res", "n_resets"):
             assert np.array_equal(getattr(rec, f), want[f]), f
@@ -595,6 +602,10 @@ def test_handle_resets(linear, policy):
                                        rec.reset_block, rec.reset_res, rec.n_resets)
         extra = (st.d_start != base["d_start"]) | (st.s_start != base["s_start"])
         assert not extra[~st0.alive].any()
+        if policy == "paused":  # none while a fault is believed; the policy's amplitudes
+            assert not extra[st0.belief[1:].max(axis=0) >= exc.pause_belief].any()
+            assert np.all(st.d_amp[st.d_start != base["d_start"]] == exc.policy_doublet_amp)
+            assert np.all(st.s_amp[st.s_start != base["s_start"]] == exc.policy_s3211_amp)
         by_policy += np.count_nonzero(extra)
     assert started > 0 and rechecked > 0 and truncated > 0
     assert (by_policy > 0) == (policy != "none"), by_policy

@@ -17,9 +17,6 @@ import yaml
 from annotated_types import Ge, Gt, Le, Lt, MinLen
 from pydantic import BaseModel
 
-FULL = {"full": True}
-"""Dump context that keeps every field (see ``ControllerConfig``'s serializer)."""
-
 DEFAULT_TEXT_MAX = 60
 """Longest default written beside a changed value; a longer one is named only."""
 
@@ -59,8 +56,8 @@ def _field_line(indent: str, name: str, value, default, info, mark: bool) -> str
 def _model_lines(model: BaseModel, indent: str) -> list:
     """``name: value  # doc`` lines of every field of ``model``; a changed value
     says its default."""
-    values = model.model_dump(mode="json", context=FULL)
-    defaults = type(model)().model_dump(mode="json", context=FULL)
+    values = model.model_dump(mode="json")
+    defaults = type(model)().model_dump(mode="json")
     return [_field_line(indent, name, values[name], defaults[name], info, True)
             for name, info in type(model).model_fields.items()]
 

@@ -20,7 +20,7 @@ import re
 from typing import Annotated, Literal
 
 from pydantic import (AfterValidator, BaseModel, BeforeValidator, ConfigDict, Field,
-                      SerializationInfo, field_validator, model_serializer, model_validator)
+                      field_validator, model_validator)
 
 from ..conventions import (ACTUATOR_NAMES, BIASED_OUTPUTS, EXCITATION_POLICIES, OUTPUT_NAMES,
                            PLANT_KINDS, S3211_UNITS, SENSOR_FAULT_KINDS, SENSOR_PREFIX,
@@ -181,10 +181,22 @@ class _Sampled(_Strict):
 
 def _check_coupling(cfg) -> None:
     """Coupled c0 and c1 are 6-DOF controllers: on the longitudinal plant
-    the field names the mismatch."""
+    the field names the mismatch; a design's own LQR weights fly the
+    separate laws, and not under a 6-DOF selection."""
     if cfg.controller.coupling == "coupled" and cfg.plant.dof != 6:
         raise ValueError("controller.coupling: coupled flies the 6-DOF plant "
                          f"(plant.dof: 6), got plant.dof {cfg.plant.dof}")
+    for name, d in cfg.designs.items():
+        if d.weights is not None and cfg.controller_of(name) == "lock_turn_selected":
+            raise ValueError(f"designs.{name}.weights: a lock_turn_selected design flies "
+                             "the controller section's weights (its selection is designed "
+                             "once a run); set controller.weights instead")
+    if cfg.controller.coupling == "coupled":
+        for name, d in cfg.designs.items():
+            if d.weights == "airspeed":
+                raise ValueError(f"designs.{name}.weights: airspeed flies with "
+                                 "controller.coupling: separate only (the coupled 6-DOF "
+                                 "LQR sums the paper's weights with the lateral loop's)")
 
 
 def _check_lock_turn(cfg, runs) -> None:
@@ -303,25 +315,6 @@ class ControllerConfig(_Strict):
             raise ValueError("weights: airspeed flies with coupling: separate only (the coupled "
                              "6-DOF LQR sums the paper's weights with the lateral loop's)")
         return self
-
-    @model_serializer(mode="wrap")
-    def _drop_added_defaults(self, handler, info: SerializationInfo):
-        """With the paper's weights, leave the weight fields out of a dump while at
-        their defaults, so configs and result folders recorded before they existed
-        resolve unchanged; ``context={"full": True}`` keeps them (``ftc-mc config
-        show``, the config reference)."""
-        data = handler(self)
-        if (info.context or {}).get("full") or self.weights != "paper":
-            return data
-        for name in WEIGHT_FIELDS:
-            if name in data and getattr(self, name) == type(self).model_fields[name].default:
-                del data[name]
-        return data
-
-
-WEIGHT_FIELDS = ("weights", "airspeed_scale_mps", "height_scale_m", "pitch_scale_deg",
-                 "pitch_rate_scale_dps", "throttle_scale", "elevon_scale_rad")
-"""``ControllerConfig`` fields left out of a dump at their defaults."""
 
 
 class ExcitationConfig(_Strict):
@@ -666,9 +659,9 @@ class DesignConfig(_Strict):
     excitation_policy: Literal[EXCITATION_POLICIES] = "none"
     """Excitation beyond the paper's on resets: none, periodic or ambiguous (docs/reference/config.md#excitation)."""
     doublet_amplitude: DoubletAmplitude | None = None
-    """This design's engine doublet amplitude [throttle fraction]; null: the excitation section's."""
+    """This design's engine doublet amplitude [throttle fraction], on resets (and by its policy); null: the excitation section's."""
     s3211_amplitude_rad: S3211Amplitude | None = None
-    """This design's elevon 3211 amplitude [rad], on resets and by its policy alike; null: the excitation section's."""
+    """This design's elevon 3211 amplitude [rad], on resets (and by its policy); null: the excitation section's."""
     s3211_floor: Annotated[float, NoBool, Field(ge=0, le=1, allow_inf_nan=False)] = 0.0
     """Under c2 the elevon 3211 is scaled by max(1 - b1_left_hat, s3211_floor) (docs/reference/config.md#excitation)."""
     excitation_period_s: Pos = 5.0
@@ -679,9 +672,17 @@ class DesignConfig(_Strict):
     """ambiguous: send while the belief's most probable mode has a probability below this (0: never on the belief)."""
     excitation_residual: Pos | None = None
     """ambiguous: send when r_q or r_nx reach this; null: never on the residuals."""
+    excitation_pause_belief: Fraction | None = None
+    """The policy sends nothing while the belief gives a fault mode at least this probability; null: never pauses."""
+    policy_doublet_amplitude: DoubletAmplitude | None = None
+    """The policy's doublets [throttle fraction]; null: as on resets (doublet_amplitude)."""
+    policy_s3211_amplitude_rad: S3211Amplitude | None = None
+    """The policy's 3211s [rad]; null: as on resets (s3211_amplitude_rad)."""
 
     controller: ControllerKind | None = None
     """Controller of this design's flights (as controller.kind); null: the controller section's kind."""
+    weights: Literal["paper", "airspeed"] | None = None
+    """LQR weights of this design's controllers (as controller.weights, on its scales); null: the controller section's."""
 
     @model_validator(mode="after")
     def _biases(self):
@@ -739,6 +740,11 @@ def _check_designs(cfg, listed, where: str, duration: tuple) -> None:
     e = cfg.excitation
     longest = max(2 * e.doublet_half_period_s, sum(S3211_UNITS) * e.s3211_unit_s)
     for n, d in cfg.designs.items():
+        for field in ("excitation_pause_belief", "policy_doublet_amplitude",
+                      "policy_s3211_amplitude_rad"):
+            if d.excitation_policy == "none" and getattr(d, field) is not None:
+                raise ValueError(f"designs.{n}.{field}: only with an excitation_policy "
+                                 "(got excitation_policy: none)")
         if d.excitation_policy != "periodic":
             continue
         if d.excitation_period_s < 2 * longest - 1e-9:

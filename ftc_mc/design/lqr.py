@@ -67,15 +67,16 @@ def bryson_r_lqr(throttle: float = 3.0, elevon_rad: float = 0.1) -> np.ndarray:
     return np.diag([1.0 / throttle ** 2, 1.0 / elevon_rad ** 2, 1.0 / elevon_rad ** 2])
 
 
-def controller_weights(c, gamma0: float):
+def controller_weights(c, gamma0: float, weights: str | None = None):
     """``(Q_lqr, R_lqr)`` of a validated ``controller`` config section.
 
-    ``weights: paper``: :func:`paper_q_lqr` and ``r_lqr I_3`` (section 5.1);
+    ``weights`` (``paper`` or ``airspeed``; None: the section's ``weights``)
+    chooses the rule. ``paper``: :func:`paper_q_lqr` and ``r_lqr I_3`` (section 5.1);
     ``weights: airspeed``: :func:`bryson_q_lqr` and :func:`bryson_r_lqr` on the
     section's scales.  c0's gain, Theorem 4.1's tables (c1), the terminal costs
     and the selection's prediction all use these weights.
     """
-    if c.weights == "airspeed":
+    if (c.weights if weights is None else weights) == "airspeed":
         return (bryson_q_lqr(c.airspeed_scale_mps, c.height_scale_m, c.pitch_scale_deg,
                              c.pitch_rate_scale_dps),
                 bryson_r_lqr(c.throttle_scale, c.elevon_scale_rad))

@@ -54,8 +54,12 @@ class ChunkStore:
         """Whether an unfinished run left chunks here."""
         return (self.folder / "manifest.json").exists()
 
-    def open(self, resume: bool) -> None:
+    def open(self, resume: bool, resolve=None) -> None:
         """Start a new chunk folder, or check the one being resumed.
+
+        ``resolve`` (optional) maps the identity the folder recorded to what it
+        means under the current schema (fields added since then at their
+        defaults), so a run recorded before a field existed still resumes.
 
         Raises
         ------
@@ -72,7 +76,7 @@ class ChunkStore:
                 theirs = json.loads(manifest.read_text(encoding="utf-8"))["config"]
             except (OSError, ValueError, KeyError):
                 raise UserError(f"--resume: {manifest} is unreadable") from None
-            if theirs != json.loads(self.config_json):
+            if (theirs if resolve is None else resolve(theirs)) != json.loads(self.config_json):
                 raise UserError(f"--resume: {self.folder.parent} was made by another "
                                 "configuration (or other --trials/--seed/--signature)")
             self._remove_temporaries()

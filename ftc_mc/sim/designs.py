@@ -81,7 +81,7 @@ from .estimator import EstimatorSettings, detection, filter_model, initial_covar
 
 
 NO_POLICY = {"policy": EXCITE_NONE, "period": 1, "phase": 0, "belief_max": 0.0,
-             "suspect": math.inf, "s3211_floor": 0.0}
+             "suspect": math.inf, "s3211_floor": 0.0, "pause_belief": math.inf}
 """The policy fields of :class:`~ftc_mc.core.longitudinal.settings.Excitation` of a
 design without an excitation policy (the paper's: signals on resets only, the 3211
 under c2 scaled by ``1 - b1_left_hat`` as eq. 23 prints)."""
@@ -91,12 +91,18 @@ def design_excitation(dc: DesignConfig, dt: float) -> dict:
     """The fields of the kernels' ``Excitation`` the design ``dc`` sets (``dt``:
     the control period [s]): the policy's, :data:`NO_POLICY` for ``none``, with
     the design's ``s3211_floor`` either way, and the signals'
-    amplitudes (``doublet_amp``, ``s3211_amp``) where the design sets its own."""
+    amplitudes where the design sets its own: ``doublet_amp`` and ``s3211_amp``
+    (on resets, and by the policy unless it sets ``policy_doublet_amp`` or
+    ``policy_s3211_amp``)."""
     own = {"s3211_floor": float(dc.s3211_floor)}
     if dc.doublet_amplitude is not None:
-        own["doublet_amp"] = float(dc.doublet_amplitude)
+        own["doublet_amp"] = own["policy_doublet_amp"] = float(dc.doublet_amplitude)
     if dc.s3211_amplitude_rad is not None:
-        own["s3211_amp"] = float(dc.s3211_amplitude_rad)
+        own["s3211_amp"] = own["policy_s3211_amp"] = float(dc.s3211_amplitude_rad)
+    if dc.policy_doublet_amplitude is not None:
+        own["policy_doublet_amp"] = float(dc.policy_doublet_amplitude)
+    if dc.policy_s3211_amplitude_rad is not None:
+        own["policy_s3211_amp"] = float(dc.policy_s3211_amplitude_rad)
     if dc.excitation_policy == "none":
         return {**NO_POLICY, **own}
     return {"policy": EXCITATION_POLICIES.index(dc.excitation_policy),
@@ -105,6 +111,8 @@ def design_excitation(dc: DesignConfig, dt: float) -> dict:
             "belief_max": float(dc.excitation_belief),
             "suspect": (math.inf if dc.excitation_residual is None
                         else float(dc.excitation_residual)),
+            "pause_belief": (math.inf if dc.excitation_pause_belief is None
+                             else float(dc.excitation_pause_belief)),
             **own}
 
 
@@ -140,6 +148,9 @@ class Design:
     controller : str or None
         ``nominal`` or ``reconfiguring``: the design's own controller kind;
         None: the config's ``controller.kind``.
+    weights : str or None
+        ``paper`` or ``airspeed``: the LQR weights of the design's controllers;
+        None: the config's ``controller.weights``.
     reset_scale : float
         Factor on the reset variances of section 3.2.2 (:func:`scaled_reset`).
     """
@@ -156,6 +167,7 @@ class Design:
     excitation: dict = dataclasses.field(default_factory=lambda: dict(NO_POLICY))
     controller: str | None = None
     reset_scale: float = 1.0
+    weights: str | None = None
 
     @property
     def n_aug(self) -> int:
@@ -282,7 +294,7 @@ def build_design(name: str, dc: DesignConfig, plant: LinearPlant, est: Estimator
     return Design(name=name, est=s, fm=fm, det=det, P0=_c(P0), test=test, window=window,
                   key=key, biases=tuple(dc.sensor_biases),
                   excitation=design_excitation(dc, plant.dt), controller=dc.controller,
-                  reset_scale=dc.reset_scale)
+                  reset_scale=dc.reset_scale, weights=dc.weights)
 
 
 SENSOR_BIAS_SD = {"q": 5.0 * math.pi / 180.0, "n_x": 0.08, "n_z": 0.08}

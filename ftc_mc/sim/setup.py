@@ -95,6 +95,10 @@ class SimSetup:
         ``(Reconfig, Belief)`` of a ``lock_turn_selected`` design
         (:func:`ftc_mc.sim.selection.selection_settings`); None when no design
         of the run flies one.
+    laws : dict or None
+        ``(ctl, eng, rc)`` of each LQR weighting a design of the run flies
+        (``paper``, ``airspeed``: :func:`control_laws`); ``ctl``, ``eng`` and
+        ``rc`` are the controller section's entry.
     """
 
     plant: LinearPlant
@@ -121,6 +125,7 @@ class SimSetup:
     gust_lat_chol: np.ndarray | None = None
     track: Track | None = None
     selection: tuple | None = None
+    laws: dict | None = None
 
     def scheme(self, name: str, detection: Detection | None = None) -> Scheme:
         """The kernels' :class:`Scheme` of the design ``name``: its filter, its
@@ -129,21 +134,26 @@ class SimSetup:
         d: Design = self.designs[name]
         rc = self.reconfig_of(name)
         bs = self.selection[1] if rc.kind == CONTROLLER_KINDS["lock_turn_selected"] else self.bs
+        ctl, eng = self.ctl, self.eng
+        if d.weights is not None and self.laws is not None:
+            ctl, eng, _ = self.laws[d.weights]
         return Scheme(filter=d.fm, detection=d.det if detection is None else detection,
-                      belief=bs, controller=self.ctl,
+                      belief=bs, controller=ctl,
                       excitation=self.exc._replace(**d.excitation),
-                      reconfig=rc, engine=self.eng)
+                      reconfig=rc, engine=eng)
 
     def reconfig_of(self, name: str) -> Reconfig:
         """The kernels' :class:`Reconfig` of the design ``name``: the config's,
         with the design's own controller kind when it sets one; a
         ``lock_turn_selected`` design's is the 6-DOF selection's
         (``selection``)."""
-        kind = self.designs[name].controller
-        code = self.rc.kind if kind is None else CONTROLLER_KINDS[kind]
+        d: Design = self.designs[name]
+        base = (self.rc if d.weights is None or self.laws is None
+                else self.laws[d.weights][2])
+        code = self.rc.kind if d.controller is None else CONTROLLER_KINDS[d.controller]
         if code == CONTROLLER_KINDS["lock_turn_selected"]:
             return self.selection[0]
-        return self.rc if kind is None else self.rc._replace(kind=code)
+        return base._replace(kind=code)
 
     @property
     def flight(self) -> Flight:
@@ -209,6 +219,34 @@ def timing_of(cfg: Config | ScenarioConfig) -> Timing:
                   detect_prob=float(t.detection_probability))
 
 
+def control_laws(cfg: Config | ScenarioConfig, plant: LinearPlant, fm, weights: str):
+    """c0's gain, c1's Theorem 4.1 tables and the selection's settings under the
+    LQR ``weights`` (``paper`` or ``airspeed``, on ``cfg.controller``'s scales).
+
+    Returns
+    -------
+    ctl : Controller
+        c0 (eq. 19) and the command limits.
+    eng : EngineTables
+        c1's tables (eq. 44), cached on disk by their weights.
+    rc : Reconfig
+        The selection's settings (eqs. 45-47) with its terminal costs J^N.
+    """
+    c = cfg.controller
+    Q, R = controller_weights(c, plant.trim.gamma0, weights)
+    K, _ = discounted_lqr(plant.A, plant.B, Q, R, c.discount)
+    ctl = Controller(K=np.ascontiguousarray(K), lo_dev=plant.u_lower - plant.u0,
+                     hi_dev=plant.u_upper - plant.u0)
+    eng = cached_engine_tables(plant, Q=Q, R=R, alpha=c.discount)
+    q_diag, r_diag = np.ascontiguousarray(np.diag(Q)), np.ascontiguousarray(np.diag(R))
+    JN = terminal_costs(fm, ctl.K, eng, ctl.lo_dev, ctl.hi_dev, c.discount, q_diag,
+                        r_diag, cfg.steps(c.terminal_horizon_s))
+    rc = Reconfig(kind=CONTROLLER_KINDS[c.kind], horizon=cfg.steps(c.horizon_s),
+                  alpha=float(c.discount), q_lqr=q_diag, r_lqr=r_diag, JN=JN,
+                  penalty=c.switch_penalty * (1.0 - np.eye(3)))
+    return ctl, eng, rc
+
+
 def build_setup(cfg: Config | ScenarioConfig) -> SimSetup:
     """Trim, linearise, design the controllers and pack the kernel settings.
 
@@ -232,17 +270,11 @@ def build_setup(cfg: Config | ScenarioConfig) -> SimSetup:
     designs = build_designs(runs, cfg.designs, plant, cfg.estimator, cfg.plant.altitude_m)
     bs = belief_settings(plant, est)
     c = cfg.controller
+    laws = {w: control_laws(cfg, plant, fm, w)
+            for w in dict.fromkeys([c.weights, *(d.weights for d in designs.values()
+                                                 if d.weights is not None)])}
+    ctl, eng, rc = laws[c.weights]
     Q, R = controller_weights(c, plant.trim.gamma0)
-    K, _ = discounted_lqr(plant.A, plant.B, Q, R, c.discount)
-    ctl = Controller(K=np.ascontiguousarray(K), lo_dev=plant.u_lower - plant.u0,
-                     hi_dev=plant.u_upper - plant.u0)
-    eng = cached_engine_tables(plant, Q=Q, R=R, alpha=c.discount)
-    q_diag, r_diag = np.ascontiguousarray(np.diag(Q)), np.ascontiguousarray(np.diag(R))
-    JN = terminal_costs(fm, ctl.K, eng, ctl.lo_dev, ctl.hi_dev, c.discount, q_diag,
-                        r_diag, cfg.steps(c.terminal_horizon_s))
-    rc = Reconfig(kind=CONTROLLER_KINDS[c.kind], horizon=cfg.steps(c.horizon_s),
-                  alpha=float(c.discount), q_lqr=q_diag, r_lqr=r_diag, JN=JN,
-                  penalty=c.switch_penalty * (1.0 - np.eye(3)))
     x = cfg.excitation
     exc = Excitation(doublet_amp=float(x.doublet_amplitude),
                      doublet_half=cfg.steps(x.doublet_half_period_s),
@@ -250,6 +282,8 @@ def build_setup(cfg: Config | ScenarioConfig) -> SimSetup:
                      s3211_unit=cfg.steps(x.s3211_unit_s),
                      resend_delay=cfg.steps(x.resend_delay_s),
                      resend_b1=float(x.resend_b1_threshold),
+                     policy_doublet_amp=float(x.doublet_amplitude),
+                     policy_s3211_amp=float(x.s3211_amplitude_rad),
                      **NO_POLICY)
     val = Validity(va_trim=float(plant.trim.y0[LONGITUDINAL.output("Va")]),
                    va_min=vc.airspeed_min_mps,
@@ -268,7 +302,7 @@ def build_setup(cfg: Config | ScenarioConfig) -> SimSetup:
             plant, pc.kind, pc.substeps, pc.turbulence, pc.altitude_m,
             monitor=monitor_spec(cfg, fm, detection(plant, EstimatorSettings()),
                                  lock_turn=cfg.flies_lock_turn(runs)),
-            paper=(K, eng, Q, R, c.discount) if c.coupling == "coupled" else None)
+            paper=(ctl.K, eng, Q, R, c.discount) if c.coupling == "coupled" else None)
         lat_std = lateral_noise(r_std)
         gust_lat_chol = None if gust_lat is None else gust_lat.P0_chol
         if cfg.selects_four(runs):
@@ -290,4 +324,4 @@ def build_setup(cfg: Config | ScenarioConfig) -> SimSetup:
         beta=(cfg.estimator.beta_engine, cfg.estimator.beta_elevon),
         truth=truth, gust=gust, gust_chol=None if gust is None else gust.P0_chol,
         dof=pc.dof, lat_std=lat_std, gust_lat_chol=gust_lat_chol,
-        track=track_of(plant, truth, pc.dof), selection=selection)
+        track=track_of(plant, truth, pc.dof), selection=selection, laws=laws)

@@ -56,7 +56,7 @@ def _table(model_type, prefix: str) -> list:
     """The field table of a section model, and its long defaults below it."""
     default = model_type.model_construct() if model_type in (FaultEvent, SensorFaultEvent) \
         else model_type()
-    values = default.model_dump(mode="json", context={"full": True}) if model_type not in (
+    values = default.model_dump(mode="json") if model_type not in (
         FaultEvent, SensorFaultEvent) else {}
     rows = ["| field | type | default | description |", "|---|---|---|---|"]
     long = []

@@ -155,6 +155,10 @@ Excitation = namedtuple("Excitation", [
                         #    reach this (inf: never)
     "s3211_floor",      # under c2 the 3211 is scaled by max(1 - b1_left_hat, this)
                         #    (0: eq. 23 as printed; DesignConfig.s3211_floor)
+    "policy_doublet_amp",  # amplitude of the doublets the policy sends [throttle]
+    "policy_s3211_amp",    # amplitude of the 3211s the policy sends [rad]
+    "pause_belief",     # the policy sends nothing while a fault mode's probability is
+                        #    at least this (inf: never pauses)
 ])
 """Excitation on reset requests (paper sections 3.2.3 and 4.1.1), and the
 design's policy of sending more."""
@@ -296,6 +300,8 @@ LaneState = namedtuple("LaneState", [
     "P",        # (n, n, L) covariance
     "d_start",  # (L,) int64 step the running doublet started at (or far past)
     "s_start",  # (L,) int64 step the running 3211 started at (or far past)
+    "d_amp",    # (L,) amplitude of the running (or last) doublet [throttle]
+    "s_amp",    # (L,) amplitude of the running (or last) 3211 [rad]
     "recheck",  # (L,) int64 step of the pending doublet re-check, or -1
     "belief",   # (4, L) mode probabilities
     "alive",    # (L,) bool: the trial is still valid (see trial.advance)

@@ -40,7 +40,8 @@ from __future__ import annotations
 import numpy as np
 
 from ...conventions import (C_ELEVON, COST_TRACK_MAX, COST_TRACK_SQ, COST_U2, EXCITE_NONE,
-                            EXCITE_PERIODIC, I_B1_LEFT, I_B1_THRUST, N_AUG, N_FAULT, N_MODES,
+                            EXCITE_PERIODIC, I_B1_LEFT, I_B1_THRUST, MODE_NOMINAL, N_AUG, N_FAULT,
+                            N_MODES,
                             N_U, N_X, NO_RESET, RESET_THRUST, STATUS_AIRSPEED, STATUS_ALPHA,
                             STATUS_BANK, STATUS_NONFINITE, STATUS_NOT_PSD, STATUS_OK)
 from .batch import filter_correct_lanes, filter_predict_lanes, innovations_lanes
@@ -105,7 +106,8 @@ def commands(path, scheme, st, k, work):
     c2 of eqs. 20-25).  Then the saturation with excitation
     headroom (eq. 15, eq. 16 without a signal): the doublet on the engine while
     one runs; the 3211 on the left elevon and its negative on the right while
-    one runs, scaled by ``1 - b1_left_hat`` under c2 (eq. 23), or by the
+    one runs (each at the amplitude it was started with, ``st.d_amp`` and
+    ``st.s_amp``: a reset's or the design's policy's), scaled by ``1 - b1_left_hat`` under c2 (eq. 23), or by the
     design's ``exc.s3211_floor`` where that is larger (0: eq. 23).
 
     Parameters
@@ -116,7 +118,7 @@ def commands(path, scheme, st, k, work):
         Reads ``controller`` (gain, limits), ``excitation``, ``engine`` and
         ``filter.u0``.
     st : LaneState
-        Reads ``xa``, ``cur``, ``d_start``, ``s_start``.
+        Reads ``xa``, ``cur``, ``d_start``, ``s_start``, ``d_amp``, ``s_amp``.
     k : int
         Step.
     work : TrialWork
@@ -137,8 +139,8 @@ def commands(path, scheme, st, k, work):
     for l in range(L):
         kd = k - st.d_start[l]
         if running(k, st.d_start[l], d_len):
-            sd = doublet(kd, exc.doublet_half, exc.doublet_amp)
-            u[U_THRUST, l] = saturate(u[U_THRUST, l], sd, exc.doublet_amp, lo[U_THRUST],
+            sd = doublet(kd, exc.doublet_half, st.d_amp[l])
+            u[U_THRUST, l] = saturate(u[U_THRUST, l], sd, st.d_amp[l], lo[U_THRUST],
                                       hi[U_THRUST])
         else:
             sd = 0.0
@@ -147,13 +149,13 @@ def commands(path, scheme, st, k, work):
         out[EXC_DOUBLET_START, l] = 1.0 if kd == 0 else 0.0
         ks = k - st.s_start[l]
         if running(k, st.s_start[l], s_len):
-            s = signal_3211(ks, exc.s3211_unit, exc.s3211_amp)
+            s = signal_3211(ks, exc.s3211_unit, st.s_amp[l])
             if st.cur[l] == C_ELEVON:  # eq. 23: scaled by the left elevon's efficiency
                 g = 1.0 - xa[I_B1_LEFT, l]
                 if exc.s3211_floor > 0.0 and g < exc.s3211_floor:  # the design's floor
                     g = exc.s3211_floor
                 s *= g
-            a = exc.s3211_amp
+            a = st.s_amp[l]
         else:
             s = 0.0
             a = 0.0
@@ -504,8 +506,8 @@ def handle_resets(excitation, st, kn, work, rec):
     recorded (step, block, residuals; counted beyond the record's capacity); a
     thrust reset starts the doublet unless one is running and schedules a
     re-check ``resend_delay`` steps later; an elevon reset starts the 3211
-    unless one is running (section 3.2.3).  At a pending re-check the doublet
-    is sent again if ``b1_thrust`` is estimated above ``resend_b1`` and none is
+    unless one is running (section 3.2.3), each at the section's (or the
+    design's) amplitude.  At a pending re-check the doublet is sent again if ``b1_thrust`` is estimated above ``resend_b1`` and none is
     running (section 4.1.1).  Resets of a lane that stopped are ignored.  Then
     the design's excitation policy, if it has one (:func:`policy_signals`).
 
@@ -513,7 +515,8 @@ def handle_resets(excitation, st, kn, work, rec):
     ----------
     excitation : Excitation
     st : LaneState
-        Reads ``alive``, ``xa``; ``d_start``, ``s_start``, ``recheck`` updated.
+        Reads ``alive``, ``xa``; ``d_start``, ``s_start``, ``d_amp``, ``s_amp``,
+        ``recheck`` updated.
     kn : int
         Step reached (``k + 1``).
     work : TrialWork
@@ -538,14 +541,17 @@ def handle_resets(excitation, st, kn, work, rec):
             if bk == RESET_THRUST:
                 if not running(kn, d_start[l], d_len):
                     d_start[l] = kn
+                    st.d_amp[l] = excitation.doublet_amp
                 st.recheck[l] = kn + excitation.resend_delay
             elif not running(kn, st.s_start[l], s_len):
                 st.s_start[l] = kn
+                st.s_amp[l] = excitation.s3211_amp
         if st.recheck[l] == kn:
             st.recheck[l] = -1
             if (st.xa[I_B1_THRUST, l] > excitation.resend_b1
                     and not running(kn, d_start[l], d_len)):
                 d_start[l] = kn
+                st.d_amp[l] = excitation.doublet_amp
     if excitation.policy != EXCITE_NONE:
         policy_signals(excitation, st, kn, work)
 
@@ -555,7 +561,9 @@ def policy_signals(excitation, st, kn, work):
     """The design's excitation beyond the requests on resets.
 
     A live lane on which neither signal runs at step ``kn`` (after the
-    requests of this step, :func:`handle_resets`) starts one:
+    requests of this step, :func:`handle_resets`), and whose belief holds no
+    fault mode at ``pause_belief`` or more, starts one, at the policy's
+    amplitudes (``policy_doublet_amp``, ``policy_s3211_amp``):
 
     * ``EXCITE_PERIODIC``: the doublet at the steps ``phase + n period`` and the
       3211 at ``phase + period // 2 + n period`` (``n`` any integer), so the two
@@ -573,9 +581,11 @@ def policy_signals(excitation, st, kn, work):
     ----------
     excitation : Excitation
         ``policy`` (not ``EXCITE_NONE``), ``period``, ``phase``, ``belief_max``,
-        ``suspect``, and the signals' lengths.
+        ``suspect``, ``pause_belief``, the policy's amplitudes and the signals'
+        lengths.
     st : LaneState
-        Reads ``alive``, ``belief``; ``d_start``, ``s_start`` updated.
+        Reads ``alive``, ``belief``; ``d_start``, ``s_start``, ``d_amp``,
+        ``s_amp`` updated.
     kn : int
         Step reached (``k + 1``).
     work : TrialWork
@@ -590,14 +600,22 @@ def policy_signals(excitation, st, kn, work):
         if (not st.alive[l] or running(kn, d_start[l], d_len)
                 or running(kn, s_start[l], s_len)):
             continue
+        fault = 0.0  # the most probable fault mode's probability
+        for m in range(st.belief.shape[0]):
+            if m != MODE_NOMINAL:
+                fault = max(fault, st.belief[m, l])
+        if fault >= excitation.pause_belief:
+            continue
         if excitation.policy == EXCITE_PERIODIC:
             ph = (kn - excitation.phase) % period
             if ph < 0:
                 ph += period
             if ph == 0:
                 d_start[l] = kn
+                st.d_amp[l] = excitation.policy_doublet_amp
             elif ph == period // 2:
                 s_start[l] = kn
+                st.s_amp[l] = excitation.policy_s3211_amp
         else:  # EXCITE_AMBIGUOUS
             if kn - max(d_start[l], s_start[l]) < period:
                 continue
@@ -608,8 +626,10 @@ def policy_signals(excitation, st, kn, work):
                     or work.res[R_NX, l] >= excitation.suspect):
                 if d_start[l] > s_start[l]:
                     s_start[l] = kn
+                    st.s_amp[l] = excitation.policy_s3211_amp
                 else:
                     d_start[l] = kn
+                    st.d_amp[l] = excitation.policy_doublet_amp
 
 
 # ------------------------------------------------------------------ 6. history

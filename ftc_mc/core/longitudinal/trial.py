@@ -175,6 +175,8 @@ def init_state(inp, st, rec):
                 st.P[i, j, l] = inp.P0[i, j]
         st.d_start[l] = NO_SIGNAL
         st.s_start[l] = NO_SIGNAL
+        st.d_amp[l] = 0.0
+        st.s_amp[l] = 0.0
         st.recheck[l] = -1
         for m in range(st.belief.shape[0]):
             st.belief[m, l] = 0.0
@@ -229,6 +231,7 @@ def new_state(L, n, window, n_x, n_lat, n_glat, n_m, window_m):
                      P=np.zeros((n, n, L)),
                      d_start=np.zeros(L, dtype=np.int64),
                      s_start=np.zeros(L, dtype=np.int64),
+                     d_amp=np.zeros(L), s_amp=np.zeros(L),
                      recheck=np.zeros(L, dtype=np.int64), belief=np.zeros((N_MODES, L)),
                      alive=np.zeros(L, dtype=np.bool_), cur=np.zeros(L, dtype=np.int64),
                      rmax=np.zeros((N_RMAX, L)), gust=np.zeros((N_GUST_STATE, L)),
