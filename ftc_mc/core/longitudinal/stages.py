@@ -107,8 +107,9 @@ def commands(path, scheme, st, k, work):
     headroom (eq. 15, eq. 16 without a signal): the doublet on the engine while
     one runs; the 3211 on the left elevon and its negative on the right while
     one runs (each at the amplitude it was started with, ``st.d_amp`` and
-    ``st.s_amp``: a reset's or the design's policy's), scaled by ``1 - b1_left_hat`` under c2 (eq. 23), or by the
-    design's ``exc.s3211_floor`` where that is larger (0: eq. 23).
+    ``st.s_amp``: a reset's or the design's policy's), scaled by
+    ``1 - b1_left_hat`` under c2 (eq. 23), or by the design's
+    ``exc.s3211_floor`` where that is larger (0: eq. 23).
 
     Parameters
     ----------
@@ -507,8 +508,9 @@ def handle_resets(excitation, st, kn, work, rec):
     thrust reset starts the doublet unless one is running and schedules a
     re-check ``resend_delay`` steps later; an elevon reset starts the 3211
     unless one is running (section 3.2.3), each at the section's (or the
-    design's) amplitude.  At a pending re-check the doublet is sent again if ``b1_thrust`` is estimated above ``resend_b1`` and none is
-    running (section 4.1.1).  Resets of a lane that stopped are ignored.  Then
+    design's) amplitude.  At a pending re-check the doublet is sent again if
+    ``b1_thrust`` is estimated above ``resend_b1`` and none is running
+    (section 4.1.1).  Resets of a lane that stopped are ignored.  Then
     the design's excitation policy, if it has one (:func:`policy_signals`).
 
     Parameters
