@@ -114,7 +114,9 @@ def test_a_folder_recorded_before_a_field_existed_still_resumes(tmp_path):
     for name in ("weights", "airspeed_scale_mps", "height_scale_m", "throttle_scale"):
         del old["controller"][name]
     for d in old["designs"].values():
-        del d["weights"]
+        for name in ("weights", "excitation_pause_belief", "policy_doublet_amplitude"):
+            if d[name] is None:  # at its default: as a folder of before the field
+                del d[name]
     del old["campaign"]["record"]
     store = tmp_path / ".chunks"
     store.mkdir()
@@ -148,9 +150,16 @@ def test_c1_and_terminal_costs_use_the_same_weights():
     assert np.array_equal(air.rc.JN, JN)
 
 
-def test_shipped_robust_moderate_defaults_to_the_paper_weights():
+def test_shipped_robust_moderate_flies_the_paper_design_on_c0_beside_the_airspeed_weights():
+    """The paper's design stays the baseline on c0's weights; the config's
+    default design flies the airspeed weights; the designs it was chosen over
+    (robust and its variants) keep c0's."""
     cfg = load_any(Path(__file__).resolve().parents[1] / "configs" / "robust_moderate.yaml")
-    assert cfg.controller.weights == "paper"
+    assert cfg.controller.weights == "paper" and cfg.campaign.signature == "swapped"
+    assert cfg.campaign.designs == ["excited_airspeed"]
+    assert cfg.designs["excited_airspeed"].weights == "airspeed"
+    assert all(cfg.designs[n].weights is None
+               for n in ("robust", "robust_ekf", "robust_clip", "robust_excited"))
 
 
 def test_the_airspeed_weights_fly_moderate_turbulence():
