@@ -54,3 +54,34 @@ def test_endurance_rows_match_the_controller_a_design_flies():
     # the design's own controller wins over the kind, on either side
     own = matching_endurance([run(_cfg(kind="nominal", own="reconfiguring"))], sweep)
     assert list(own["variant"]) == ["d"]
+
+
+def test_endurance_rows_match_the_weights_a_design_flies_and_results_of_before():
+    """A design recorded before fields were added (here every design field the
+    current schema fills in) is the same design; one that flies other LQR
+    weights (its own, or the controller section's, or other scales) is not."""
+    from ftc_mc.config.schema import DesignConfig
+
+    table = pd.DataFrame({"variant": ["d"]})
+
+    def run(cfg):
+        return SimpleNamespace(meta={"config": cfg}, tables={"endurance": table})
+
+    def with_(cfg, design=None, controller=None):
+        cfg["designs"]["d"].update(design or {})
+        cfg["controller"].update(controller or {})
+        return cfg
+
+    sweep = _cfg()  # a design recorded with only the fields it set
+    full = _cfg()
+    full["designs"]["d"] = DesignConfig.model_validate(DESIGN).model_dump(mode="json")
+    assert "weights" in full["designs"]["d"] and "weights" not in sweep["designs"]["d"]
+    assert list(matching_endurance([run(full)], sweep)["variant"]) == ["d"]
+    assert matching_endurance([run(with_(_cfg(), {"weights": "airspeed"}))], sweep) is None
+    assert matching_endurance([run(with_(_cfg(), None, {"weights": "airspeed"}))],
+                              sweep) is None
+    own = with_(_cfg(), {"weights": "airspeed"})
+    section = with_(_cfg(), None, {"weights": "airspeed"})
+    assert list(matching_endurance([run(section)], own)["variant"]) == ["d"]
+    other_scale = with_(_cfg(), None, {"weights": "airspeed", "height_scale_m": 3.0})
+    assert matching_endurance([run(other_scale)], own) is None

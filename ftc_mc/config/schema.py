@@ -179,7 +179,7 @@ class _Sampled(_Strict):
         return any(self.controller_of(r) == "lock_turn_selected" for r in runs)
 
 
-def _check_coupling(cfg) -> None:
+def _check_coupling(cfg, runs) -> None:
     """Coupled c0 and c1 are 6-DOF controllers: on the longitudinal plant
     the field names the mismatch; a design's own LQR weights fly the
     separate laws, and not under a 6-DOF selection."""
@@ -187,7 +187,8 @@ def _check_coupling(cfg) -> None:
         raise ValueError("controller.coupling: coupled flies the 6-DOF plant "
                          f"(plant.dof: 6), got plant.dof {cfg.plant.dof}")
     for name, d in cfg.designs.items():
-        if d.weights is not None and cfg.controller_of(name) == "lock_turn_selected":
+        if (name in runs and d.weights not in (None, cfg.controller.weights)
+                and cfg.controller_of(name) == "lock_turn_selected"):
             raise ValueError(f"designs.{name}.weights: a lock_turn_selected design flies "
                              "the controller section's weights (its selection is designed "
                              "once a run); set controller.weights instead")
@@ -295,7 +296,7 @@ class ControllerConfig(_Strict):
     coupling: Literal["separate", "coupled"] = "separate"
     """6-DOF c0 and c1: separate (the paper's laws and a lateral LQR) or coupled (6-DOF LQRs) (docs/reference/config.md#controllers)."""
     weights: Literal["paper", "airspeed"] = "paper"
-    """LQR weights of c0-c2 and J^N: paper (section 5.1) or airspeed (Bryson's rule on the scales below) (docs/reference/config.md#controllers)."""
+    """LQR weights of c0-c2 and J^N: paper (section 5.1) or airspeed (Bryson, scales below); a design's own override (docs/reference/config.md#controllers)."""
     airspeed_scale_mps: Pos = 2.0
     """airspeed weights: largest accepted deviation of the body velocity u, the airspeed's proxy [m/s]."""
     height_scale_m: Pos = 1.0
@@ -315,6 +316,11 @@ class ControllerConfig(_Strict):
             raise ValueError("weights: airspeed flies with coupling: separate only (the coupled "
                              "6-DOF LQR sums the paper's weights with the lateral loop's)")
         return self
+
+
+WEIGHT_SCALES = ("airspeed_scale_mps", "height_scale_m", "pitch_scale_deg",
+                 "pitch_rate_scale_dps", "throttle_scale", "elevon_scale_rad")
+"""``ControllerConfig`` fields that set the ``airspeed`` weights."""
 
 
 class ExcitationConfig(_Strict):
@@ -863,7 +869,7 @@ class Config(_Sampled):
                              f"({t.duration_s:g} s), got {self.controller.horizon_s:g}")
         _check_length("timing.duration_s", t.duration_s, dt)
         _check_lock_turn(self, self.campaign.runs())
-        _check_coupling(self)
+        _check_coupling(self, self.campaign.runs())
         lower, upper = _check_airframe_use(self)
         for actuator, name in (("engine", "engine_lock_range"),
                                ("left_elevon", "elevon_lock_range_rad"),
@@ -1010,7 +1016,7 @@ class ScenarioConfig(_Sampled):
             raise ValueError(f"controller.horizon_s: must not exceed scenario.duration_s "
                              f"({sc.duration_s:g} s), got {self.controller.horizon_s:g}")
         _check_lock_turn(self, (sc.design or sc.signature,))
-        _check_coupling(self)
+        _check_coupling(self, (sc.design or sc.signature,))
         lower, upper = _check_airframe_use(self)
         for i, e in enumerate(sc.schedule):
             if e.fault == "lock" and e.position != "trim":

@@ -115,6 +115,14 @@ def controller_of(cfg: dict, design: str | None) -> str:
     return own or cfg.get("controller", {}).get("kind", "?")
 
 
+def weights_of(cfg: dict, design: str | None) -> str:
+    """The LQR weights the design ``design`` flies in a stored config: its own
+    ``weights``, else the ``controller`` section's (``paper`` in results written
+    before either existed)."""
+    own = (cfg.get("designs", {}).get(design) or {}).get("weights") if design else None
+    return own or cfg.get("controller", {}).get("weights") or "paper"
+
+
 def plant_text(cfg: dict) -> str:
     """``airframe `name`, truth plant `kind`, turbulence `level``` of a config."""
     kind, turbulence = plant_condition(cfg)

@@ -372,6 +372,7 @@ def _design_text(cfg: dict) -> str:
         test = d.get("test", "?") + (f" {d.get('window_s', '?'):g} s"
                                      if d.get("test") == "glr" else "")
         own = f", controller `{d['controller']}`" if d.get("controller") else ""
+        own += f", `{d['weights']}` weights" if d.get("weights") else ""
         return (f"`{n}` ({d.get('estimator', '?')} estimator, {test}, "
                 f"t_q {d.get('t_q', '?')}, t_nx {d.get('t_nx', '?')}{own})")
 

@@ -33,8 +33,11 @@ A design may also send excitation beyond the paper's requests on resets
 policy fields of the kernels' :class:`~ftc_mc.core.longitudinal.settings.Excitation`
 (:data:`NO_POLICY` for the paper's, which leaves the kernels as before), and
 the signals' amplitudes where the design sets its own (``doublet_amplitude``,
-``s3211_amplitude_rad``; else the config's ``excitation`` section).  A policy
-changes the flight before any reset, so it is part of the design key.
+``s3211_amplitude_rad``; else the config's ``excitation`` section), the
+policy's own (``policy_*_amplitude``) and its pause
+(``excitation_pause_belief``).  A policy changes the flight before any reset,
+so it is part of the design key.  A design's ``weights`` chooses the LQR
+weights of its controllers (:class:`ftc_mc.sim.setup.SimSetup`'s ``laws``).
 
 A design changes only what the filter assumes: the truth noise of every trial
 comes from the config's ``estimator`` and ``noise`` sections, so all designs fly

@@ -130,12 +130,14 @@ class SimSetup:
     def scheme(self, name: str, detection: Detection | None = None) -> Scheme:
         """The kernels' :class:`Scheme` of the design ``name``: its filter, its
         detection (or ``detection``), its excitation policy, its controller
-        kind (:meth:`reconfig_of`) and the belief its selection reads."""
+        kind and settings (:meth:`reconfig_of`), the belief its selection reads,
+        and c0's gain and c1's tables of its LQR weights (its own ``weights``,
+        from :attr:`laws`; else the config's)."""
         d: Design = self.designs[name]
         rc = self.reconfig_of(name)
         bs = self.selection[1] if rc.kind == CONTROLLER_KINDS["lock_turn_selected"] else self.bs
         ctl, eng = self.ctl, self.eng
-        if d.weights is not None and self.laws is not None:
+        if d.weights is not None:
             ctl, eng, _ = self.laws[d.weights]
         return Scheme(filter=d.fm, detection=d.det if detection is None else detection,
                       belief=bs, controller=ctl,
@@ -144,12 +146,12 @@ class SimSetup:
 
     def reconfig_of(self, name: str) -> Reconfig:
         """The kernels' :class:`Reconfig` of the design ``name``: the config's,
-        with the design's own controller kind when it sets one; a
-        ``lock_turn_selected`` design's is the 6-DOF selection's
+        or that of the design's own LQR weights (its ``q_lqr``, ``r_lqr`` and
+        J^N, from :attr:`laws`), with the design's own controller kind when it
+        sets one; a ``lock_turn_selected`` design's is the 6-DOF selection's
         (``selection``)."""
         d: Design = self.designs[name]
-        base = (self.rc if d.weights is None or self.laws is None
-                else self.laws[d.weights][2])
+        base = self.rc if d.weights is None else self.laws[d.weights][2]
         code = self.rc.kind if d.controller is None else CONTROLLER_KINDS[d.controller]
         if code == CONTROLLER_KINDS["lock_turn_selected"]:
             return self.selection[0]

@@ -137,9 +137,9 @@ Controller = namedtuple("Controller", [
 """Nominal controller c0 with its saturation (paper section 4.1, eqs. 15-19)."""
 
 Excitation = namedtuple("Excitation", [
-    "doublet_amp",      # amplitude of the engine doublet [throttle]
+    "doublet_amp",      # amplitude of the engine doublet a reset sends [throttle]
     "doublet_half",     # steps of each half of the doublet
-    "s3211_amp",        # amplitude of the elevon 3211 [rad]
+    "s3211_amp",        # amplitude of the elevon 3211 a reset sends [rad]
     "s3211_unit",       # steps of one unit of the 3211
     "resend_delay",     # steps after a thrust reset before the doublet re-check (3 s)
     "resend_b1",        # re-send the doublet if b1_thrust estimate exceeds this (0.7)
