@@ -232,25 +232,16 @@ def _check_out(out, resume: bool) -> Path | None:
     return Path(out)
 
 
-def _current(config: dict) -> dict:
-    """A configuration recorded in a result folder, as the current schema resolves
-    it: fields added since it was recorded take their defaults, so an identity
-    check compares meanings, not the schema's age.  Unreadable: returned as is
-    (it then differs)."""
+def _current_identity(identity):
+    """A result folder's recorded identity with its configuration as the current
+    schema resolves it (:func:`ftc_mc.config.load.as_current`): a run's identity
+    is its configuration, a sweep's or an endurance run's a mapping holding one."""
+    from .config.load import as_current
     from .config.schema import Config
 
-    try:
-        return Config.model_validate(config).model_dump(mode="json")
-    except Exception:  # noqa: BLE001 -- not ours: the comparison fails
-        return config
-
-
-def _current_identity(identity):
-    """:func:`_current` on the ``config`` an identity holds (a run's identity is
-    its configuration, a sweep's or an endurance run's a mapping with one)."""
     if isinstance(identity, dict) and isinstance(identity.get("config"), dict):
-        return {**identity, "config": _current(identity["config"])}
-    return _current(identity) if isinstance(identity, dict) else identity
+        return {**identity, "config": as_current(Config, identity["config"])}
+    return as_current(Config, identity)
 
 
 def _open_chunks(out_dir: Path, identity_json: str, overwrite: bool, resume: bool):

@@ -75,6 +75,18 @@ def validate_model(model: type[BaseModel], data, source: str):
         raise UserError(_format_error(exc, source)) from None
 
 
+def as_current(model: type[BaseModel], data):
+    """``data`` recorded from a ``model`` (a result folder's config, a section of
+    it) as the current schema resolves it, as JSON types: fields added since it
+    was recorded take their defaults, so comparing two records compares
+    meanings, not the schema's age.  Returned as it is when it does not
+    validate (a comparison then fails)."""
+    try:
+        return model.model_validate(data).model_dump(mode="json")
+    except Exception:  # noqa: BLE001 -- not ours to judge: compared as recorded
+        return data
+
+
 def load_config(path) -> Config:
     """Read and validate a YAML campaign configuration file.
 

@@ -16,20 +16,12 @@ import json
 import numpy as np
 import pandas as pd
 
+from ..config.load import as_current
 from ..config.schema import WEIGHT_SCALES, ControllerConfig, DesignConfig, EstimatorConfig
 from .load import ResultDir
 from .markdown import controller_of, plant_text, weights_of
 
 THRESHOLDS = ("t_q", "t_nx")
-
-
-def _resolved(model, data: dict) -> dict:
-    """``data`` as the current schema's ``model`` resolves it (fields added since it
-    was recorded at their defaults); as it is when it does not validate."""
-    try:
-        return model.model_validate(data).model_dump(mode="json")
-    except Exception:  # noqa: BLE001 -- compared as recorded
-        return dict(data)
 
 
 def _definition(cfg: dict, design: str) -> str:
@@ -38,14 +30,14 @@ def _definition(cfg: dict, design: str) -> str:
     the current schema, with the controller it flies (its own, else the
     ``controller`` section's kind) and its LQR weights (with their scales)."""
     own = cfg.get("designs", {}).get(design)
-    d = (_resolved(DesignConfig, own) if own
-         else _resolved(EstimatorConfig, cfg.get("estimator", {})))
+    d = dict(as_current(DesignConfig, own) if own
+             else as_current(EstimatorConfig, cfg.get("estimator", {})))
     for t in THRESHOLDS:
         d.pop(t, None)
     d["controller"] = controller_of(cfg, design)
     d["weights"] = weights_of(cfg, design)
     if d["weights"] != "paper":
-        c = _resolved(ControllerConfig, cfg.get("controller", {}))
+        c = as_current(ControllerConfig, cfg.get("controller", {}))
         d["weight_scales"] = {f: c.get(f) for f in WEIGHT_SCALES}
     return json.dumps(d, sort_keys=True)
 

@@ -276,7 +276,6 @@ def build_setup(cfg: Config | ScenarioConfig) -> SimSetup:
             for w in dict.fromkeys([c.weights, *(d.weights for d in designs.values()
                                                  if d.weights is not None)])}
     ctl, eng, rc = laws[c.weights]
-    Q, R = controller_weights(c, plant.trim.gamma0)
     x = cfg.excitation
     exc = Excitation(doublet_amp=float(x.doublet_amplitude),
                      doublet_half=cfg.steps(x.doublet_half_period_s),
@@ -304,7 +303,8 @@ def build_setup(cfg: Config | ScenarioConfig) -> SimSetup:
             plant, pc.kind, pc.substeps, pc.turbulence, pc.altitude_m,
             monitor=monitor_spec(cfg, fm, detection(plant, EstimatorSettings()),
                                  lock_turn=cfg.flies_lock_turn(runs)),
-            paper=(ctl.K, eng, Q, R, c.discount) if c.coupling == "coupled" else None)
+            paper=((ctl.K, eng, *controller_weights(c, plant.trim.gamma0), c.discount)
+                   if c.coupling == "coupled" else None))
         lat_std = lateral_noise(r_std)
         gust_lat_chol = None if gust_lat is None else gust_lat.P0_chol
         if cfg.selects_four(runs):
