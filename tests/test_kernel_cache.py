@@ -329,3 +329,34 @@ def test_a_test_kernel_is_keyed_on_the_tree_s_content_not_its_path(tmp_path):
     # without pyproject.toml (an installed package's neighbours): Numba's own locator
     (b / "pyproject.toml").unlink()
     assert "/clone/" not in _run_tree(b, cache)["cache"]
+
+
+def test_an_index_holding_a_type_this_process_cannot_import_stays_readable(tmp_path,
+                                                                           monkeypatch):
+    """The tests compile package kernels on namedtuples of their own modules; a
+    process without those modules (``ftc-mc`` after the tests, on one shared
+    cache) once failed to load the kernel's whole index. Such entries are now
+    left out (a cache miss), the others still load."""
+    import importlib
+    import pickle
+
+    from numba.core import caching
+
+    (tmp_path / "foreign_types.py").write_text(
+        "from collections import namedtuple\nP = namedtuple('P', ['a'])\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    foreign = importlib.import_module("foreign_types")
+    index = caching.IndexDataCacheFile(cache_path=str(tmp_path), filename_base="k",
+                                       source_stamp=("stamp",))
+    index._save_index({("native", 1): "k-1.nbc", (foreign.P(1), 1): "k-2.nbc"})
+    monkeypatch.delitem(sys.modules, "foreign_types")
+    monkeypatch.setattr(sys, "path", [p for p in sys.path if p != str(tmp_path)])
+    with pytest.raises(ImportError):
+        index._load_index()  # Numba's own reader
+    tolerant = jit.TolerantIndexFile(cache_path=str(tmp_path), filename_base="k",
+                                     source_stamp=("stamp",))
+    assert tolerant._load_index() == {("native", 1): "k-1.nbc"}
+    stale = jit.TolerantIndexFile(cache_path=str(tmp_path), filename_base="k",
+                                  source_stamp=("other",))
+    assert stale._load_index() == {}
+    assert pickle.dumps(("native", 1))

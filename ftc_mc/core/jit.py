@@ -31,7 +31,9 @@ from __future__ import annotations
 import ast
 import functools
 import hashlib
+import io
 import os
+import pickle
 from pathlib import Path
 
 import numba
@@ -371,6 +373,63 @@ def _claim_held(fd: int) -> bool:
     return False
 
 
+class _ForeignType:
+    """Stands in, while a cache index is read, for a class of a module this
+    process cannot import (:class:`TolerantIndexFile`); built from whatever
+    the pickle holds."""
+
+    def __new__(cls, *args, **kwargs):
+        return object.__new__(cls)
+
+    def __init__(self, *args, **kwargs):
+        pass
+
+    def __setstate__(self, state):
+        pass
+
+
+class _TolerantUnpickler(pickle.Unpickler):
+    """Numba's index unpickler, but a class of a module this process cannot
+    import (a test's namedtuple passed to a package kernel) becomes a subclass
+    of :class:`_ForeignType`, which no live signature equals."""
+
+    def find_class(self, module, name):
+        try:
+            return super().find_class(module, name)
+        except (ImportError, AttributeError):
+            return type(name, (_ForeignType,), {"__module__": module})
+
+
+def _native(key) -> bool:
+    """Whether a cache index key holds no :class:`_ForeignType` (it pickles)."""
+    try:
+        pickle.dumps(key)
+    except Exception:  # noqa: BLE001 -- a stand-in class pickles by a name that is not there
+        return False
+    return True
+
+
+class TolerantIndexFile(caching.IndexDataCacheFile):
+    """A kernel's cache index that stays readable in a process that cannot import
+    a type some other process compiled the kernel for (the tests compile package
+    kernels on types of their own modules; a process without ``tests/`` on its
+    path failed to load such an index at all).  Those entries are left out of
+    what this process reads, so they are a cache miss here and are dropped when
+    this process saves an overload of the kernel."""
+
+    def _load_index(self):
+        try:
+            return super()._load_index()
+        except (ImportError, AttributeError):
+            pass
+        with open(self._index_path, "rb") as f:
+            pickle.load(f)  # the version, checked by the first attempt
+            stamp, overloads = _TolerantUnpickler(io.BytesIO(f.read())).load()
+        if stamp != self._source_stamp:
+            return {}
+        return {k: v for k, v in overloads.items() if _native(k)}
+
+
 class ContentFunctionCache(caching.FunctionCache):
     """The on-disk cache of one kernel (:func:`kernel`): Numba's, located by
     :class:`ContentCacheImpl`, that saves nothing once the kernel sources have
@@ -391,6 +450,10 @@ class ContentFunctionCache(caching.FunctionCache):
     _impl_class = ContentCacheImpl
     _warned = False
     awaits_claims = True
+
+    def __init__(self, py_func):
+        super().__init__(py_func)
+        self._cache_file.__class__ = TolerantIndexFile
     """Whether this process waits for claims; a compile helper, which holds
     claims, does not (so two helpers never wait for each other)."""
 
