@@ -90,7 +90,8 @@ def test_rows_the_paper_did_not_run_have_no_verdict(tmp_path):
             assert np.isnan(s.loc[name, f"paper_p_{q}"]), (name, q)
             assert s.loc[name, f"paper_agrees_{q}"] is pd.NA, (name, q)
         assert s.loc[name, "paper_agrees"] is pd.NA, name
-    assert agreement_text(s.loc["right_elevon_lock"]) == "-"
+    assert agreement_text(s.loc["right_elevon_lock"]) == "not in the paper"
+    assert agreement_text(s.loc["elevon_lock"]) == "-"  # no judged trial
     # the NA (not False) survives the Parquet file the run writes
     write_parquet(s.reset_index(), tmp_path / "summary.parquet", {"kind": "run"})
     back = pd.read_parquet(tmp_path / "summary.parquet").set_index("transition")

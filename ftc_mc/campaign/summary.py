@@ -199,21 +199,29 @@ def paper_agreement(row: dict) -> dict:
     return out
 
 
+def p_text(p: float) -> str:
+    """A p-value to two significant digits; ``<1e-300`` where it underflowed to 0."""
+    return "<1e-300" if p == 0 else f"{p:.2g}"
+
+
 def agreement_text(r) -> str:
     """The verdict of a summary row in words, with the p-values it rests on.
 
     ``agrees (p 0.61 / 0.28)``, ``differs: no reset (p 1 / 3.1e-09)`` (the
     p-values of inappropriate / no reset, the quantities that differ named);
-    ``-`` for a row without a verdict (not in the paper, or no judged trial);
-    ``not recorded`` for a summary written before the verdict columns.
+    ``not in the paper`` for a row the paper did not run (the right elevon's:
+    no verdict); ``-`` for a paper row without a judged trial; ``not
+    recorded`` for a summary written before the verdict columns.
     """
     if "paper_agrees" not in r:
         return "not recorded"
+    if not np.isfinite(float(r["paper_trials"])):
+        return "not in the paper"
     verdict = r["paper_agrees"]
     if verdict is None or verdict is pd.NA or (isinstance(verdict, float)
                                               and not np.isfinite(verdict)):
         return "-"
-    ps = " / ".join(f"{r[f'paper_p_{q}']:.2g}" for q in AGREEMENT_QUANTITIES)
+    ps = " / ".join(p_text(r[f"paper_p_{q}"]) for q in AGREEMENT_QUANTITIES)
     if verdict:
         return f"agrees (p {ps})"
     differ = [q.replace("_", " ") for q in AGREEMENT_QUANTITIES
@@ -459,7 +467,7 @@ def markdown_table(summary: pd.DataFrame) -> str:
 
 AGREEMENT_NOTE = ("*Agrees with the paper?*: per quantity, our count of the judged trials "
                   "against the paper's of 1000, two-sided Fisher exact test at 5 %; a row "
-                  "agrees only if both quantities do (`-`: a row the paper did not run). "
+                  "agrees only if both quantities do (`-`: no trial judged). "
                   "Agreement means no difference this test can detect, not equality "
                   "(docs/findings/paper-tables.md, \"How agreement is judged\").")
 """The sentence under a table with the verdict column (``summary.md``, the report)."""
