@@ -10,6 +10,9 @@ come from the same formula:
 * :func:`poisson_upper`, :func:`hours_to_show`: one-sided upper bound of a
   Poisson rate, and the exposure a rate target needs (endurance runs);
 * :func:`mcnemar_exact`: paired comparison of the two signature variants;
+* :func:`two_proportion_p`, :func:`agrees`: unpaired comparison of two
+  counts, e.g. our rate of a Tables 2-3 row against the paper's count
+  (``docs/findings/paper-tables.md``, "How agreement is judged");
 * :func:`finite`, :func:`finite_median`, :func:`median_p95`: delay and
   detection-time quantiles over the trials that have one.
 """
@@ -202,6 +205,78 @@ def mcnemar_exact(only_a: int, only_b: int) -> float:
     if not only_a + only_b:
         return 1.0
     return _scipy_stats().binomtest(only_a, only_a + only_b).pvalue
+
+
+AGREEMENT_LEVEL = 0.05
+"""Level of :func:`agrees`: two counts agree unless the two-sided exact test
+of :func:`two_proportion_p` rejects equal proportions at 5 %."""
+
+
+def two_proportion_p(k_a: int, n_a: int, k_b: int, n_b: int) -> float:
+    """Two-sided p-value of Fisher's exact test of two binomial proportions.
+
+    Tests whether ``k_a`` of ``n_a`` and ``k_b`` of ``n_b`` can come from the
+    same proportion, on the 2x2 table ``[[k_a, n_a - k_a], [k_b, n_b - k_b]]``
+    (``scipy.stats.fisher_exact``, two-sided: the probability, under the
+    hypergeometric distribution of the table with its margins fixed, of the
+    tables no more probable than the one observed; Fisher 1935, Agresti 1992).
+    Both counts are treated as samples: the test is the one for two
+    independent Monte Carlo estimates.  It is exact, so never too liberal
+    (conditioning on both margins makes it conservative), and costs
+    microseconds at any ``n`` (Boschloo's unconditional test, more powerful,
+    takes 1-30 s per table at ``n = 1000``, measured with ``scipy.stats.
+    boschloo_exact`` on scipy 1.17).
+
+    Parameters
+    ----------
+    k_a, n_a : int
+        Successes and trials of the first sample (``0 <= k_a <= n_a``).
+    k_b, n_b : int
+        The same of the second sample.
+
+    Returns
+    -------
+    float
+        The p-value; NaN if either sample is empty (nothing to compare).
+
+    References
+    ----------
+    R. A. Fisher, "The logic of inductive inference", J. R. Stat. Soc. 98
+    (1935) 39-82.
+    A. Agresti, "A survey of exact inference for contingency tables", Stat.
+    Sci. 7 (1992) 131-153.
+    """
+    k_a, n_a, k_b, n_b = (int(x) for x in (k_a, n_a, k_b, n_b))
+    if not (n_a and n_b):
+        return np.nan
+    if not (0 <= k_a <= n_a and 0 <= k_b <= n_b):
+        raise ValueError(f"counts out of range: {k_a}/{n_a}, {k_b}/{n_b}")
+    table = [[k_a, n_a - k_a], [k_b, n_b - k_b]]
+    return float(_scipy_stats().fisher_exact(table, alternative="two-sided").pvalue)
+
+
+def agrees(p: float, level: float = AGREEMENT_LEVEL):
+    """Whether a comparison with p-value ``p`` finds agreement.
+
+    Agreement means the test does not reject equal proportions (``p >= level``);
+    it does not show that they are equal, only that the data cannot tell them
+    apart at that level.
+
+    Parameters
+    ----------
+    p : float
+        A p-value (:func:`two_proportion_p`), NaN when nothing was compared.
+    level : float
+        Significance level of the test.
+
+    Returns
+    -------
+    bool or None
+        None when ``p`` is NaN (no verdict).
+    """
+    if not np.isfinite(p):
+        return None
+    return bool(p >= level)
 
 
 def finite(values) -> np.ndarray:

@@ -4,7 +4,12 @@ What is checked, on a small real run (4 trials, nominal controller) and the
 paper scenario, both made once per module through the CLI:
 
 * the report holds the paper's counts and ours (with Wilson intervals), the
-  scenario timeline beside the paper's, and the provenance of every input;
+  verdict whether ours agree with the paper's as ``summary.parquet`` recorded
+  it, the scenario timeline beside the paper's, and the provenance of every
+  input;
+* the scenario's controller names come from its files' metadata, with the
+  code that builds them from the config made to fail (and the bare codes for a
+  result written before they were recorded); so do Fig. 11's;
 * every image link is relative and points to a non-empty PNG;
 * the report rebuilds from the Parquet files alone, to the same text;
 * refusals (no results, mixed versions or revisions) write nothing;
@@ -23,13 +28,15 @@ import pandas as pd
 import pytest
 from click.testing import CliRunner
 
+import ftc_mc.sim.setup
+from ftc_mc.campaign.summary import agreement_text
 from ftc_mc.campaign.transitions import PAPER_TABLES, TRANSITION_TABLE
 from ftc_mc.cli import cli
 from ftc_mc.errors import UserError
 from ftc_mc.io.lock import acquire
 from ftc_mc.io.results import read_metadata, write_parquet
 from ftc_mc.report import build_report, exclusion_table, variant_comparison
-from ftc_mc.stats import wilson
+from ftc_mc.stats import agrees, two_proportion_p, wilson
 
 from result_dirs import copy_dir, same_stamp
 
@@ -93,10 +100,110 @@ def test_report_has_paper_and_our_numbers(inputs, report):
             if r.trials:
                 assert row[2] == _count(r.inappropriate, r.trials)
                 assert row[4] == _count(r.no_reset, r.trials)
+            assert row[-1] == agreement_text(summary.loc[r.Index])
     for heading in ("#### Signature `paper`", "#### Signature `swapped`",
                     "### Excluded trials", "### Which signature variant is better",
                     "### Event timeline beside the paper", "## Provenance"):
         assert heading in text
+
+
+def test_summary_of_a_small_run_records_the_verdict(inputs):
+    summary = pd.read_parquet(inputs[0] / "summary.parquet")
+    assert len(summary) == 2 * len(PAPER_TABLES)
+    for col in ("paper_agrees_inappropriate", "paper_agrees_no_reset", "paper_agrees"):
+        assert str(summary[col].dtype) == "boolean", col
+    for _, r in summary.iterrows():
+        n, *paper = PAPER_TABLES[r["transition"]]
+        each = []
+        for q, k in zip(("inappropriate", "no_reset"), paper):
+            p = two_proportion_p(r[q], r["trials"], k, n)
+            assert r[f"paper_p_{q}"] == p
+            assert r[f"paper_agrees_{q}"] == agrees(p)
+            each.append(agrees(p))
+        assert r["paper_agrees"] == all(each)
+    text = (inputs[0] / "summary.md").read_text(encoding="utf-8")
+    for _, r in summary.iterrows():
+        assert f"| {agreement_text(r)} " in text
+
+
+def test_report_shows_the_recorded_verdict(inputs, tmp_path):
+    """The report prints the verdict the summary holds; it does not judge again."""
+    run = copy_dir(inputs[0], tmp_path / "run")
+    path = run / "summary.parquet"
+    meta, summary = read_metadata(path), pd.read_parquet(path)
+    flipped = ~summary["paper_agrees"]  # the opposite of what the p-values say
+    forged = summary.assign(paper_p_inappropriate=0.5, paper_p_no_reset=0.25,
+                            paper_agrees_inappropriate=flipped, paper_agrees_no_reset=flipped,
+                            paper_agrees=flipped)
+    write_parquet(forged, path, meta)
+    text = build_report([run], tmp_path / "a.md").read_text(encoding="utf-8")
+    for variant, g in forged.groupby("variant"):
+        rows = _rows(text, f"#### Signature `{variant}`")
+        for row, (_, r) in zip(rows, g.iterrows()):
+            assert row[-1] == agreement_text(r)
+            assert row[-1] == ("agrees (p 0.5 / 0.25)" if r["paper_agrees"] else
+                               "differs: inappropriate, no reset (p 0.5 / 0.25)")
+    assert forged["paper_agrees"].any() and not forged["paper_agrees"].all()
+    old = summary.drop(columns=[c for c in summary if c.startswith(("paper_p_",
+                                                                    "paper_agrees"))])
+    write_parquet(old, path, meta)
+    text = build_report([run], tmp_path / "b.md").read_text(encoding="utf-8")
+    for variant in forged["variant"].unique():
+        assert {row[-1] for row in _rows(text, f"#### Signature `{variant}`")} == {
+            "not recorded"}
+
+
+def _no_setup(*args, **kwargs):
+    raise AssertionError("the controller names were rebuilt from the config")
+
+
+def test_report_names_the_recorded_controllers(inputs, tmp_path, monkeypatch):
+    monkeypatch.setattr(ftc_mc.sim.setup, "controller_names", _no_setup)
+    monkeypatch.setattr(ftc_mc.sim.setup, "build_setup", _no_setup)
+    scen = copy_dir(inputs[1], tmp_path / "scen")
+    meta = read_metadata(scen / "events.parquet")
+    assert meta["controller_names"] == ["c0 nominal", "c1 engine fault", "c2 elevon fault"]
+
+    def section(name):
+        text = build_report([scen], tmp_path / f"{name}.md").read_text(encoding="utf-8")
+        return text.split(f"## Scenario `{scen}`", 1)[1].split("\n## ", 1)[0]
+
+    assert ("Controllers flown (recorded with the result): `c0 nominal`, "
+            "`c1 engine fault`, `c2 elevon fault`.") in section("as_written")
+    for path in scen.glob("*.parquet"):  # other names recorded: the report prints them
+        m = read_metadata(path)
+        write_parquet(pd.read_parquet(path), path, {**m, "controller_names": ["k0 a", "k1 b"]})
+    assert "recorded with the result): `k0 a`, `k1 b`." in section("other")
+    for path in scen.glob("*.parquet"):  # a result written before the names were recorded
+        m = read_metadata(path)
+        m.pop("controller_names")
+        write_parquet(pd.read_parquet(path), path, m)
+    assert ("Controllers flown: `c0`, `c1`, `c2`, `c3` (codes only: the result was written "
+            "before `ftc-mc scenario` recorded their names).") in section("old")
+
+
+def test_fig11_labels_the_recorded_controllers(inputs, tmp_path, monkeypatch):
+    import ftc_mc.plots.scenario as plots
+    from ftc_mc.config import ScenarioConfig
+    from ftc_mc.scenario import ScenarioResult
+
+    monkeypatch.setattr(ftc_mc.sim.setup, "controller_names", _no_setup)
+    drawn = {}
+
+    def keep(fig, path):
+        drawn[Path(path).name] = [t.get_text() for t in fig.axes[0].get_yticklabels()]
+        return path
+
+    monkeypatch.setattr(plots, "save", keep)
+    d = inputs[1]
+    res = ScenarioResult(
+        timeseries=pd.read_parquet(d / "timeseries.parquet"),
+        events=pd.read_parquet(d / "events.parquet"),
+        segments=pd.read_parquet(d / "segments.parquet"),
+        config=ScenarioConfig.model_validate(read_metadata(d / "events.parquet")["config"]),
+        status="ok", controller_names=("c0 first", "c1 second", "c2 third", "c3 fourth"))
+    plots.scenario_figures(res, tmp_path)
+    assert drawn["fig11_controller.png"] == ["1 first", "2 second", "3 third", "4 fourth"]
 
 
 def test_report_has_scenario_timeline_and_provenance(inputs, report):

@@ -8,6 +8,11 @@
   closed forms at k = 0 (hi = -ln 0.025) and k = 1 (lo = -ln 0.975);
 * McNemar: the exact conditional p-value 2 P(X <= min(b, c)), X ~ Bin(b + c,
   1/2) (Fagerland et al. 2013), summed with ``math.comb``;
+* Fisher's exact two-proportion test: the hypergeometric probabilities of
+  the tables with the observed margins, summed with ``math.comb`` over those
+  no more probable than the observed one (Agresti 1992, section 2.1), and
+  Fisher's tea-tasting table 3/4 against 1/4, two-sided p = 34/70 (Fisher
+  1935, Agresti 1992 Table 1);
 * quantiles: linear interpolation between order statistics written out
   (Hyndman and Fan 1996, type 7).
 """
@@ -20,8 +25,8 @@ from statistics import NormalDist
 import numpy as np
 import pytest
 
-from ftc_mc.stats import (finite, finite_median, mcnemar_exact, median_p95, poisson_ci,
-                          poisson_rate, wilson)
+from ftc_mc.stats import (AGREEMENT_LEVEL, agrees, finite, finite_median, mcnemar_exact,
+                          median_p95, poisson_ci, poisson_rate, two_proportion_p, wilson)
 
 
 def _wilson_closed_form(k, n, confidence=0.95):
@@ -119,6 +124,53 @@ def test_mcnemar_exact_values():
     assert mcnemar_exact(1, 9) == pytest.approx(2 * 11 / 1024, rel=1e-12)  # 0.0215
     assert mcnemar_exact(0, 0) == 1.0
     assert mcnemar_exact(2, 2) == 1.0
+
+
+def _fisher_reference(k_a, n_a, k_b, n_b):
+    """Two-sided Fisher p-value: the hypergeometric probabilities of the tables
+    with the observed margins that are no more probable than the observed one
+    (relative tolerance 1e-7 for ties, as scipy's), summed."""
+    m = k_a + k_b  # the successes' margin
+
+    def prob(x):  # x successes in the first sample
+        return math.comb(n_a, x) * math.comb(n_b, m - x) / math.comb(n_a + n_b, m)
+
+    observed = prob(k_a)
+    xs = range(max(0, m - n_b), min(n_a, m) + 1)
+    return min(1.0, sum(prob(x) for x in xs if prob(x) <= observed * (1 + 1e-7)))
+
+
+@pytest.mark.parametrize("k_a,n_a,k_b,n_b", [(3, 4, 1, 4), (0, 20, 5, 20), (17, 1000, 0, 887),
+                                             (74, 1000, 157, 1000), (1, 1000, 9, 1000),
+                                             (5, 30, 5, 12), (70, 1000, 11, 1000)])
+def test_two_proportion_p_equals_the_hypergeometric_sum(k_a, n_a, k_b, n_b):
+    ref = _fisher_reference(k_a, n_a, k_b, n_b)
+    assert two_proportion_p(k_a, n_a, k_b, n_b) == pytest.approx(ref, rel=1e-9)
+    assert two_proportion_p(k_b, n_b, k_a, n_a) == pytest.approx(ref, rel=1e-9)  # symmetric
+
+
+def test_two_proportion_p_known_values():
+    # Fisher's lady tasting tea: 3 of 4 against 1 of 4; the tables with these margins
+    # have 0-4 successes in the first row with probabilities (1, 16, 36, 16, 1) / 70,
+    # and those no more probable than the observed 16 / 70 sum to 34 / 70
+    assert two_proportion_p(3, 4, 1, 4) == pytest.approx(34 / 70, rel=1e-12)
+    assert two_proportion_p(0, 1000, 0, 896) == 1.0  # equal (zero) counts
+    assert two_proportion_p(74, 1000, 74, 1000) == 1.0  # the same count twice
+    assert two_proportion_p(0, 1000, 999, 1000) < 1e-100  # as far apart as can be
+    assert np.isnan(two_proportion_p(0, 1000, 0, 0))  # no trial judged: nothing to compare
+    with pytest.raises(ValueError):
+        two_proportion_p(5, 4, 1, 4)
+
+
+def test_agreement_verdict():
+    assert AGREEMENT_LEVEL == 0.05
+    assert agrees(two_proportion_p(0, 1000, 0, 896)) is True
+    assert agrees(two_proportion_p(74, 1000, 74, 1000)) is True
+    assert agrees(two_proportion_p(0, 1000, 999, 1000)) is False
+    assert agrees(two_proportion_p(17, 1000, 0, 887)) is False  # p = 2.2e-5
+    assert agrees(np.nan) is None
+    assert agrees(0.05) is True and agrees(0.0499) is False  # p >= level agrees
+    assert agrees(0.2, level=0.25) is False
 
 
 def _type7(x, p):

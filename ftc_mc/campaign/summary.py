@@ -1,7 +1,9 @@
 """The Tables 2-3 summary: one row per transition and signature variant.
 
 Rates carry 95 % Wilson score intervals (:func:`ftc_mc.stats.wilson`).  The
-paper's own counts stand beside ours.
+paper's own counts stand beside ours, with the verdict whether ours agree with
+them (:func:`paper_agreement`: a two-sided Fisher exact test per quantity,
+``docs/findings/paper-tables.md``, "How agreement is judged").
 
 A sensor transition (``sensor_<kind>:<output>``) has no correct
 actuator block, so its row has no Tables 2-3 columns (inappropriate, no reset,
@@ -15,7 +17,7 @@ import numpy as np
 import pandas as pd
 
 from ..core.longitudinal.trial import STATUS_NAMES
-from ..stats import median_p95, wilson
+from ..stats import agrees, median_p95, two_proportion_p, wilson
 from .chunk import COST_COLUMNS
 from .scoring import real_flight_scores
 from .transitions import TRANSITION_TABLE, is_sensor, paper_counts, transition_of
@@ -70,7 +72,8 @@ def summarize(trials: pd.DataFrame) -> pd.DataFrame:
     side (the ``correct_side`` trial column; rate NaN where no trial applies:
     engine rows, recoveries, and tables written before the column existed).
     The paper's counts (``paper_*``) are NaN in the right elevon's rows, which
-    the paper did not run.
+    the paper did not run; where they stand, :func:`paper_agreement` adds the
+    verdict whether ours agree with them (``paper_p_*``, ``paper_agrees*``).
 
     Only judged trials (``judged`` column: no numerical failure, inside the
     validity envelope through the judging window, all resets stored) enter the
@@ -143,6 +146,7 @@ def summary_row(name: str, variant: str, g: pd.DataFrame) -> dict:
     row.update(_quantiles("detection", ok["detection_s"].to_numpy()))
     row.update({"paper_trials": paper[0], "paper_inappropriate": paper[1],
                 "paper_no_reset": paper[2]})
+    row.update(paper_agreement(row))
     row.update(real_flight_scores(name, ok))  # ALFA and FDDBenchmark (scoring.py)
     side = _column(ok, "correct_side")
     applies = np.isfinite(side)
@@ -151,6 +155,78 @@ def summary_row(name: str, variant: str, g: pd.DataFrame) -> dict:
     row.update(lateral_summary(g))
     row.update(cost_summary(ok))
     return row
+
+
+AGREEMENT_QUANTITIES = ("inappropriate", "no_reset")
+"""The two counts of Tables 2-3 that :func:`paper_agreement` judges."""
+AGREEMENT_COLUMNS = ("paper_agrees_inappropriate", "paper_agrees_no_reset", "paper_agrees")
+"""The verdict columns (nullable booleans: NA where there is no verdict)."""
+
+
+def paper_agreement(row: dict) -> dict:
+    """Whether the counts of a summary row agree with the paper's.
+
+    Per quantity of :data:`AGREEMENT_QUANTITIES`, our count of the judged trials
+    (``row[q]`` of ``row["trials"]``) against the paper's (``row["paper_" + q]``
+    of ``row["paper_trials"]``): the p-value of the two-sided Fisher exact test
+    (:func:`ftc_mc.stats.two_proportion_p`) and whether it finds agreement at
+    5 % (:func:`ftc_mc.stats.agrees`).  The row agrees only if both quantities
+    do.
+
+    Parameters
+    ----------
+    row : dict
+        A summary row with the counts, ``trials`` and the paper's counts
+        (:func:`~ftc_mc.campaign.transitions.paper_counts`).
+
+    Returns
+    -------
+    dict
+        ``paper_p_inappropriate``, ``paper_p_no_reset`` (NaN where not
+        compared), ``paper_agrees_inappropriate``, ``paper_agrees_no_reset`` and
+        ``paper_agrees`` (None: no verdict, for a row the paper did not run or
+        with no judged trial).
+    """
+    out = {}
+    for q in AGREEMENT_QUANTITIES:
+        paper_n, paper_k = row["paper_trials"], row[f"paper_{q}"]
+        p = (two_proportion_p(row[q], row["trials"], paper_k, paper_n)
+             if np.isfinite(paper_n) and np.isfinite(paper_k) else np.nan)
+        out[f"paper_p_{q}"] = p
+        out[f"paper_agrees_{q}"] = agrees(p)
+    each = [out[f"paper_agrees_{q}"] for q in AGREEMENT_QUANTITIES]
+    out["paper_agrees"] = None if None in each else all(each)
+    return out
+
+
+def p_text(p: float) -> str:
+    """A p-value to two significant digits; ``<1e-300`` where it underflowed to 0."""
+    return "<1e-300" if p == 0 else f"{p:.2g}"
+
+
+def agreement_text(r) -> str:
+    """The verdict of a summary row in words, with the p-values it rests on.
+
+    ``agrees (p 0.61 / 0.28)``, ``differs: no reset (p 1 / 3.1e-09)`` (the
+    p-values of inappropriate / no reset, the quantities that differ named);
+    ``not in the paper`` for a row the paper did not run (the right elevon's:
+    no verdict); ``-`` for a paper row without a judged trial; ``not
+    recorded`` for a summary written before the verdict columns.
+    """
+    if "paper_agrees" not in r:
+        return "not recorded"
+    if not np.isfinite(float(r["paper_trials"])):
+        return "not in the paper"
+    verdict = r["paper_agrees"]
+    if verdict is None or verdict is pd.NA or (isinstance(verdict, float)
+                                              and not np.isfinite(verdict)):
+        return "-"
+    ps = " / ".join(p_text(r[f"paper_p_{q}"]) for q in AGREEMENT_QUANTITIES)
+    if verdict:
+        return f"agrees (p {ps})"
+    differ = [q.replace("_", " ") for q in AGREEMENT_QUANTITIES
+              if r[f"paper_agrees_{q}"] is not pd.NA and not r[f"paper_agrees_{q}"]]
+    return f"differs: {', '.join(differ)} (p {ps})"
 
 
 def cost_summary(ok: pd.DataFrame) -> dict:
@@ -211,6 +287,9 @@ def summary_frame(rows, transitions, variants) -> pd.DataFrame:
         out = out.sort_values(["transition", "variant"],
                               key=lambda s: s.map(order if s.name == "transition" else vorder),
                               kind="stable").reset_index(drop=True)
+        for col in AGREEMENT_COLUMNS:  # True / False / NA, also beside sensor rows
+            if col in out:
+                out[col] = out[col].astype("boolean")
     return out
 
 
@@ -349,8 +428,8 @@ def markdown_table(summary: pd.DataFrame) -> str:
     Columns: transition, variant, trials, inappropriate (rate, 95 % CI), no reset
     (rate, CI, share explained), correct, median / p95 reset delay, false alarms,
     detection median, correct side (``k/n``, rate, 95 % CI; ``-`` outside the
-    elevon-fault trials), and the paper's counts (``-`` for the right elevon's
-    rows).
+    elevon-fault trials), the paper's counts (``-`` for the right elevon's
+    rows) and whether ours agree with them (:func:`agreement_text`).
     """
     def pct(r, p):
         return (f"{r[p]} ({100 * r[p + '_rate']:.1f} %, "
@@ -377,7 +456,18 @@ def markdown_table(summary: pd.DataFrame) -> str:
             "detection median [s]": num(r["detection_median_s"]),
             "correct side (%, 95% CI)": side_text(r),
             "paper: inappropriate / no reset": paper_text(r),
+            "agrees with the paper? (p inappr. / no reset)": agreement_text(r),
             **extra_columns(r),
         })
     table = pd.DataFrame(rows).to_markdown(index=False)
+    if (summary["paper_trials"].notna().any() if "paper_trials" in summary else False):
+        table += ("\n\n" + AGREEMENT_NOTE)
     return table + ("\n\n" + sensor if sensor else "")
+
+
+AGREEMENT_NOTE = ("*Agrees with the paper?*: per quantity, our count of the judged trials "
+                  "against the paper's of 1000, two-sided Fisher exact test at 5 %; a row "
+                  "agrees only if both quantities do (`-`: no trial judged). "
+                  "Agreement means no difference this test can detect, not equality "
+                  "(docs/findings/paper-tables.md, \"How agreement is judged\").")
+"""The sentence under a table with the verdict column (``summary.md``, the report)."""

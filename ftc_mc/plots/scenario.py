@@ -4,7 +4,6 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..sim.setup import controller_names
 from .figure import plt, save
 
 
@@ -20,7 +19,9 @@ def scenario_figures(res, out: Path) -> list:
     ----------
     res : ftc_mc.scenario.ScenarioResult
         One flight: its time series (time [s], errors [m], fault parameters,
-        residuals, beliefs, controller, commands) and its config (schedule).
+        residuals, beliefs, controller, commands), its config (schedule) and
+        the names of the controllers it flew (``controller_names``, as recorded:
+        Fig. 11 labels its codes with them, nothing is rebuilt from the config).
     out : Path
         Folder of the PNG files (``fig06_trajectory.png`` ... ``fig12_commands.png``).
 
@@ -96,8 +97,8 @@ def scenario_figures(res, out: Path) -> list:
 
     fig, ax = plt.subplots(figsize=(8, 2.8))
     ax.step(t, ts.controller + 1, where="post")
-    names = controller_names(res.config)
-    ax.set_yticks(range(1, len(names) + 1), [f"{i + 1} {n.split(' ', 1)[1]}"
+    names = res.controller_names
+    ax.set_yticks(range(1, len(names) + 1), [f"{i + 1} {n.split(' ', 1)[-1]}"
                                                for i, n in enumerate(names)])
     ax.set_xlabel("time [s]")
     _switch_lines(ax, res)

@@ -1,7 +1,8 @@
 """The report section of one run (``ftc-mc run``).
 
 Tables 2-3 beside the paper's counts, per signature variant, with 95 % Wilson
-intervals (:func:`paper_tables`); the excluded trials and why
+intervals and the verdict whether ours agree with the paper's, as the summary
+recorded it (:func:`paper_tables`; the report does not judge again); the excluded trials and why
 (:func:`exclusion_table`); a paired comparison of the signature variants with
 an exact McNemar test (:func:`variant_comparison`); a link to the delay figure
 (``ftc_mc/plots/campaign.py``).
@@ -15,7 +16,8 @@ import numpy as np
 import pandas as pd
 
 from ..conventions import VARIANTS
-from ..stats import mcnemar_exact, wilson
+from ..campaign.summary import AGREEMENT_NOTE, agreement_text
+from ..stats import mcnemar_exact
 from .load import ResultDir
 from .markdown import LABELS, count, label, num, plant_text, rel_link
 
@@ -45,20 +47,6 @@ def _side(r: pd.Series) -> str:
     return count(int(r["correct_side"]), int(r["correct_side_trials"]))
 
 
-def _vs_paper(r: pd.Series) -> str:
-    """Where our 95 % interval lies wholly above or below the paper's."""
-    if not _has_paper(r):
-        return "not in the paper"
-    notes = []
-    for col in ("inappropriate", "no_reset"):
-        lo, hi = wilson(r[f"paper_{col}"], r["paper_trials"])
-        if r["trials"] and r[f"{col}_ci_low"] > hi:
-            notes.append(f"{col.replace('_', ' ')} higher")
-        elif r["trials"] and r[f"{col}_ci_high"] < lo:
-            notes.append(f"{col.replace('_', ' ')} lower")
-    return ", ".join(notes) or "consistent"
-
-
 def _paper_row(r: pd.Series) -> dict:
     """One row of the ours-beside-the-paper table."""
     n = int(r["trials"])
@@ -76,7 +64,7 @@ def _paper_row(r: pd.Series) -> dict:
             f"{num(r['detection_median_s'])} / {num(r['detection_p95_s'])}",
         "false-alarm trials": int(r["false_alarm_trials"]),
         "correct side": _side(r),
-        "95 % CIs vs paper": _vs_paper(r),
+        "agrees with the paper? (p inappr. / no reset)": agreement_text(r),
     }
 
 
@@ -104,8 +92,9 @@ def paper_tables(summary: pd.DataFrame) -> list:
               "*Correct side*: of the judged trials whose final mode is an elevon fault, "
               "those whose belief at the end of the judging window holds the faulty "
               "elevon more probable than the other (`correct_side_rate`; `-` in other "
-              "rows). *95 % CIs vs paper* says where our interval lies wholly above or "
-              "below the paper's.", ""]
+              "rows). " + AGREEMENT_NOTE + " The verdict is the one `summary.parquet` "
+              "recorded (`paper_agrees*`, `paper_p_*`); *not recorded*: a summary written "
+              "before those columns.", ""]
     return lines
 
 

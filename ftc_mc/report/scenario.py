@@ -2,7 +2,10 @@
 
 The event timeline beside the paper's (section 5.2, :data:`ftc_mc.paper.PAPER_TIMELINE`),
 the controller switches and excitations beside the paper's, every event, and
-links to the scenario's own figures (the report does not redraw them).
+links to the scenario's own figures (the report does not redraw them).  The
+names of the controllers flown are the ones ``ftc-mc scenario`` recorded in the
+files' metadata (:func:`recorded_controller_names`), never rebuilt from the
+config.
 """
 
 from __future__ import annotations
@@ -15,6 +18,45 @@ import pandas as pd
 from ..paper import PAPER_EXCITATIONS, PAPER_TIMELINE
 from .load import ResultDir
 from .markdown import controller_of, num, plant_text, rel_link
+
+
+GENERIC_CONTROLLER_NAMES = ("c0", "c1", "c2", "c3")
+"""Names of the controller codes of a scenario written before the names were
+recorded: the codes alone (the paper's three, or four with a
+``lock_turn_selected`` design; which, the result does not say)."""
+
+
+def recorded_controller_names(meta: dict) -> tuple:
+    """The names of the controller codes a scenario flew, as recorded.
+
+    Parameters
+    ----------
+    meta : dict
+        The ``ftc_mc`` metadata of a scenario's Parquet file.
+
+    Returns
+    -------
+    (tuple of str, bool)
+        The names, indexed by controller code, and whether they were recorded;
+        a result written before ``ftc-mc scenario`` recorded them gets
+        :data:`GENERIC_CONTROLLER_NAMES` and False (the report does not
+        rebuild them from the config: today's code may name them otherwise
+        than the code that flew).
+    """
+    names = meta.get("controller_names")
+    if names:
+        return tuple(names), True
+    return GENERIC_CONTROLLER_NAMES, False
+
+
+def controller_line(meta: dict) -> str:
+    """The sentence naming the controllers a scenario flew (:func:`recorded_controller_names`)."""
+    names, recorded = recorded_controller_names(meta)
+    listed = ", ".join(f"`{n}`" for n in names)
+    if recorded:
+        return f"Controllers flown (recorded with the result): {listed}."
+    return (f"Controllers flown: {listed} (codes only: the result was written before "
+            "`ftc-mc scenario` recorded their names).")
 
 
 def _in_segment(ev: pd.DataFrame, kind: str, t0: float, t1: float) -> pd.DataFrame:
@@ -131,7 +173,7 @@ def scenario_section(r: ResultDir, report: Path) -> list:
              f"`{controller_of(r.meta.get('config', {}), sc.get('design'))}`, seed "
              f"{sc.get('seed', '?')}, {sc.get('duration_s', '?')} s, "
              f"{len(sc.get('schedule', []))} schedule entries, "
-             f"{plant_text(r.meta.get('config', {}))}.", "",
+             f"{plant_text(r.meta.get('config', {}))}.", "", controller_line(r.meta), "",
              "### Event timeline beside the paper", ""] + timeline_table(seg, ev)
             + ["### Controller switches and excitations", ""] + switches_and_excitations(ev)
             + ["<details><summary>All events</summary>", "", details, "", "</details>", "",

@@ -46,6 +46,11 @@ class ScenarioResult:
     config : ScenarioConfig
     status : str
         ``ok`` or why the run stopped being trusted (see core/longitudinal/trial.py).
+    controller_names : tuple of str
+        The name of each controller code the design flew (the ``controller``
+        column's values index it): recorded with the result, so figures and
+        reports drawn later read what was flown instead of rebuilding it from
+        the config with code that may have changed.
     """
 
     timeseries: pd.DataFrame
@@ -53,6 +58,7 @@ class ScenarioResult:
     segments: pd.DataFrame
     config: ScenarioConfig
     status: str
+    controller_names: tuple
 
 
 def run_scenario(sc: ScenarioConfig, seed: int | None = None,
@@ -87,7 +93,7 @@ def run_scenario(sc: ScenarioConfig, seed: int | None = None,
     status = STATUS_NAMES[int(rec.status[0])]
     segments["run_status"] = status
     return ScenarioResult(timeseries=ts, events=events, segments=segments, config=sc,
-                          status=status)
+                          status=status, controller_names=tuple(controller_names(sc)))
 
 
 LATERAL_COLUMNS = ("y", "phi", "psi", "v", "p", "r")

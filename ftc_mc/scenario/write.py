@@ -14,6 +14,10 @@ def write_scenario(res: ScenarioResult, out: Path, meta: dict) -> list:
     """Write timeseries.parquet, events.parquet, segments.parquet, the figures
     (:func:`ftc_mc.plots.scenario_figures`) and summary.md to ``out``.
 
+    Each Parquet file's metadata is ``meta`` plus ``controller_names``, the
+    names of the controller codes flown (:attr:`ScenarioResult.controller_names`),
+    which the report reads instead of finding them again.
+
     Returns
     -------
     list of Path
@@ -22,6 +26,7 @@ def write_scenario(res: ScenarioResult, out: Path, meta: dict) -> list:
     from ..plots import scenario_figures  # matplotlib: imported only to write figures
 
     out.mkdir(parents=True, exist_ok=True)
+    meta = {**meta, "controller_names": list(res.controller_names)}
     write_parquet(res.timeseries, out / "timeseries.parquet", meta)
     write_parquet(res.events, out / "events.parquet", meta)
     write_parquet(res.segments, out / "segments.parquet", meta)
