@@ -579,10 +579,21 @@ def report(dirs, output, allow_mixed):
 def score(run_dir, detector, out, name):
     """Score your own detector on RUN_DIR's recorded signals (ftc-mc run or endurance
     --record signals) by the built-in designs' definitions: Tables 2-3 and the ALFA
-    scores, or false alarms per flight hour."""
+    scores, or false alarms per flight hour.
+
+    The detector is passed what the aircraft sees (measurements, commands,
+    excitation, the flown design's innovations, statistics, resets and belief);
+    the truth (mode, b0_*, b1_*) only when its `columns` names it, and then its
+    rows are marked as reading the truth.
+    """
     from . import api
 
     res = api.score_detector(run_dir, detector, out=out, name=name)
+    if res["summary"]["reads_truth"].any():
+        from .campaign.signals import TRUTH_COLUMNS
+        truth = [c for c in res["columns"] if c in TRUTH_COLUMNS]
+        click.echo(f"reads the truth ({', '.join(truth)}): an oracle, not a detector an "
+                   "aircraft could fly")
     if "trials" in res:
         from .campaign.summary import actuator_rows
         acts = actuator_rows(res["summary"])

@@ -10,8 +10,13 @@ A *detector* is a plain NumPy function::
         # or: return alarm_s, block       # block: (trials,) "thrust" / "elevons",
         #                                 # an actuator name, or "" where unnamed
 
-A detector with an attribute ``columns`` (a tuple of signal names) receives only
-those, in that order: less to read.  Row ``j`` of ``signals`` holds the step that reached sample ``j + 1`` (time
+A detector sees what the aircraft sees: by default the observable columns, every
+signal column but the truth (:data:`ftc_mc.campaign.signals.TRUTH_COLUMNS`: the
+true ``mode`` and each actuator's ``b0_*``, ``b1_*``).  A detector with an
+attribute ``columns`` (a tuple of signal names) receives only those, in that
+order: less to read.  It gets a truth column only when ``columns`` names it, and
+then its rows are marked as having read the truth (``reads_truth``: an oracle,
+not a detector an aircraft could fly).  Row ``j`` of ``signals`` holds the step that reached sample ``j + 1`` (time
 ``(j + 1) dt``, the ``step`` column of ``signals/``).  It is called once per
 signals file (one chunk of trials) and design, with the signals of the loop
 that design flew: the detector sees them *open loop*, it cannot act on them
@@ -54,7 +59,7 @@ from ..conventions import LONGITUDINAL as LAY
 from ..conventions import MODE_NAMES, MODE_NOMINAL, NO_RESET
 from ..errors import UserError
 from ..io.results import META_KEY
-from .signals import KEYS, signal_files
+from .signals import KEYS, TRUTH_COLUMNS, signal_files
 from .summary import summary_frame, summary_row
 from .transitions import TRANSITION_TABLE, is_sensor
 
@@ -107,9 +112,19 @@ consecutive chunk files of a transition are joined up to it (fewer, larger
 calls; 16 MB of float32, whatever the run's size)."""
 
 
-def batches(run_dir, columns=None):
+def batches(run_dir, columns=None, truth: bool = True):
     """The recorded signals of a run, in batches of one transition and design
     (consecutive chunk files joined up to :data:`BATCH_VALUES` values).
+
+    Parameters
+    ----------
+    run_dir : str or Path
+    columns : sequence of str, optional
+        The signal columns to read, in this order (default: all of a file's).
+    truth : bool
+        With ``columns`` None, whether the truth columns
+        (:data:`~ftc_mc.campaign.signals.TRUTH_COLUMNS`, the labels of a learned
+        detector's training) are among them; the scoring passes False.
 
     Yields
     ------
@@ -129,7 +144,8 @@ def batches(run_dir, columns=None):
     group, group_name, values = [], None, 0
     for f in files:
         have = pq.read_schema(f).names
-        names = tuple(c for c in have if c not in KEYS) if columns is None \
+        names = tuple(c for c in have if c not in KEYS
+                      and (truth or c not in TRUTH_COLUMNS)) if columns is None \
             else tuple(columns)
         missing = [c for c in names if c not in have]
         if missing:
@@ -288,7 +304,9 @@ def score_detector(run_dir, detector, out=None, name: str | None = None) -> dict
         A run (``ftc-mc run --record signals``) or endurance run
         (``ftc-mc endurance --record signals``) directory.
     detector : callable or str
-        The detector (module docstring), or ``"module:function"``.
+        The detector (module docstring), or ``"module:function"``.  It is
+        passed the observable signal columns, or those its ``columns``
+        attribute names (a truth column only then: ``reads_truth``).
     out : str or Path, optional
         Where to write ``trials.parquet`` and ``summary.parquet`` (a run) or
         ``endurance.parquet`` (an endurance run) of the detector, and
@@ -301,8 +319,10 @@ def score_detector(run_dir, detector, out=None, name: str | None = None) -> dict
     -------
     dict
         ``summary`` (DataFrame, one row per transition and design the signals
-        came from, variant ``<name>@<design>``), ``trials`` (a run) or
-        ``flights`` (an endurance run), and ``out`` (the folder written).
+        came from, variant ``<name>@<design>``, ``reads_truth`` whether the
+        detector read a truth column), ``trials`` (a run) or ``flights`` (an
+        endurance run), ``out`` (the folder written) and ``columns`` (the
+        signal columns the detector was passed).
 
     Raises
     ------
@@ -327,8 +347,9 @@ def score_detector(run_dir, detector, out=None, name: str | None = None) -> dict
     by = ["variant"] if endurance else ["transition", "variant"]
     flown_of = {k if isinstance(k, tuple) else (k,): g.set_index(key)
                 for k, g in flown_all.groupby(by if len(by) > 1 else by[0], sort=False)}
-    parts = []
-    for tr, design, ids, sig, names in batches(run_dir, getattr(detector, "columns", None)):
+    parts, names = [], ()
+    for tr, design, ids, sig, names in batches(run_dir, getattr(detector, "columns", None),
+                                               truth=False):
         if not endurance and is_sensor(tr):
             continue
         where = f"{tr} trials {ids[0]}-{ids[-1]} of {design}"
@@ -345,6 +366,7 @@ def score_detector(run_dir, detector, out=None, name: str | None = None) -> dict
         g["variant"] = f"{name}@{design}"
         g["design"] = design
         parts.append(g)
+    reads_truth = any(c in TRUTH_COLUMNS for c in names)
     rows = pd.concat(parts, ignore_index=True) if parts else pd.DataFrame()
     if endurance:
         summary = _endurance_summary(rows, cfg)
@@ -356,9 +378,19 @@ def score_detector(run_dir, detector, out=None, name: str | None = None) -> dict
                                  for t in transitions for v in variants
                                  if ((rows["transition"] == t) & (rows["variant"] == v)).any()],
                                 transitions, variants)
+    summary["reads_truth"] = reads_truth
     folder = Path(out) if out is not None else run_dir / "detectors" / name
-    _write(folder, rows, summary, endurance, {**meta, "detector": name})
-    return {"summary": summary, ("flights" if endurance else "trials"): rows, "out": folder}
+    _write(folder, rows, summary, endurance,
+           {**meta, "detector": name, "detector_columns": list(names),
+            "reads_truth": reads_truth})
+    return {"summary": summary, ("flights" if endurance else "trials"): rows,
+            "out": folder, "columns": names}
+
+
+TRUTH_NOTE = ("**Reads the truth** ({columns}): an oracle, not a detector an aircraft "
+              "could fly.")
+"""The line of ``summary.md`` (and the report) above a detector that read a
+truth column."""
 
 
 def _endurance_summary(flights: pd.DataFrame, cfg: dict) -> pd.DataFrame:
@@ -389,6 +421,9 @@ def _write(folder: Path, rows, summary, endurance: bool, meta: dict) -> None:
         md = endurance_markdown(summary)
     else:
         md = markdown_table(summary)
+    if meta["reads_truth"]:
+        truth = [c for c in meta["detector_columns"] if c in TRUTH_COLUMNS]
+        md = TRUTH_NOTE.format(columns=", ".join(f"`{c}`" for c in truth)) + "\n\n" + md
     write_text(folder / "summary.md", f"# detector {meta['detector']}\n\n{md}\n")
 
 

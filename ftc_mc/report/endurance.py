@@ -69,9 +69,13 @@ def _fmt(x, f="{:.3g}") -> str:
 
 
 def endurance_table(summary: pd.DataFrame) -> str:
-    """The per-design table of an endurance run, in Markdown."""
+    """The per-design table of an endurance run, in Markdown: a detector's rows
+    (``ftc-mc score``) that read the truth are marked an oracle."""
+    from .runs import reads_truth
+    oracle = reads_truth(summary).to_numpy()
     view = pd.DataFrame({
-        "design": summary["variant"],
+        "design": [f"{v} (oracle: read the truth)" if o else v
+                   for v, o in zip(summary["variant"], oracle)],
         "t_q / t_nx": [f"{a:g} / {b:g}" for a, b in zip(summary["t_q"], summary["t_nx"])],
         "flights (judged)": [f"{a} ({b})" for a, b in zip(summary["flights"],
                                                          summary["judged"])],
