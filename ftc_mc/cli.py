@@ -571,10 +571,11 @@ def report(dirs, output, allow_mixed):
               help="Your detector: a NumPy function (signals, names, dt) -> alarm times "
               "[s] per trial (NaN: none), optionally with the block it names "
               "(docs/guides/your-detector.md).")
-@click.option("-o", "--out", type=click.Path(file_okay=False),
+@click.option("-o", "--out", type=click.Path(),
               help="Folder of the detector's tables [default: RUN_DIR/detectors/<function>/, "
-              "which ftc-mc report reads].")
-@click.option("--name", help="The detector's name in the tables [default: its function name].")
+              "which ftc-mc report reads]; inside RUN_DIR only below detectors/.")
+@click.option("--name", help="The detector's name in the tables, a plain name (letters, "
+              "digits, _ . + -), never a path [default: its function name].")
 @user_errors
 def score(run_dir, detector, out, name):
     """Score your own detector on RUN_DIR's recorded signals (ftc-mc run or endurance
@@ -584,7 +585,8 @@ def score(run_dir, detector, out, name):
     The detector is passed what the aircraft sees (measurements, commands,
     excitation, the flown design's innovations, statistics, resets and belief);
     the truth (mode, b0_*, b1_*) only when its `columns` names it, and then its
-    rows are marked as reading the truth.
+    rows are marked as reading the truth. A bad input (name, run folder, signals,
+    the detector's return) is refused with one line and nothing written.
     """
     from . import api
 

@@ -225,7 +225,7 @@ def shape(s, names, dt):
 def inf(s, names, dt):
     return np.full(s.shape[0], np.inf)
 def block(s, names, dt):
-    return np.zeros(s.shape[0]), np.full(s.shape[0], "rudder")
+    return np.full(s.shape[0], 6.0), np.full(s.shape[0], "rudder")
 '''
 
 
