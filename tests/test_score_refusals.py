@@ -478,3 +478,16 @@ def test_the_api_refuses_too(sandbox):
             ftc_mc.score_detector(run, **kwargs)
         assert "\n" not in str(err.value)
     assert _tree(sandbox) == before
+
+
+def test_a_run_being_written(sandbox):
+    """A run folder another ftc-mc command holds is not scored."""
+    from ftc_mc.io.lock import acquire
+    run = sandbox / "run"
+    with acquire(run, "ftc-mc run cfg.yaml"):
+        before = _tree(sandbox)
+        r = CliRunner().invoke(cli, ["score", str(run), "--detector", GOOD])
+        assert _tree(sandbox) == before
+    assert r.exit_code == 2, r.output
+    lines = r.output.strip().splitlines()
+    assert len(lines) == 1 and "being written by `ftc-mc run cfg.yaml`" in lines[0], r.output
