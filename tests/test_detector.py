@@ -261,8 +261,10 @@ def test_run_without_signals(tmp_path):
     assert _digest(tmp_path / "plain") == before
 
 
-def test_endurance_records_and_scores(tmp_path):
-    """Fault-free flights recorded: a detector's false alarms per flight hour."""
+def test_endurance_records_and_scores(tmp_path, monkeypatch):
+    """Fault-free flights recorded: a detector's false alarms per flight hour, in
+    the run's condition (plant, turbulence), without thresholds."""
+    monkeypatch.chdir(ROOT)
     cfg = {k: v for k, v in CFG.items() if k != "timing"}
     cfg["campaign"] = {**CFG["campaign"], "signature": "paper"}
     ftc_mc.run_endurance(cfg, 0.02, flight_s=15.0, out=tmp_path / "end", record="signals",
@@ -276,12 +278,19 @@ def test_endurance_records_and_scores(tmp_path):
     np.testing.assert_array_equal(res["flights"]["false_resets"].to_numpy() > 0,
                                   flights["false_resets"].to_numpy() > 0)
     built_in = pd.read_parquet(tmp_path / "end" / "endurance.parquet").iloc[0]
-    for c in ("flight_hours", "false_resets_per_hour_ci_high", "false_resets_per_hour_upper95"):
+    for c in ("flight_hours", "false_resets_per_hour_ci_high", "false_resets_per_hour_upper95",
+              "plant", "turbulence", "airframe"):
         assert s[c] == built_in[c], c  # first alarm = first reset: the same flights
+    r = CliRunner().invoke(cli, ["score", str(tmp_path / "end"), "--detector",
+                                 "examples.cusum:cusum", "-o", str(tmp_path / "c")])
+    assert r.exit_code == 0, r.output
+    assert "nan" not in r.output and "| cusum@paper | -" in r.output
+    md = (tmp_path / "c" / "summary.md").read_text()
+    assert f"| {built_in['plant']} / {built_in['turbulence']} " in md and "nan" not in md
 
     assert (tmp_path / "end" / "detectors" / "table1_paper" / "endurance.parquet").exists()
     md = ftc_mc.build_report([str(tmp_path / "end")], tmp_path / "r.md").read_text()
-    assert "table1_paper@paper" in md
+    assert "table1_paper@paper" in md and "nan / nan" not in md
 
 
 def test_a_sweep_does_not_record(tmp_path):
