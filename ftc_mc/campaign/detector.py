@@ -669,8 +669,8 @@ def score_detector(run_dir, detector, out=None, name: str | None = None) -> dict
 
 TRUTH_NOTE = ("**Reads the truth** ({columns}): an oracle, not a detector an aircraft "
               "could fly.")
-"""The line of ``summary.md`` (and the report) above a detector that read a
-truth column."""
+"""The line of ``summary.md`` above the table of a detector that read a truth
+column (the report heads its rows *Oracle*: :func:`ftc_mc.report.runs.paper_tables`)."""
 
 
 def _endurance_summary(flights: pd.DataFrame, config) -> pd.DataFrame:
