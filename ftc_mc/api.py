@@ -645,19 +645,24 @@ def score_detector(run_dir, detector, *, out=None, name=None):
         Folder of the detector's tables (default ``run_dir/detectors/<name>/``,
         which ``ftc-mc report`` reads).
     name : str, optional
-        The detector's name in the tables (default its function name).
+        The detector's name in the tables (default its function name): a plain
+        name, never a path.
 
     Returns
     -------
     dict
-        ``summary``, ``trials`` (or ``flights``) and ``out``.
+        ``summary``, ``trials`` (or ``flights``), ``columns`` (the signal
+        columns the detector was passed: the observable ones, or those its
+        ``columns`` attribute names) and ``out``.
 
     Raises
     ------
     UserError
-        A module that cannot be imported, a run recorded without signals, a
-        detector that raises or returns the wrong shape or infinite alarm
-        times; nothing is written then.
+        A bad name or output folder, a module that cannot be imported, a run
+        folder, table, metadata or signals file that is missing, damaged or
+        inconsistent, a run recorded without signals, a detector that raises
+        or returns anything but one valid alarm time (and block) per trial;
+        nothing is written then.
     """
     from .campaign.detector import score_detector as score
 

@@ -571,18 +571,31 @@ def report(dirs, output, allow_mixed):
               help="Your detector: a NumPy function (signals, names, dt) -> alarm times "
               "[s] per trial (NaN: none), optionally with the block it names "
               "(docs/guides/your-detector.md).")
-@click.option("-o", "--out", type=click.Path(file_okay=False),
+@click.option("-o", "--out", type=click.Path(),
               help="Folder of the detector's tables [default: RUN_DIR/detectors/<function>/, "
-              "which ftc-mc report reads].")
-@click.option("--name", help="The detector's name in the tables [default: its function name].")
+              "which ftc-mc report reads]; inside RUN_DIR only below detectors/.")
+@click.option("--name", help="The detector's name in the tables, a plain name (letters, "
+              "digits, _ . + -), never a path [default: its function name].")
 @user_errors
 def score(run_dir, detector, out, name):
     """Score your own detector on RUN_DIR's recorded signals (ftc-mc run or endurance
     --record signals) by the built-in designs' definitions: Tables 2-3 and the ALFA
-    scores, or false alarms per flight hour."""
+    scores, or false alarms per flight hour.
+
+    The detector is passed what the aircraft sees (measurements, commands,
+    excitation, the flown design's innovations, statistics, resets and belief);
+    the truth (mode, b0_*, b1_*) only when its `columns` names it, and then its
+    rows are marked as reading the truth. A bad input (name, run folder, signals,
+    the detector's return) is refused with one line and nothing written.
+    """
     from . import api
 
     res = api.score_detector(run_dir, detector, out=out, name=name)
+    if res["summary"]["reads_truth"].any():
+        from .campaign.signals import TRUTH_COLUMNS
+        truth = [c for c in res["columns"] if c in TRUTH_COLUMNS]
+        click.echo(f"reads the truth ({', '.join(truth)}): an oracle, not a detector an "
+                   "aircraft could fly")
     if "trials" in res:
         from .campaign.summary import actuator_rows
         acts = actuator_rows(res["summary"])

@@ -12,7 +12,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 TRIAL_KERNEL_FILES = {
     "test_airframe_runs.py", "test_api.py", "test_big_runs.py", "test_campaign.py",
-    "test_detector.py",
+    "test_detector.py", "test_score_refusals.py",
     "test_compile_notice.py", "test_dask.py", "test_designs.py", "test_fuzz_configs.py",
     "test_golden.py", "test_lock.py", "test_operating.py", "test_report.py",
     "test_report_plant.py", "test_reset_scale.py", "test_resume.py", "test_scenario.py",

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import hashlib
 import os
+import shutil
 from pathlib import Path
 
 import numpy as np
@@ -13,8 +14,8 @@ import pytest
 from click.testing import CliRunner
 
 import ftc_mc
-from ftc_mc.campaign.detector import table1_detector
-from ftc_mc.campaign.signals import KEYS, signal_columns, signal_files
+from ftc_mc.campaign.detector import batches, table1_detector
+from ftc_mc.campaign.signals import KEYS, TRUTH_COLUMNS, signal_columns, signal_files
 from ftc_mc.cli import cli
 from ftc_mc.conventions import LONGITUDINAL as LAY
 
@@ -158,6 +159,63 @@ def test_learned_example(recorded, tmp_path, monkeypatch):
     assert s["trials"].sum() > 0 and s["correct"].sum() > 0
 
 
+def test_truth_columns_are_the_truth():
+    """One definition of the truth: the mode and every actuator's b0, b1."""
+    assert TRUTH_COLUMNS == ("mode", *(f"b{i}_{a}" for i in (0, 1) for a in LAY.actuators))
+    assert set(TRUTH_COLUMNS) <= set(signal_columns())
+    seen = [c for c in signal_columns() if c not in TRUTH_COLUMNS]
+    assert not [c for c in seen if c == "mode" or c[:3] in ("b0_", "b1_")]
+
+
+def test_a_detector_sees_what_an_aircraft_sees(recorded, tmp_path):
+    """By default the observable columns only; no truth, and not marked."""
+    got = []
+
+    def looks(signals, names, dt):
+        got.append(names)
+        assert signals.shape[2] == len(names)
+        return np.full(signals.shape[0], np.nan)
+
+    res = ftc_mc.score_detector(recorded, looks, out=tmp_path / "l")
+    observable = tuple(c for c in signal_columns() if c not in TRUTH_COLUMNS)
+    assert got and all(n == observable for n in got)
+    assert res["columns"] == observable
+    s = pd.read_parquet(tmp_path / "l" / "summary.parquet")
+    assert "reads_truth" in s and not s["reads_truth"].any()
+    assert "truth" not in (tmp_path / "l" / "summary.md").read_text()
+
+
+def test_the_truth_only_when_asked_and_then_marked(recorded, tmp_path):
+    def oracle(signals, names, dt):
+        assert names == ("innov_q", "mode")
+        m = signals[:, :, 1]
+        hit = np.nan_to_num(m) > 0
+        return np.where(hit.any(axis=1), (np.argmax(hit, axis=1) + 1) * dt, np.nan)
+
+    oracle.columns = ("innov_q", "mode")
+    run = tmp_path / "run"
+    shutil.copytree(recorded, run, ignore=shutil.ignore_patterns("detectors"))
+    res = ftc_mc.score_detector(run, oracle)
+    folder = run / "detectors" / "oracle"
+    s = pd.read_parquet(folder / "summary.parquet")
+    assert s["reads_truth"].all() and res["summary"]["reads_truth"].all()
+    assert "**Reads the truth** (`mode`)" in (folder / "summary.md").read_text()
+    md = ftc_mc.build_report([str(run)], tmp_path / "r.md").read_text()
+    assert "#### Oracle (a detector that read the truth: mode, b0, b1) `oracle@paper`" in md
+    assert "#### Design `oracle@paper`" not in md
+    t = res["trials"]  # the truth's first fault: at the switch, in every window
+    lock = t[(t["transition"] == "elevon_lock") & t["judged"]]
+    assert len(lock) and lock["correct"].all()
+
+
+def test_batches_keep_the_labels(recorded):
+    """Training reads the truth: batches() gives every recorded column."""
+    _, _, _, sig, names = next(batches(recorded))
+    assert set(TRUTH_COLUMNS) <= set(names) and sig.shape[2] == len(names)
+    _, _, _, _, names = next(batches(recorded, truth=False))
+    assert not set(TRUTH_COLUMNS) & set(names)
+
+
 BAD = '''
 import numpy as np
 def raises(s, names, dt):
@@ -167,7 +225,7 @@ def shape(s, names, dt):
 def inf(s, names, dt):
     return np.full(s.shape[0], np.inf)
 def block(s, names, dt):
-    return np.zeros(s.shape[0]), np.full(s.shape[0], "rudder")
+    return np.full(s.shape[0], 6.0), np.full(s.shape[0], "rudder")
 '''
 
 
@@ -203,8 +261,10 @@ def test_run_without_signals(tmp_path):
     assert _digest(tmp_path / "plain") == before
 
 
-def test_endurance_records_and_scores(tmp_path):
-    """Fault-free flights recorded: a detector's false alarms per flight hour."""
+def test_endurance_records_and_scores(tmp_path, monkeypatch):
+    """Fault-free flights recorded: a detector's false alarms per flight hour, in
+    the run's condition (plant, turbulence), without thresholds."""
+    monkeypatch.chdir(ROOT)
     cfg = {k: v for k, v in CFG.items() if k != "timing"}
     cfg["campaign"] = {**CFG["campaign"], "signature": "paper"}
     ftc_mc.run_endurance(cfg, 0.02, flight_s=15.0, out=tmp_path / "end", record="signals",
@@ -218,11 +278,19 @@ def test_endurance_records_and_scores(tmp_path):
     np.testing.assert_array_equal(res["flights"]["false_resets"].to_numpy() > 0,
                                   flights["false_resets"].to_numpy() > 0)
     built_in = pd.read_parquet(tmp_path / "end" / "endurance.parquet").iloc[0]
-    for c in ("flight_hours", "false_resets_per_hour_ci_high", "false_resets_per_hour_upper95"):
+    for c in ("flight_hours", "false_resets_per_hour_ci_high", "false_resets_per_hour_upper95",
+              "plant", "turbulence", "airframe"):
         assert s[c] == built_in[c], c  # first alarm = first reset: the same flights
+    r = CliRunner().invoke(cli, ["score", str(tmp_path / "end"), "--detector",
+                                 "examples.cusum:cusum", "-o", str(tmp_path / "c")])
+    assert r.exit_code == 0, r.output
+    assert "nan" not in r.output and "| cusum@paper | -" in r.output
+    md = (tmp_path / "c" / "summary.md").read_text()
+    assert f"| {built_in['plant']} / {built_in['turbulence']} " in md and "nan" not in md
+
     assert (tmp_path / "end" / "detectors" / "table1_paper" / "endurance.parquet").exists()
     md = ftc_mc.build_report([str(tmp_path / "end")], tmp_path / "r.md").read_text()
-    assert "table1_paper@paper" in md
+    assert "table1_paper@paper" in md and "nan / nan" not in md
 
 
 def test_a_sweep_does_not_record(tmp_path):

@@ -6,12 +6,19 @@ A *detector* is a plain NumPy function::
         # signals: float ndarray (trials, steps, len(names)), NaN after a trial stopped
         # names:   tuple of str, the signal columns (docs/reference/outputs.md)
         # dt:      the sampling period [s]
-        return alarm_s                    # (trials,) first alarm time [s], NaN: none
-        # or: return alarm_s, block       # block: (trials,) "thrust" / "elevons",
-        #                                 # an actuator name, or "" where unnamed
+        return alarm_s                    # (trials,) first alarm time [s], NaN: none,
+        #                                 # from dt to the trial's last sample
+        # or: return alarm_s, block       # block: (trials,) "thrust" / "elevons"
+        #                                 # (or 1 / 2), an actuator name, or ""
+        #                                 # (None, NaN) where unnamed
 
-A detector with an attribute ``columns`` (a tuple of signal names) receives only
-those, in that order: less to read.  Row ``j`` of ``signals`` holds the step that reached sample ``j + 1`` (time
+A detector sees what the aircraft sees: by default the observable columns, every
+signal column but the truth (:data:`ftc_mc.campaign.signals.TRUTH_COLUMNS`: the
+true ``mode`` and each actuator's ``b0_*``, ``b1_*``).  A detector with an
+attribute ``columns`` (a tuple of signal names) receives only those, in that
+order: less to read.  It gets a truth column only when ``columns`` names it, and
+then its rows are marked as having read the truth (``reads_truth``: an oracle,
+not a detector an aircraft could fly).  Row ``j`` of ``signals`` holds the step that reached sample ``j + 1`` (time
 ``(j + 1) dt``, the ``step`` column of ``signals/``).  It is called once per
 signals file (one chunk of trials) and design, with the signals of the loop
 that design flew: the detector sees them *open loop*, it cannot act on them
@@ -35,6 +42,14 @@ Fault-free flights of ``ftc-mc endurance --record signals``: every alarm is a
 false alarm, summarised as the designs' false resets are
 (:func:`ftc_mc.campaign.endurance.summarize_endurance`: per flight hour with
 exact Poisson intervals; at most one per flight, its first alarm).
+
+Scoring refuses, with one line (a :class:`~ftc_mc.errors.UserError`) and before
+anything is written, every input it cannot score honestly: a name that is not a
+plain name, an output folder inside the run's own files, a run folder, table,
+metadata or signals file that is missing, damaged or inconsistent, and every
+detector return that is not one alarm time per trial (numbers, NaN for none,
+from the first sample ``dt`` to the trial's last recorded sample) with an
+optional valid block per trial, or a detector that raises.
 """
 
 from __future__ import annotations
@@ -42,6 +57,7 @@ from __future__ import annotations
 import importlib
 import json
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -53,13 +69,36 @@ import pyarrow.parquet as pq
 from ..conventions import LONGITUDINAL as LAY
 from ..conventions import MODE_NAMES, MODE_NOMINAL, NO_RESET
 from ..errors import UserError
+from ..io.lock import holder
 from ..io.results import META_KEY
-from .signals import KEYS, signal_files
+from .signals import KEYS, TRUTH_COLUMNS, signal_files
 from .summary import summary_frame, summary_row
 from .transitions import TRANSITION_TABLE, is_sensor
 
 ENDURANCE_NAME = "endurance"
 """The chunk (and ``transition``) name of an endurance run's flights."""
+
+
+NAME_PATTERN = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.+-]{0,99}")
+"""A detector's name: a plain name (the folder ``detectors/<name>/`` and the
+prefix of its variants ``<name>@<design>``), never a path."""
+
+
+def check_name(name) -> str:
+    """``name`` when it is a plain name (:data:`NAME_PATTERN`), else a UserError.
+
+    Raises
+    ------
+    UserError
+        Not a string, empty, a path, longer than 100 characters, or holding a
+        character other than letters, digits, ``_``, ``.``, ``+``, ``-`` (or
+        starting with ``.``, ``+``, ``-``).
+    """
+    if not isinstance(name, str) or not NAME_PATTERN.fullmatch(name):
+        raise UserError(f"--name: {name!r} is not a plain name (letters, digits, '_', "
+                        "'.', '+', '-', at most 100, starting with a letter, digit or '_'; "
+                        "never a path)")
+    return name
 
 
 def load_detector(spec: str):
@@ -80,23 +119,69 @@ def load_detector(spec: str):
         sys.path.insert(0, "")
     try:
         module = importlib.import_module(mod)
-    except Exception as exc:  # noqa: BLE001 -- any import failure is the user's
+    except (Exception, SystemExit) as exc:  # noqa: BLE001 -- any import failure is the user's
         raise UserError(f"--detector: cannot import {mod!r}: {type(exc).__name__}: "
-                        f"{exc}") from None
+                        f"{_one_line(exc)}") from None
     func = getattr(module, fn, None)
     if not callable(func):
         raise UserError(f"--detector: {mod!r} has no function {fn!r}")
     return func
 
 
+def _one_line(exc) -> str:
+    """An exception's message on one line."""
+    return " ".join(str(exc).split())
+
+
+def _read_schema(f: Path):
+    """The Parquet schema of ``f``, or a one-line UserError."""
+    if not f.is_file():
+        raise UserError(f"{f}: not a file")
+    try:
+        return pq.read_schema(f)
+    except (pa.ArrowException, OSError) as exc:
+        raise UserError(f"{f}: not a readable Parquet file ({_one_line(exc)})") from None
+
+
+def _read_table(f: Path, columns) -> pa.Table:
+    """The columns ``columns`` of the Parquet file ``f``, or a one-line UserError."""
+    try:
+        return pq.read_table(f, columns=list(columns))
+    except (pa.ArrowException, OSError) as exc:
+        raise UserError(f"{f}: not a readable Parquet file ({_one_line(exc)})") from None
+
+
 def run_meta(run_dir) -> dict:
-    """The provenance of a run or endurance directory (its config included)."""
+    """The provenance of a run or endurance directory (its config included).
+
+    Raises
+    ------
+    UserError
+        No such folder, not a folder, no ``trials.parquet`` or
+        ``flights.parquet``, a table that cannot be read, or metadata that is
+        missing, damaged or not of a run or endurance run.
+    """
     d = Path(run_dir)
-    for name in ("trials.parquet", "flights.parquet"):
-        if (d / name).exists():
-            md = pq.read_schema(d / name).metadata or {}
-            if META_KEY in md:
-                return json.loads(md[META_KEY])
+    if not d.exists():
+        raise UserError(f"{run_dir}: no such folder")
+    if not d.is_dir():
+        raise UserError(f"{run_dir}: not a folder")
+    for name, kind in (("trials.parquet", "run"), ("flights.parquet", "endurance")):
+        f = d / name
+        if not f.exists() and not f.is_symlink():
+            continue
+        md = _read_schema(f).metadata or {}
+        if META_KEY not in md:
+            raise UserError(f"{f}: no ftc-mc metadata (not written by ftc-mc)")
+        try:
+            meta = json.loads(md[META_KEY])
+        except (ValueError, UnicodeDecodeError):
+            raise UserError(f"{f}: damaged ftc-mc metadata (not JSON)") from None
+        if not isinstance(meta, dict) or not isinstance(meta.get("config"), dict):
+            raise UserError(f"{f}: damaged ftc-mc metadata (no config)")
+        if meta.get("kind") != kind:
+            raise UserError(f"{f}: metadata of kind {meta.get('kind')!r}, expected {kind!r}")
+        return meta
     raise UserError(f"{run_dir}: not a finished run or endurance directory "
                     "(no trials.parquet or flights.parquet)")
 
@@ -107,9 +192,19 @@ consecutive chunk files of a transition are joined up to it (fewer, larger
 calls; 16 MB of float32, whatever the run's size)."""
 
 
-def batches(run_dir, columns=None):
+def batches(run_dir, columns=None, truth: bool = True):
     """The recorded signals of a run, in batches of one transition and design
     (consecutive chunk files joined up to :data:`BATCH_VALUES` values).
+
+    Parameters
+    ----------
+    run_dir : str or Path
+    columns : sequence of str, optional
+        The signal columns to read, in this order (default: all of a file's).
+    truth : bool
+        With ``columns`` None, whether the truth columns
+        (:data:`~ftc_mc.campaign.signals.TRUTH_COLUMNS`, the labels of a learned
+        detector's training) are among them; the scoring passes False.
 
     Yields
     ------
@@ -121,20 +216,51 @@ def batches(run_dir, columns=None):
         NaN after a trial's last recorded step.
     names : tuple of str
         The signal columns (all of the file's but the keys, or ``columns``).
+
+    Raises
+    ------
+    UserError
+        No signals, or a signals file that cannot be read or holds wrong
+        columns, types or rows.
     """
+    for name, design, ids, sig, names, _ in _batches(run_dir, columns, truth):
+        yield name, design, ids, sig, names
+
+
+def _batches(run_dir, columns=None, truth: bool = True, max_step: int | None = None):
+    """:func:`batches`, each with the last recorded step of each trial; steps
+    beyond ``max_step`` (the flight's samples) are refused."""
     files = signal_files(run_dir)
     if not files:
         raise UserError(f"{run_dir}: recorded without signals (run it with "
                         "--record signals)")
     group, group_name, values = [], None, 0
+    names = None
     for f in files:
-        have = pq.read_schema(f).names
-        names = tuple(c for c in have if c not in KEYS) if columns is None \
-            else tuple(columns)
+        schema = _read_schema(f)
+        have = schema.names
+        lost = [k for k in KEYS if k not in have]
+        if lost:
+            raise UserError(f"{f}: not a signals file (no key columns {lost})")
+        if columns is None:
+            names = tuple(c for c in have if c not in KEYS
+                          and (truth or c not in TRUTH_COLUMNS))
+        else:
+            names = tuple(columns)
         missing = [c for c in names if c not in have]
         if missing:
             raise UserError(f"{f}: no signal columns {missing}")
-        table = pq.read_table(f, columns=[*KEYS, *names])
+        if not names:
+            raise UserError(f"{f}: no signal columns")
+        for c in names:
+            t = schema.field(c).type
+            text = _is_text(t)
+            if (c == "mode") != text or not (text or pa.types.is_integer(t)
+                                             or pa.types.is_floating(t)):
+                raise UserError(f"{f}: signal column {c!r} is of type {t}, not "
+                                + ("the mode's names" if c == "mode" else "numbers"))
+        table = _read_table(f, [*KEYS, *names])
+        _check_rows(f, table, max_step)
         name = table["transition"][0].as_py()
         size = table.num_rows * len(names)
         if group and (name != group_name or values + size > BATCH_VALUES):
@@ -147,8 +273,48 @@ def batches(run_dir, columns=None):
         yield from _split(pa.concat_tables(group), group_name, names)
 
 
+def _check_rows(f: Path, table: pa.Table, max_step: int | None) -> None:
+    """One signals file's rows: some, of one transition, keys without nulls, the
+    steps of the flight (``1 .. max_step``), modes known."""
+    if table.num_rows == 0:
+        raise UserError(f"{f}: no rows")
+    for k in KEYS:
+        if table[k].null_count:
+            raise UserError(f"{f}: {k} has empty values")
+    for k in ("trial_id", "step"):
+        if not pa.types.is_integer(table.schema.field(k).type):
+            raise UserError(f"{f}: {k} is of type {table.schema.field(k).type}, not integers")
+    for k in ("transition", "variant"):
+        if not _is_text(table.schema.field(k).type):
+            raise UserError(f"{f}: {k} is of type {table.schema.field(k).type}, not names")
+    if len(pc.unique(_text(table["transition"]))) != 1:
+        raise UserError(f"{f}: rows of more than one transition")
+    lo, hi = pc.min_max(table["step"]).values()
+    if lo.as_py() < 1 or (max_step is not None and hi.as_py() > max_step):
+        raise UserError(f"{f}: steps {lo.as_py()}..{hi.as_py()} outside the flight's "
+                        f"1..{max_step if max_step is not None else ''}")
+    if "mode" in table.column_names:
+        seen = pc.unique(_text(table["mode"])).to_pylist()
+        bad = [m for m in seen if m not in MODE_NAMES]
+        if bad:
+            raise UserError(f"{f}: mode {bad[0]!r} is none of {list(MODE_NAMES)}")
+
+
+def _is_text(t) -> bool:
+    """Whether an Arrow type holds names (strings, or a dictionary of them)."""
+    if pa.types.is_dictionary(t):
+        t = t.value_type
+    return pa.types.is_string(t) or pa.types.is_large_string(t)
+
+
+def _text(col) -> pa.Array:
+    """A column of names as plain strings."""
+    col = col.combine_chunks()
+    return col.cast(pa.string()) if isinstance(col, pa.DictionaryArray) else col
+
+
 def _split(table, name: str, names):
-    """The batches of one joined table, one per design (:func:`batches`)."""
+    """The batches of one joined table, one per design (:func:`_batches`)."""
     # float64 when a column is (the decision statistics: thresholds compare exactly)
     wide = any(pa.types.is_float64(table.schema.field(c).type) for c in names)
     variant = table["variant"].combine_chunks()
@@ -160,6 +326,10 @@ def _split(table, name: str, names):
         step = t["step"].to_numpy().astype(np.int64)
         uid, lane = np.unique(ids, return_inverse=True)
         n_steps = int(step.max())
+        if len(np.unique(lane * (n_steps + 1) + step)) != len(step):
+            raise UserError(f"signals of {name}, {design}: a trial's step recorded twice")
+        last = np.zeros(len(uid), dtype=np.int64)
+        np.maximum.at(last, lane, step)
         out = np.full((len(uid), n_steps, len(names)), np.nan,
                       dtype=np.float64 if wide else np.float32)
         for j, c in enumerate(names):
@@ -173,33 +343,58 @@ def _split(table, name: str, names):
                     v = np.array([MODE_NAMES.index(m) for m in d.to_pylist()],
                                  dtype=np.float32)
             else:
-                v = col.to_numpy()
+                v = col.to_numpy(zero_copy_only=False)
             out[lane, step - 1, j] = v
-        yield name, design, uid, out, names
+        yield name, design, uid, out, names, last
 
 
-def _check_output(res, n: int, where: str):
+def _check_output(res, n: int, where: str, dt: float | None = None, last_s=None):
     """The alarm times, and the block codes and actuator names of a detector's
-    return, or a UserError."""
+    return, or a UserError: one alarm time per trial (numbers, not booleans;
+    NaN for none; none infinite, none before the first sample ``dt``, none after
+    the trial's last recorded sample ``last_s``), and optionally one block per
+    trial."""
     block = None
     if isinstance(res, tuple):
         if len(res) != 2:
             raise UserError(f"detector: {where}: expected alarm_s or (alarm_s, block), "
                             f"got a tuple of {len(res)}")
         res, block = res
+    if res is None:
+        raise UserError(f"detector: {where}: returned None, not alarm times")
     try:
-        alarm = np.asarray(res, dtype=float)
-    except (TypeError, ValueError):
+        raw = np.asarray(res)
+    except Exception:  # noqa: BLE001 -- whatever the user returned
         raise UserError(f"detector: {where}: alarm times are not numbers") from None
+    if raw.dtype.kind not in "iuf":
+        what = {"b": "booleans", "c": "complex numbers"}.get(raw.dtype.kind, "not numbers")
+        raise UserError(f"detector: {where}: alarm times are {what} (dtype {raw.dtype}), "
+                        "expected times [s]")
+    alarm = raw.astype(float)
     if alarm.shape != (n,):
         raise UserError(f"detector: {where}: expected {n} alarm times (one per trial), "
                         f"got shape {alarm.shape}")
     if np.isinf(alarm).any():
         raise UserError(f"detector: {where}: alarm times must be finite or NaN (none)")
+    if dt is not None:
+        early = alarm < dt * (1 - 1e-9)
+        if early.any():
+            i = int(np.argmax(early))
+            raise UserError(f"detector: {where}: alarm at {alarm[i]:g} s, before the "
+                            f"flight's first sample ({dt:g} s; trial index {i})")
+    if last_s is not None:
+        late = alarm > np.asarray(last_s, dtype=float) + 1e-9 * max(dt or 1.0, 1.0)
+        if late.any():
+            i = int(np.argmax(late))
+            raise UserError(f"detector: {where}: alarm at {alarm[i]:g} s, after the "
+                            f"trial's last recorded sample ({last_s[i]:g} s; trial index {i})")
     codes = np.full(n, -1, dtype=np.int64)  # -1: no block named
     sides = np.full(n, "", dtype=object)  # the actuator named, if one was
     if block is not None:
-        block = np.asarray(block, dtype=object)
+        try:
+            block = np.asarray(block, dtype=object)
+        except Exception:  # noqa: BLE001 -- whatever the user returned
+            raise UserError(f"detector: {where}: blocks are not an array") from None
         if block.shape != (n,):
             raise UserError(f"detector: {where}: expected {n} blocks, got shape "
                             f"{block.shape}")
@@ -211,26 +406,100 @@ def _check_output(res, n: int, where: str):
 
 
 def _block_code(b, where: str) -> int:
-    if b is None or b == "" or (isinstance(b, float) and math.isnan(b)):
+    """The block code of a named block: ``"thrust"`` / ``"elevons"`` (or their
+    codes 1, 2), an actuator's name; -1 for none named (``""``, None, NaN)."""
+    if b is None or (isinstance(b, str) and b == "") \
+            or (isinstance(b, (float, np.floating)) and math.isnan(b)):
         return -1
-    if isinstance(b, (int, np.integer)):
-        if 0 <= b < len(LAY.blocks):
+    if isinstance(b, (int, np.integer)) and not isinstance(b, (bool, np.bool_)):
+        if 0 < b < len(LAY.blocks):
             return int(b)
-    elif b in LAY.blocks:
+    elif isinstance(b, str) and b in LAY.blocks[1:]:
         return LAY.blocks.index(b)
-    elif b in LAY.actuators:
+    elif isinstance(b, str) and b in LAY.actuators:
         return LAY.actuator_block[LAY.actuators.index(b)]
     raise UserError(f"detector: {where}: block {b!r} is none of {LAY.blocks[1:]} "
                     f"or {LAY.actuators}")
 
 
-def call_detector(detector, signals, names, dt: float, where: str):
-    """Call ``detector`` on one batch; its failure or bad output is a UserError."""
+def call_detector(detector, signals, names, dt: float, where: str, last_s=None):
+    """Call ``detector`` on one batch; its failure or bad output is a UserError
+    (:func:`_check_output`; ``last_s``: each trial's last recorded sample [s])."""
     try:
         res = detector(signals, names, dt)
-    except Exception as exc:  # noqa: BLE001 -- the user's code
-        raise UserError(f"detector raised {type(exc).__name__} on {where}: {exc}") from None
-    return _check_output(res, signals.shape[0], where)
+    except (Exception, SystemExit) as exc:  # noqa: BLE001 -- the user's code
+        raise UserError(f"detector raised {type(exc).__name__} on {where}: "
+                        f"{_one_line(exc)}") from None
+    return _check_output(res, signals.shape[0], where, dt, last_s)
+
+
+def _wanted_columns(detector):
+    """The detector's ``columns`` as a tuple of names (None: it has none), or a
+    UserError."""
+    cols = getattr(detector, "columns", None)
+    if cols is None:
+        return None
+    bad = isinstance(cols, (str, bytes)) or not hasattr(cols, "__iter__")
+    cols = () if bad else tuple(cols)
+    if bad or not cols or not all(isinstance(c, str) for c in cols):
+        raise UserError(f"detector.columns: expected a tuple of signal names, got "
+                        f"{getattr(detector, 'columns')!r}")
+    keys = [c for c in cols if c in KEYS]
+    if keys:
+        raise UserError(f"detector.columns: {keys[0]!r} is a key, not a signal column")
+    if len(set(cols)) != len(cols):
+        raise UserError(f"detector.columns: a name given twice in {cols}")
+    return cols
+
+
+def _check_out(run_dir: Path, folder: Path, default: bool) -> None:
+    """The detector's output folder: inside the run folder only below
+    ``detectors/``, no file on its path."""
+    run = run_dir.resolve()
+    f = folder.resolve()
+    allowed = run / "detectors"
+    if default and allowed not in f.parents:
+        raise UserError(f"{folder}: leads out of {run_dir}/detectors/ (a link?)")
+    if (f == run or run in f.parents) and allowed not in f.parents:
+        raise UserError(f"-o {folder}: inside the run folder only as "
+                        f"{run_dir}/detectors/<folder> (the run's own files are never "
+                        "written)")
+    for q in (f, *f.parents):
+        if q.exists():
+            if not q.is_dir():
+                raise UserError(f"-o {folder}: {q} is a file, not a folder")
+            break
+
+
+FLOWN_COLUMNS = {"run": ("transition", "variant", "trial_id", "judged", "status",
+                         "mode_pre", "mode_post", "correct_side", "mode_changed",
+                         "small_b1", "lock_near_trim"),
+                 "endurance": ("variant", "flight_id", "judged", "status", "flown_s")}
+"""The columns of the run's ``trials.parquet`` (``flights.parquet``) the scoring
+reads beside the keys."""
+
+
+def _flown(table: Path, endurance: bool) -> pd.DataFrame:
+    """The run's trials (flights), checked: readable, its columns there, each
+    trial once."""
+    need = FLOWN_COLUMNS["endurance" if endurance else "run"]
+    have = _read_schema(table).names
+    lost = [c for c in need if c not in have]
+    if lost:
+        raise UserError(f"{table}: no columns {lost}")
+    try:
+        flown = pd.read_parquet(table)
+    except (pa.ArrowException, OSError, ValueError) as exc:
+        raise UserError(f"{table}: not a readable Parquet file ({_one_line(exc)})") from None
+    key = ["variant", "flight_id"] if endurance else ["transition", "variant", "trial_id"]
+    if not pd.api.types.is_integer_dtype(flown[key[-1]]) \
+            or not pd.api.types.is_bool_dtype(flown["judged"]):
+        raise UserError(f"{table}: {key[-1]} is not integers or judged not booleans")
+    if flown[key].isna().any().any():
+        raise UserError(f"{table}: {'/'.join(key)} has empty values")
+    if flown.duplicated(key).any():
+        raise UserError(f"{table}: a {'flight' if endurance else 'trial'} listed twice")
+    return flown
 
 
 def _trial_rows(flown: pd.DataFrame, alarm, named_by, cfg: dict, name: str) -> pd.DataFrame:
@@ -288,52 +557,85 @@ def score_detector(run_dir, detector, out=None, name: str | None = None) -> dict
         A run (``ftc-mc run --record signals``) or endurance run
         (``ftc-mc endurance --record signals``) directory.
     detector : callable or str
-        The detector (module docstring), or ``"module:function"``.
+        The detector (module docstring), or ``"module:function"``.  It is
+        passed the observable signal columns, or those its ``columns``
+        attribute names (a truth column only then: ``reads_truth``).
     out : str or Path, optional
         Where to write ``trials.parquet`` and ``summary.parquet`` (a run) or
-        ``endurance.parquet`` (an endurance run) of the detector, and
-        ``summary.md``; default ``run_dir/detectors/<name>/``.  The run's own
-        files are never written.
+        ``flights.parquet`` and ``endurance.parquet`` (an endurance run) of the
+        detector, and ``summary.md``; default ``run_dir/detectors/<name>/``.
+        Inside ``run_dir`` only below ``detectors/``: the run's own files are
+        never written.
     name : str, optional
-        The detector's name in the tables (default: its function name).
+        The detector's name in the tables (default: its function name), a plain
+        name (:func:`check_name`), never a path.
 
     Returns
     -------
     dict
         ``summary`` (DataFrame, one row per transition and design the signals
-        came from, variant ``<name>@<design>``), ``trials`` (a run) or
-        ``flights`` (an endurance run), and ``out`` (the folder written).
+        came from, variant ``<name>@<design>``, ``reads_truth`` whether the
+        detector read a truth column), ``trials`` (a run) or ``flights`` (an
+        endurance run), ``out`` (the folder written) and ``columns`` (the
+        signal columns the detector was passed).
 
     Raises
     ------
     UserError
-        A module that cannot be imported, a run without signals, a detector
-        that raises or returns the wrong shape or infinite alarm times.
-        Nothing is written then.
+        A bad name or output folder, a module that cannot be imported, a run
+        folder, table, metadata or signals file that is missing, damaged or
+        inconsistent, a run without signals, a detector that raises or
+        returns anything but one valid alarm time (and block) per trial
+        (module docstring).  Nothing is written then.
     """
+    from ..config import parse_config
     if isinstance(detector, str):
         spec = detector
+        if name is not None:
+            check_name(name)
         detector = load_detector(spec)
         name = name or spec.partition(":")[2]
-    name = name or getattr(detector, "__name__", "detector")
+    if not callable(detector):
+        raise UserError(f"detector: expected a function (signals, names, dt), got "
+                        f"{type(detector).__name__}")
+    name = check_name(name if name is not None else getattr(detector, "__name__", "detector"))
+    wanted = _wanted_columns(detector)
     run_dir = Path(run_dir)
     meta = run_meta(run_dir)
-    cfg = meta["config"]
-    dt = float(cfg["model"]["dt_s"])
+    owner = holder(run_dir)
+    if owner is not None:
+        raise UserError(f"{run_dir}: being written by `{owner.get('command')}` (pid "
+                        f"{owner.get('pid')}); score it when it has finished")
     endurance = meta.get("kind") == "endurance"
     table = run_dir / ("flights.parquet" if endurance else "trials.parquet")
+    config = parse_config(meta["config"], f"{table} metadata")
+    cfg = config.model_dump(mode="json")
+    dt = float(config.model.dt_s)
+    max_step = round(config.timing.duration_s / dt)
+    folder = Path(out) if out is not None else run_dir / "detectors" / name
+    _check_out(run_dir, folder, out is None)
     key = "flight_id" if endurance else "trial_id"
-    flown_all = pd.read_parquet(table)
+    flown_all = _flown(table, endurance)
     by = ["variant"] if endurance else ["transition", "variant"]
     flown_of = {k if isinstance(k, tuple) else (k,): g.set_index(key)
                 for k, g in flown_all.groupby(by if len(by) > 1 else by[0], sort=False)}
-    parts = []
-    for tr, design, ids, sig, names in batches(run_dir, getattr(detector, "columns", None)):
+    parts, names = [], ()
+    for tr, design, ids, sig, names, last in _batches(run_dir, wanted, truth=False,
+                                                      max_step=max_step):
+        if endurance and tr != ENDURANCE_NAME or not endurance and tr not in TRANSITION_TABLE:
+            raise UserError(f"{run_dir}: signals of {tr!r}, not "
+                            + ("an endurance run's flights" if endurance
+                               else "a transition (ftc-mc run --help)"))
         if not endurance and is_sensor(tr):
             continue
         where = f"{tr} trials {ids[0]}-{ids[-1]} of {design}"
-        alarm, codes = call_detector(detector, sig, names, dt, where)
-        flown = flown_of[(design,) if endurance else (tr, design)].loc[ids].reset_index()
+        flown = flown_of.get((design,) if endurance else (tr, design))
+        unknown = ids if flown is None else ids[~np.isin(ids, flown.index.to_numpy())]
+        if len(unknown):
+            raise UserError(f"{run_dir}: signals of {where} hold {key} {unknown[0]}, "
+                            f"which {table.name} does not list")
+        alarm, codes = call_detector(detector, sig, names, dt, where, last * dt)
+        flown = flown.loc[ids].reset_index()
         if endurance:
             g = flown.copy()
             ok = np.isfinite(alarm) & (alarm <= g["flown_s"].to_numpy() + 1e-9)
@@ -345,9 +647,10 @@ def score_detector(run_dir, detector, out=None, name: str | None = None) -> dict
         g["variant"] = f"{name}@{design}"
         g["design"] = design
         parts.append(g)
+    reads_truth = any(c in TRUTH_COLUMNS for c in names)
     rows = pd.concat(parts, ignore_index=True) if parts else pd.DataFrame()
     if endurance:
-        summary = _endurance_summary(rows, cfg)
+        summary = _endurance_summary(rows, config)
     else:
         variants = list(dict.fromkeys(rows["variant"])) if len(rows) else []
         transitions = list(dict.fromkeys(rows["transition"])) if len(rows) else []
@@ -356,40 +659,58 @@ def score_detector(run_dir, detector, out=None, name: str | None = None) -> dict
                                  for t in transitions for v in variants
                                  if ((rows["transition"] == t) & (rows["variant"] == v)).any()],
                                 transitions, variants)
-    folder = Path(out) if out is not None else run_dir / "detectors" / name
-    _write(folder, rows, summary, endurance, {**meta, "detector": name})
-    return {"summary": summary, ("flights" if endurance else "trials"): rows, "out": folder}
+    summary["reads_truth"] = reads_truth
+    _write(folder, rows, summary, endurance,
+           {**meta, "detector": name, "detector_columns": list(names),
+            "reads_truth": reads_truth})
+    return {"summary": summary, ("flights" if endurance else "trials"): rows,
+            "out": folder, "columns": names}
 
 
-def _endurance_summary(flights: pd.DataFrame, cfg: dict) -> pd.DataFrame:
+TRUTH_NOTE = ("**Reads the truth** ({columns}): an oracle, not a detector an aircraft "
+              "could fly.")
+"""The line of ``summary.md`` above the table of a detector that read a truth
+column (the report heads its rows *Oracle*: :func:`ftc_mc.report.runs.paper_tables`)."""
+
+
+def _endurance_summary(flights: pd.DataFrame, config) -> pd.DataFrame:
     """The endurance summary of the detector's alarms, with the built-in designs'
     columns and definitions (:func:`ftc_mc.campaign.endurance.summarize_endurance`:
     rates per flight hour with exact Poisson intervals, the one-sided bound, the
-    hours that would show the target); each alarm is a false reset."""
-    from ..config import parse_config
+    hours that would show the target); each alarm is a false reset.  Its
+    condition (``plant``, ``turbulence``, ``airframe``) is the run's."""
     from .endurance import summarize_endurance
     ok = flights["false_resets"].to_numpy() > 0
     resets = pd.DataFrame({"variant": flights["variant"][ok], "flight_id":
                            flights["flight_id"][ok], "time_s": flights["alarm_s"][ok]})
-    return summarize_endurance(flights, resets, parse_config(cfg),
+    return summarize_endurance(flights, resets, config,
                                list(dict.fromkeys(flights["variant"])))
 
 
 def _write(folder: Path, rows, summary, endurance: bool, meta: dict) -> None:
-    """The detector's tables, each written atomically."""
+    """The detector's tables, each written atomically; a folder that cannot be
+    written is a UserError."""
     from ..io.atomic import write_text
     from ..io.results import write_parquet
     from .summary import markdown_table
-    folder.mkdir(parents=True, exist_ok=True)
-    write_parquet(rows, folder / ("flights.parquet" if endurance else "trials.parquet"), meta)
-    write_parquet(summary, folder / ("endurance.parquet" if endurance else "summary.parquet"),
-                  meta)
     if endurance:
         from .endurance import endurance_markdown
         md = endurance_markdown(summary)
     else:
         md = markdown_table(summary)
-    write_text(folder / "summary.md", f"# detector {meta['detector']}\n\n{md}\n")
+    if meta["reads_truth"]:
+        truth = [c for c in meta["detector_columns"] if c in TRUTH_COLUMNS]
+        md = TRUTH_NOTE.format(columns=", ".join(f"`{c}`" for c in truth)) + "\n\n" + md
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        write_parquet(rows, folder / ("flights.parquet" if endurance else "trials.parquet"),
+                      meta)
+        write_parquet(summary, folder / ("endurance.parquet" if endurance
+                                         else "summary.parquet"), meta)
+        write_text(folder / "summary.md", f"# detector {meta['detector']}\n\n{md}\n")
+    except OSError as exc:
+        raise UserError(f"{folder}: cannot write the detector's tables "
+                        f"({_one_line(exc)})") from None
 
 
 def _plain(df: pd.DataFrame) -> str:

@@ -49,15 +49,27 @@ def innovation_names() -> tuple:
     return tuple("innov_" + r.partition("_")[2] for r in LAY.residuals)
 
 
+TRUTH_COLUMNS = (("mode",) + tuple(f"b0_{a}" for a in LAY.actuators)
+                 + tuple(f"b1_{a}" for a in LAY.actuators))
+"""The signal columns that hold the truth, not what the aircraft sees: the true
+mode and each actuator's ``b0``, ``b1``.  A detector scored by ``ftc-mc score``
+reads them only when it names them (:mod:`ftc_mc.campaign.detector`); every
+other signal column is observable on board."""
+
+
 def signal_columns(n_z: int = LAY.n_z) -> tuple:
     """Names of the signal columns of a signals row (after :data:`KEYS`), in file
-    order (``docs/reference/outputs.md``)."""
+    order (``docs/reference/outputs.md``); :data:`TRUTH_COLUMNS` among them."""
     outs = LAY.outputs if n_z == LAY.n_z else tuple(str(i) for i in range(n_z))
     return (tuple(f"z_{o}" for o in outs) + tuple(f"u_{i}" for i in LAY.inputs)
-            + ("mode",) + tuple(f"b0_{a}" for a in LAY.actuators)
-            + tuple(f"b1_{a}" for a in LAY.actuators) + ("exc_doublet", "exc_3211")
+            + TRUTH_COLUMNS + ("exc_doublet", "exc_3211")
             + innovation_names() + tuple(LAY.residuals) + ("reset",)
             + tuple(f"belief_{m}" for m in MODE_NAMES))
+
+
+def is_truth(column: str) -> bool:
+    """Whether a signal column holds the truth (:data:`TRUTH_COLUMNS`)."""
+    return column in TRUTH_COLUMNS
 
 
 def _rows(a: np.ndarray, keep: np.ndarray) -> np.ndarray:

@@ -69,10 +69,17 @@ def _fmt(x, f="{:.3g}") -> str:
 
 
 def endurance_table(summary: pd.DataFrame) -> str:
-    """The per-design table of an endurance run, in Markdown."""
+    """The per-design table of an endurance run, in Markdown: a detector's rows
+    (``ftc-mc score``) have no thresholds (``-``), and one that read the truth is
+    marked an oracle."""
+    from .runs import reads_truth
+    oracle = reads_truth(summary).to_numpy()
     view = pd.DataFrame({
-        "design": summary["variant"],
-        "t_q / t_nx": [f"{a:g} / {b:g}" for a, b in zip(summary["t_q"], summary["t_nx"])],
+        "design": [f"{v} (oracle: read the truth)" if o else v
+                   for v, o in zip(summary["variant"], oracle)],
+        "t_q / t_nx": [f"{_fmt(a, '{:g}')} / {_fmt(b, '{:g}')}"
+                       if np.isfinite(a) or np.isfinite(b) else "-"
+                       for a, b in zip(summary["t_q"], summary["t_nx"])],
         "flights (judged)": [f"{a} ({b})" for a, b in zip(summary["flights"],
                                                          summary["judged"])],
         "flight hours": summary["flight_hours"].map("{:.4g}".format),

@@ -68,6 +68,24 @@ def _paper_row(r: pd.Series) -> dict:
     }
 
 
+def reads_truth(rows: pd.DataFrame) -> pd.Series:
+    """Per row, whether it is a detector's that read the truth (``reads_truth``
+    of ``ftc-mc score``'s tables; False for the designs' rows).
+
+    Parameters
+    ----------
+    rows : DataFrame
+        Summary or endurance rows.
+
+    Returns
+    -------
+    Series of bool
+    """
+    if "reads_truth" not in rows:
+        return pd.Series(False, index=rows.index)
+    return rows["reads_truth"].eq(True)
+
+
 def paper_tables(summary: pd.DataFrame) -> list:
     """Markdown lines: Tables 2-3 beside the paper's, one table per variant.
 
@@ -83,6 +101,8 @@ def paper_tables(summary: pd.DataFrame) -> list:
     lines = []
     for variant, g in summary.groupby("variant", sort=False):
         kind = "Signature" if variant in VARIANTS else "Design"
+        if reads_truth(g).any():  # a detector scored on the truth (ftc-mc score)
+            kind = "Oracle (a detector that read the truth: mode, b0, b1)"
         lines += [f"#### {kind} `{variant}`", "",
                   pd.DataFrame([_paper_row(r) for _, r in g.iterrows()])
                   .to_markdown(index=False), ""]
