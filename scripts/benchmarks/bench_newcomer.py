@@ -33,9 +33,14 @@ dev.py run`` (install, start, compile and trials), the cold compile of the
 default path, and the wall time of ``python3 dev.py test`` (its install of the
 test extras included); ``tests_s=nan`` with ``--skip-tests``.
 
-Usage: ``python scripts/benchmarks/bench_newcomer.py [--skip-tests] [--keep]
-[--python PYTHON]`` (``--keep`` leaves the clone and its caches and prints
-where).  It takes several minutes (a cold install from the index, a cold
+With ``--tests-only``, only ``python3 dev.py test`` runs on the fresh clone,
+every cache empty (the whole install and every kernel the tests need compiled
+cold: the test command's own worst case); then ``first_run_s=nan
+compile_s=nan``.
+
+Usage: ``python scripts/benchmarks/bench_newcomer.py [--skip-tests |
+--tests-only] [--keep] [--python PYTHON]`` (``--keep`` leaves the clone and
+its caches and prints where).  It takes several minutes (a cold install from the index, a cold
 compile, 8,000 trials, the tests).
 """
 
@@ -151,8 +156,12 @@ def first(lines, pattern) -> tuple | None:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--skip-tests", action="store_true",
+    which = ap.add_mutually_exclusive_group()
+    which.add_argument("--skip-tests", action="store_true",
                     help="do not run python3 dev.py test (tests_s=nan)")
+    which.add_argument("--tests-only", action="store_true",
+                    help="run only python3 dev.py test, on the fresh clone with every cache "
+                    "empty (first_run_s=nan compile_s=nan)")
     ap.add_argument("--keep", action="store_true",
                     help="keep the clone and its caches, and print where they are")
     ap.add_argument("--python", default=None,
@@ -184,38 +193,20 @@ def main() -> None:
                        check=True)
         subprocess.run(["git", "checkout", "--quiet", commit], cwd=clone, check=True)
 
-        # python3 dev.py run, in its two parts: the install, then the same
-        # command finding it done (the main job)
-        install_s, _ = run([python, "-c", "import dev; dev.ensure_venv('')"], clone, env, log)
-        job_s, lines = run([python, "dev.py", "run"], clone, env, log)
-        first_run_s = install_s + job_s
-        notice, done = first(lines, COMPILING), first(lines, COMPILED)
-        if notice is None or done is None:
-            sys.exit(f"bench_newcomer: the main job printed no compile notice (a cache was "
-                     f"not empty?); its output: {log}")
-        compile_s = float(done[1].group(1))
-        start_s = notice[0]
-        trials_s = job_s - done[0]
-
-        print(f"python3 dev.py run            {first_run_s:7.1f} s")
-        print(f"  install (venv, pip, ftc-mc) {install_s:7.1f} s")
-        print(f"  ftc-mc run configs/paper_tables.yaml (8,000 trials) {job_s:7.1f} s:")
-        print(f"    start to the compile notice {start_s:7.1f} s")
-        print(f"    cold compile, default path  {compile_s:7.1f} s  (ftc-mc: compiled in ...)")
-        print(f"    trials and writing results  {trials_s:7.1f} s")
-        other = job_s - start_s - compile_s - trials_s
-        if abs(other) > 0.5:
-            print(f"    other (between the notices) {other:7.1f} s")
+        first_run_s = compile_s = float("nan")
+        if not args.tests_only:
+            first_run_s, compile_s = first_run(python, clone, env, log)
 
         tests_s = float("nan")
         if not args.skip_tests:
             tests_s, lines = run([python, "dev.py", "test"], clone, env, log)
             summary = first(lines, PYTEST_SUMMARY)
-            print(f"python3 dev.py test           {tests_s:7.1f} s")
+            print(f"python3 dev.py test           {tests_s:7.1f} s"
+                  + (" (every cache empty)" if args.tests_only else ""))
             if summary is not None:
                 passed, pytest_s = summary[1].group(1), float(summary[1].group(2))
-                print(f"  install of the test extras and pytest's start "
-                      f"{tests_s - pytest_s:7.1f} s")
+                print(f"  install{' of the test extras' if not args.tests_only else ''} "
+                      f"and pytest's start {tests_s - pytest_s:7.1f} s")
                 print(f"  pytest: {passed} passed in {pytest_s:.1f} s")
         print(f"load average after: {load()}; every command's output: "
               f"{log if args.keep else '(removed; --keep keeps it)'}")
@@ -226,6 +217,34 @@ def main() -> None:
             print(f"kept: {top}", file=sys.stderr)
         else:
             shutil.rmtree(top, ignore_errors=True)
+
+
+def first_run(python: str, clone: Path, env: dict, log: Path) -> tuple[float, float]:
+    """Time ``python3 dev.py run`` on the clone and print its parts; return
+    its wall time and the cold compile's."""
+    # python3 dev.py run, in its two parts: the install, then the same
+    # command finding it done (the main job)
+    install_s, _ = run([python, "-c", "import dev; dev.ensure_venv('')"], clone, env, log)
+    job_s, lines = run([python, "dev.py", "run"], clone, env, log)
+    first_run_s = install_s + job_s
+    notice, done = first(lines, COMPILING), first(lines, COMPILED)
+    if notice is None or done is None:
+        sys.exit(f"bench_newcomer: the main job printed no compile notice (a cache was "
+                 f"not empty?); its output: {log}")
+    compile_s = float(done[1].group(1))
+    start_s = notice[0]
+    trials_s = job_s - done[0]
+
+    print(f"python3 dev.py run            {first_run_s:7.1f} s")
+    print(f"  install (venv, pip, ftc-mc) {install_s:7.1f} s")
+    print(f"  ftc-mc run configs/paper_tables.yaml (8,000 trials) {job_s:7.1f} s:")
+    print(f"    start to the compile notice {start_s:7.1f} s")
+    print(f"    cold compile, default path  {compile_s:7.1f} s  (ftc-mc: compiled in ...)")
+    print(f"    trials and writing results  {trials_s:7.1f} s")
+    other = job_s - start_s - compile_s - trials_s
+    if abs(other) > 0.5:
+        print(f"    other (between the notices) {other:7.1f} s")
+    return first_run_s, compile_s
 
 
 if __name__ == "__main__":
