@@ -40,19 +40,22 @@ NEWCOMER = {
         "test_stages.py::test_advance_matches_the_chained_twins[linear-none]",
     ],
     "6-DOF kernels against their NumPy twins": [
-        "test_sixdof.py::test_derivatives_and_outputs_equal_the_numpy_twin[x8-gryte2018]",
+        "test_sixdof_trial.py::test_sixdof_truth_matches_its_twin[nonlinear-separate]",
     ],
 }
 """The newcomer's tier, ``pytest --newcomer`` (``python3 dev.py test``; the
 whole suite is ``python3 dev.py test --all``): the cheapest tests that show
 the install works, every file of ``tests/golden/`` holds, and each kernel
-family agrees with its plain-NumPy twin on one path.  Chosen by compile cost:
-the golden cases compile the default, nonlinear and 6-DOF paths; the
-longitudinal twin runs the whole trial loop on the default path the golden
-linear case compiled; the 6-DOF twin compiles the flying wing's equations
-alone (its truth stage's twin would compile that stage again with Python
-wrappers, tens of seconds).  Node ids relative to ``tests/``;
-``tests/test_newcomer.py`` checks each exists and what the tier covers."""
+family agrees with its plain-NumPy twin on one path.  Chosen by compile cost
+(each test's cold compile measured with two pytest-xdist workers): the golden
+cases compile the default, nonlinear and 6-DOF paths, and the scenarios
+reuse them; the longitudinal twin runs the whole trial loop on the default
+path the golden linear case compiled (under a second); the 6-DOF twin runs
+the flying wing's truth stage (equations, lateral loops, gusts, faults)
+against its twin, its stage compiled again with Python wrappers (about 10 s
+more CPU in the tier, 34 s alone on an empty cache, where the side monitor's
+twin took 63 s and the equations' twin 3 s; one sitting, a shared machine).  Node ids relative to ``tests/``; ``tests/test_newcomer.py`` checks
+each exists and what the tier covers."""
 
 
 def _newcomer_ids() -> set:
