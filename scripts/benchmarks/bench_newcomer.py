@@ -201,12 +201,12 @@ def main() -> None:
         if not args.skip_tests:
             tests_s, lines = run([python, "dev.py", "test"], clone, env, log)
             summary = first(lines, PYTEST_SUMMARY)
-            print(f"python3 dev.py test           {tests_s:7.1f} s"
+            print(f"python3 dev.py test             {tests_s:7.1f} s"
                   + (" (every cache empty)" if args.tests_only else ""))
             if summary is not None:
                 passed, pytest_s = summary[1].group(1), float(summary[1].group(2))
                 print(f"  install{' of the test extras' if not args.tests_only else ''} "
-                      f"and pytest's start {tests_s - pytest_s:7.1f} s")
+                      f"and pytest's start: {tests_s - pytest_s:.1f} s")
                 print(f"  pytest: {passed} passed in {pytest_s:.1f} s")
         print(f"load average after: {load()}; every command's output: "
               f"{log if args.keep else '(removed; --keep keeps it)'}")
@@ -233,17 +233,21 @@ def first_run(python: str, clone: Path, env: dict, log: Path) -> tuple[float, fl
                  f"not empty?); its output: {log}")
     compile_s = float(done[1].group(1))
     start_s = notice[0]
-    trials_s = job_s - done[0]
-
-    print(f"python3 dev.py run            {first_run_s:7.1f} s")
-    print(f"  install (venv, pip, ftc-mc) {install_s:7.1f} s")
-    print(f"  ftc-mc run configs/paper_tables.yaml (8,000 trials) {job_s:7.1f} s:")
+    bars = [t for t, line in lines if line.startswith("trials:")]  # the progress bar
+    print(f"python3 dev.py run              {first_run_s:7.1f} s")
+    print(f"  install (venv, pip, ftc-mc)   {install_s:7.1f} s")
+    print(f"  ftc-mc run configs/paper_tables.yaml, 8,000 trials {job_s:.1f} s:")
     print(f"    start to the compile notice {start_s:7.1f} s")
     print(f"    cold compile, default path  {compile_s:7.1f} s  (ftc-mc: compiled in ...)")
-    print(f"    trials and writing results  {trials_s:7.1f} s")
-    other = job_s - start_s - compile_s - trials_s
+    if bars:
+        print(f"    then to the first trial     {bars[0] - done[0]:7.1f} s")
+        print(f"    trials (the progress bar)   {bars[-1] - bars[0]:7.1f} s")
+        print(f"    table and result files      {job_s - bars[-1]:7.1f} s")
+    else:
+        print(f"    trials and result files     {job_s - done[0]:7.1f} s")
+    other = done[0] - start_s - compile_s
     if abs(other) > 0.5:
-        print(f"    other (between the notices) {other:7.1f} s")
+        print(f"    (between the two notices, besides the compile: {other:.1f} s)")
     return first_run_s, compile_s
 
 
