@@ -15,6 +15,7 @@ pytest-xdist worker per core, idle ones take queued tests.  Extra arguments
 after ``run`` go to ``ftc-mc``; after ``test`` they go to ``pytest`` in place
 of the tier (``python3 dev.py test tests/test_golden.py -x``), and after
 ``test --all`` they are added to the whole suite's command.
+
 The install is repeated only when ``pyproject.toml`` changes.  It is editable
 (the sources stay in this folder, so an edit is run and tested at once), and
 pip runs with ``-qq``: its errors are shown, its warnings are not (setuptools

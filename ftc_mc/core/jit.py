@@ -21,7 +21,10 @@ source tree's own ``tests/`` or ``scripts/`` is keyed the same way, on the kerne
 sources and on those folders' files (:class:`CloneFolderLocator`), so a new
 clone loads the test kernels too.  ``NUMBA_CACHE_DIR`` in the environment takes
 precedence over ``$FTC_MC_CACHE_DIR/numba`` (``$NUMBA_CACHE_DIR/<digest>``; the
-benchmarks point it at an empty folder), and ``FTC_MC_NUMBA_CACHE=0`` turns caching off.  ``fastmath`` stays
+benchmarks point it at an empty folder), and ``FTC_MC_NUMBA_CACHE=0`` turns caching off.
+A cache the installed Numba cannot use (an index of another Numba version, a
+file that does not unpickle) is a cache miss, said in one line on stderr
+(:class:`TolerantIndexFile`, :meth:`ContentFunctionCache.load_overload`).  ``fastmath`` stays
 off: it was no faster here (``scripts/benchmarks/bench_core.py``) and breaks bit-for-bit
 agreement with the NumPy references.
 """
