@@ -7,11 +7,11 @@ the README's quick start says, timing each:
 * ``python3 dev.py run``, split in its two parts, run back to back: dev.py's
   install (the virtual environment, pip, ftc-mc and its dependencies, their
   bytecode) and the main job, ``ftc-mc run configs/paper_tables.yaml`` (8,000
-  trials: the eight rows of Tables 2-3, both variants of Table 1, 500 each),
-  itself split by the times its notices appear on stderr: the start (imports,
-  config, setup) up to the compile notice, the cold compile of the default
-  path (the figure ``ftc-mc: compiled in X s`` reports), and the trials with
-  the writing of the results after it;
+  trials: the eight rows of Tables 2-3, 1000 each, both variants of Table 1),
+  itself split by the times its output appears: the start (imports, config,
+  setup) up to the compile notice, the cold compile of the default path (the
+  figure ``ftc-mc: compiled in X s`` reports), the trials (from the progress
+  bar's first line to its last), and the table and result files after them;
 * ``python3 dev.py test``, after the run as a newcomer would: its install of
   the test extras into the same ``.venv`` and the tests it runs (pytest's own
   figure is printed beside it).
@@ -19,9 +19,11 @@ the README's quick start says, timing each:
 Empty caches: the kernel and design caches (``FTC_MC_CACHE_DIR``), pip's
 (``PIP_CACHE_DIR``, an empty folder: a fresh machine has none, and pip fills it
 during the first install as it would there) and matplotlib's
-(``MPLCONFIGDIR``).  ``HOME`` is kept, for pip's configuration (its index).
+(``MPLCONFIGDIR``).  ``HOME`` is kept, for pip's configuration (its index:
+where that is a local mirror, as on the machine this was written on, pip
+caches nothing and the install is quicker than from PyPI over a network).
 ``PYTHONPATH``, ``VIRTUAL_ENV``, ``NUMBA_CACHE_DIR``, ``FTC_MC_NUMBA_CACHE``,
-``FTC_MC_COMPILE_HELPER`` and ``PYTHONDONTWRITEBYTECODE`` are removed from the
+``FTC_MC_COMPILE_HELPER``, ``PYTHONDONTWRITEBYTECODE`` and ``PYTHONHOME`` are removed from the
 commands' environment.  The interpreter is the ``python3`` a newcomer would
 type (``python3.11`` if there is one, as ``.ci/run`` picks it), outside any
 virtual environment; ``--python`` names another.
@@ -39,9 +41,10 @@ cold: the test command's own worst case); then ``first_run_s=nan
 compile_s=nan``.
 
 Usage: ``python scripts/benchmarks/bench_newcomer.py [--skip-tests |
---tests-only] [--keep] [--python PYTHON]`` (``--keep`` leaves the clone and
-its caches and prints where).  It takes several minutes (a cold install from the index, a cold
-compile, 8,000 trials, the tests).
+--tests-only] [--keep] [--python PYTHON]`` (``--keep`` leaves the clone, its
+caches and the commands' output, and prints where; a failure keeps them too).
+It takes several minutes: a cold install, a cold compile, 8,000 trials, the
+tests.
 """
 
 from __future__ import annotations
