@@ -35,7 +35,9 @@ NEWCOMER = {
         "test_golden.py::test_scenario_is_golden[linear]",
         "test_golden.py::test_scenario_is_golden[nonlinear_moderate]",
         "test_golden.py::test_scenario_is_golden[sixdof]",
-    ],
+        "test_config_equivalence.py::test_every_shipped_config_has_a_record",
+    ] + [f"test_config_equivalence.py::test_shipped_config_resolves_as_recorded[{f.stem}]"
+         for f in sorted((ROOT / "tests" / "golden" / "configs").glob("*.json"))],
     "longitudinal kernels against their NumPy twins": [
         "test_stages.py::test_advance_matches_the_chained_twins[linear-none]",
     ],
@@ -49,7 +51,8 @@ the install works, every file of ``tests/golden/`` holds, and each kernel
 family agrees with its plain-NumPy twin on one path.  Chosen by compile cost
 (each test's cold compile measured with two pytest-xdist workers): the golden
 cases compile the default, nonlinear and 6-DOF paths, and the scenarios
-reuse them; the longitudinal twin runs the whole trial loop on the default
+reuse them (the recorded configs of ``tests/golden/configs/`` compile
+nothing); the longitudinal twin runs the whole trial loop on the default
 path the golden linear case compiled (under a second); the 6-DOF twin runs
 the flying wing's truth stage (equations, lateral loops, gusts, faults)
 against its twin, its stage compiled again with Python wrappers (about 10 s

@@ -29,13 +29,23 @@ def test_the_tier_collects_exactly_the_tests_it_names():
 
 
 def test_the_tier_holds_every_golden_file():
+    """Every file of ``tests/golden/``: the campaigns' and scenarios' tables
+    (``tests/test_golden.py``) and the recorded configs
+    (``tests/test_config_equivalence.py``), and nothing else."""
     golden = NEWCOMER["every golden file"]
     files = sorted(GOLDEN.glob("*.parquet"))
     assert len(files) >= 2 * len(CAMPAIGNS) + len(SCENARIOS)
     for f in files:
         kind, name, _ = f.stem.split("-")
         assert f"test_golden.py::test_{kind}_is_golden[{name}]" in golden, f.name
-    assert len(golden) == len(CAMPAIGNS) + len(SCENARIOS)
+    configs = sorted((GOLDEN / "configs").glob("*.json"))
+    assert len(configs) >= 20
+    for f in configs:
+        assert (f"test_config_equivalence.py::test_shipped_config_resolves_as_recorded"
+                f"[{f.stem}]") in golden, f.name
+    assert "test_config_equivalence.py::test_every_shipped_config_has_a_record" in golden
+    assert {p.name for p in GOLDEN.iterdir()} == {f.name for f in files} | {"configs"}
+    assert len(golden) == len(CAMPAIGNS) + len(SCENARIOS) + len(configs) + 1
 
 
 def test_the_tier_compares_each_kernel_family_with_its_twin():
