@@ -29,7 +29,9 @@ type (``python3.11`` if there is one, as ``.ci/run`` picks it), outside any
 virtual environment; ``--python`` names another.
 
 Prints the machine (CPU model, cores, load average before and after: other
-work on the machine slows every figure), each part, and as its last line
+work on the machine slows every figure), each part, with each command's CPU
+seconds (its processes' user and system time: on 2 cores an unshared wall time
+is at least half of it), and as its last line
 ``first_run_s=<a> compile_s=<b> tests_s=<c>``: the wall time of ``python3
 dev.py run`` (install, start, compile and trials), the cold compile of the
 default path, and the wall time of ``python3 dev.py test`` (its install of the
@@ -52,6 +54,7 @@ from __future__ import annotations
 import argparse
 import os
 import re
+import resource
 import shutil
 import subprocess
 import sys
@@ -111,11 +114,23 @@ def newcomer_python(env: dict) -> str:
     sys.exit("bench_newcomer: no python3 on PATH outside a virtual environment (--python)")
 
 
+CPU: dict = {}
+"""The CPU seconds (user and system) of each command :func:`run` ran, in order:
+on 2 cores its wall time can be no less than half of it, whatever else runs."""
+
+
+def _children_cpu() -> float:
+    """CPU seconds of this process's finished children and theirs."""
+    r = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return r.ru_utime + r.ru_stime
+
+
 def run(cmd, cwd: Path, env: dict, log: Path):
     """Run ``cmd``; return (wall seconds, [(seconds since start, line of its
     output)]).  Lines end at a newline or a carriage return (progress bars);
     the output is also written to ``log``.  Exits if the command fails."""
     t0 = time.perf_counter()
+    cpu0 = _children_cpu()
     proc = subprocess.Popen(cmd, cwd=cwd, env=env, stdout=subprocess.PIPE,
                             stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL)
     lines = []
@@ -139,6 +154,7 @@ def run(cmd, cwd: Path, env: dict, log: Path):
     code = proc.wait()
     reader.join()
     wall = time.perf_counter() - t0
+    CPU[len(CPU)] = _children_cpu() - cpu0
     with open(log, "a") as f:
         f.write(f"$ {' '.join(map(str, cmd))}  (exit {code}, {wall:.1f} s)\n")
         f.writelines(f"[{t:8.2f}] {line}\n" for t, line in lines)
@@ -205,7 +221,8 @@ def main() -> None:
             tests_s, lines = run([python, "dev.py", "test"], clone, env, log)
             summary = first(lines, PYTEST_SUMMARY)
             print(f"python3 dev.py test             {tests_s:7.1f} s"
-                  + (" (every cache empty)" if args.tests_only else ""))
+                  + (" (every cache empty)" if args.tests_only else "")
+                  + f"  (CPU {CPU[len(CPU) - 1]:.1f} s)")
             if summary is not None:
                 passed, pytest_s = summary[1].group(1), float(summary[1].group(2))
                 print(f"  install{' of the test extras' if not args.tests_only else ''} "
@@ -237,9 +254,12 @@ def first_run(python: str, clone: Path, env: dict, log: Path) -> tuple[float, fl
     compile_s = float(done[1].group(1))
     start_s = notice[0]
     bars = [t for t, line in lines if line.startswith("trials:")]  # the progress bar
-    print(f"python3 dev.py run              {first_run_s:7.1f} s")
-    print(f"  install (venv, pip, ftc-mc)   {install_s:7.1f} s")
-    print(f"  ftc-mc run configs/paper_tables.yaml, 8,000 trials {job_s:.1f} s:")
+    cpu_install, cpu_job = CPU[len(CPU) - 2], CPU[len(CPU) - 1]
+    print(f"python3 dev.py run              {first_run_s:7.1f} s  "
+          f"(CPU {cpu_install + cpu_job:.1f} s)")
+    print(f"  install (venv, pip, ftc-mc)   {install_s:7.1f} s  (CPU {cpu_install:.1f} s)")
+    print(f"  ftc-mc run configs/paper_tables.yaml, 8,000 trials {job_s:.1f} s "
+          f"(CPU {cpu_job:.1f} s):")
     print(f"    start to the compile notice {start_s:7.1f} s")
     print(f"    cold compile, default path  {compile_s:7.1f} s  (ftc-mc: compiled in ...)")
     if bars:
