@@ -3,12 +3,19 @@
 Only the Python standard library is used, so this works on a fresh machine with
 nothing but Python 3.11::
 
-    python3 dev.py run     # create .venv if needed, install, run the main job
-    python3 dev.py test    # create .venv if needed, install with test extras, run pytest
-                           # (-q -n auto --dist worksteal: one pytest-xdist
-                           # worker per core, idle ones take queued tests)
+    python3 dev.py run         # create .venv if needed, install, run the main job
+    python3 dev.py test        # create .venv if needed, install with test extras, and run
+                               # the newcomer's tier of the tests: the install works,
+                               # every golden file holds, each kernel family agrees
+                               # with its NumPy twin (pytest --newcomer, tests/conftest.py)
+    python3 dev.py test --all  # the same install, then the whole test suite (CI runs it)
 
-Extra arguments after ``run`` go to ``ftc-mc``; after ``test`` to ``pytest``.
+Both test commands run pytest with ``-q -n auto --dist worksteal``: one
+pytest-xdist worker per core, idle ones take queued tests.  Extra arguments
+after ``run`` go to ``ftc-mc``; after ``test`` they go to ``pytest`` in place
+of the tier (``python3 dev.py test tests/test_golden.py -x``), and after
+``test --all`` they are added to the whole suite's command.
+
 The install is repeated only when ``pyproject.toml`` changes.  It is editable
 (the sources stay in this folder, so an edit is run and tested at once), and
 pip runs with ``-qq``: its errors are shown, its warnings are not (setuptools
@@ -84,11 +91,24 @@ def main(argv: list[str]) -> int:
         args = [str(BIN / "ftc-mc")] + (rest or MAIN_JOB)
     else:
         ensure_venv("test")
-        # one worker per core; tests/conftest.py orders the tests so that the
-        # workers share the trial kernel's cold compile, and worksteal lets the
-        # other worker take the first one's queued tests meanwhile
-        args = [str(PY), "-m", "pytest"] + (rest or ["-q", "-n", "auto", "--dist", "worksteal"])
+        args = [str(PY), "-m", "pytest"] + pytest_args(rest)
     return subprocess.run(args, cwd=ROOT).returncode
+
+
+# one worker per core; tests/conftest.py orders the tests so that the
+# workers share the trial kernel's cold compile, and worksteal lets the
+# other worker take the first one's queued tests meanwhile
+PYTEST = ["-q", "-n", "auto", "--dist", "worksteal"]
+
+
+def pytest_args(rest: list[str]) -> list[str]:
+    """pytest's arguments for ``python3 dev.py test REST...``: the newcomer's
+    tier, the whole suite (``--all``, then more arguments), or ``REST``."""
+    if not rest:
+        return PYTEST + ["--newcomer"]
+    if rest[0] == "--all":
+        return PYTEST + rest[1:]
+    return rest
 
 
 if __name__ == "__main__":

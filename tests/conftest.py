@@ -1,5 +1,6 @@
 """Shared fixtures: the linear plant and paper-default estimator settings; the
-order that lets two test workers share the trial kernel's one cold compile."""
+order that lets two test workers share the trial kernel's one cold compile;
+the newcomer's tier (``--newcomer``, what ``python3 dev.py test`` runs)."""
 
 from pathlib import Path
 
@@ -20,6 +21,86 @@ TRIAL_KERNEL_FILES = {
 }
 """Test files that run campaigns, sweeps or scenarios (the trial kernel
 ``core.longitudinal.trial.advance``); the other files test kernels and models piece by piece."""
+
+
+NEWCOMER = {
+    "the install": [
+        "test_install.py::test_the_command_is_installed_and_runs",
+        "test_install.py::test_numba_is_a_tested_version",
+    ],
+    "every golden file": [
+        "test_golden.py::test_campaign_is_golden[linear]",
+        "test_golden.py::test_campaign_is_golden[nonlinear_moderate]",
+        "test_golden.py::test_campaign_is_golden[sixdof_moderate]",
+        "test_golden.py::test_scenario_is_golden[linear]",
+        "test_golden.py::test_scenario_is_golden[nonlinear_moderate]",
+        "test_golden.py::test_scenario_is_golden[sixdof]",
+        "test_config_equivalence.py::test_every_shipped_config_has_a_record",
+    ] + [f"test_config_equivalence.py::test_shipped_config_resolves_as_recorded[{f.stem}]"
+         for f in sorted((ROOT / "tests" / "golden" / "configs").glob("*.json"))],
+    "longitudinal kernels against their NumPy twins": [
+        "test_stages.py::test_advance_matches_the_chained_twins[linear-none]",
+    ],
+    "6-DOF kernels against their NumPy twins": [
+        "test_sixdof_trial.py::test_sixdof_truth_matches_its_twin[nonlinear-separate]",
+    ],
+}
+"""The newcomer's tier, ``pytest --newcomer`` (``python3 dev.py test``; the
+whole suite is ``python3 dev.py test --all``): the cheapest tests that show
+the install works, every file of ``tests/golden/`` holds, and each kernel
+family agrees with its plain-NumPy twin on one path.  Chosen by compile cost
+(each test's cold compile measured with two pytest-xdist workers): the golden
+cases compile the default, nonlinear and 6-DOF paths, and the scenarios
+reuse them (the recorded configs of ``tests/golden/configs/`` compile
+nothing); the longitudinal twin runs the whole trial loop on the default
+path the golden linear case compiled (under a second); the 6-DOF twin runs
+the flying wing's truth stage (equations, lateral loops, gusts, faults)
+against its twin, its stage compiled again with Python wrappers (about 10 s
+more CPU in the tier, 34 s alone on an empty cache, where the side monitor's
+twin took 63 s and the equations' twin 3 s; one sitting, a shared machine).  Node ids relative to ``tests/``; ``tests/test_newcomer.py`` checks
+each exists and what the tier covers."""
+
+
+def _newcomer_ids() -> set:
+    return {f"tests/{i}" for ids in NEWCOMER.values() for i in ids}
+
+
+def pytest_addoption(parser):
+    parser.addoption("--newcomer", action="store_true", default=False,
+                     help="run only the newcomer's tier (tests/conftest.py NEWCOMER): the "
+                     "install, the golden files, a kernel-vs-twin test per family")
+
+
+def pytest_ignore_collect(collection_path, config):
+    """With ``--newcomer``, test files outside the tier are not even imported."""
+    if (config.getoption("newcomer") and collection_path.suffix == ".py"
+            and collection_path.name.startswith("test_")
+            and collection_path.name not in {i.split("::")[0] for ids in NEWCOMER.values()
+                                             for i in ids}):
+        return True
+    return None
+
+
+def _select_newcomer(config, items) -> None:
+    """With ``--newcomer``, keep the tier's tests only; a test it names that a
+    collected file no longer holds (renamed, parametrised otherwise), or
+    whose file is gone, stops the run, so the tier never shrinks unnoticed."""
+    if not config.getoption("newcomer"):
+        return
+    wanted = _newcomer_ids()
+    collected_files = {item.nodeid.split("::")[0] for item in items}
+    found = {item.nodeid for item in items}
+    missing = sorted(i for i in wanted if i not in found
+                     and (i.split("::")[0] in collected_files
+                          or not (ROOT / i.split("::")[0]).is_file()))
+    if missing:
+        raise pytest.UsageError("the newcomer's tier (tests/conftest.py NEWCOMER) names tests "
+                                "that do not exist: " + ", ".join(missing))
+    keep = [item for item in items if item.nodeid in wanted]
+    deselected = [item for item in items if item.nodeid not in wanted]
+    if deselected:
+        config.hook.pytest_deselected(items=deselected)
+    items[:] = keep
 
 
 def _late(item) -> bool:
@@ -83,7 +164,9 @@ def pytest_collection_modifyitems(config, items):
     Runs last (``trylast``), after ``-k``, ``-m`` and ``--deselect`` have
     removed tests, so that the parts match what xdist hands out; ``--lf`` and
     ``--ff`` still change the list afterwards (the order is then only less
-    good)."""
+    good).  With ``--newcomer``, the tier's tests are chosen first
+    (:func:`_select_newcomer`)."""
+    _select_newcomer(config, items)
     items.sort(key=_late)
     workers = _worksteal_workers(config)
     if workers:

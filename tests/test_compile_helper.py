@@ -106,13 +106,66 @@ def _write_plan(path: Path, version=None) -> Path:
     return path
 
 
-def test_a_plan_of_another_numba_or_unreadable_is_not_used(tmp_path):
+def _notices(capsys, monkeypatch) -> list:
+    """The lines this test printed to stderr; the plan's notice may be
+    printed again afterwards (it is printed once per process)."""
+    lines = capsys.readouterr().err.splitlines()
+    monkeypatch.setattr(compile_helper, "_PLAN_NOTICED", False)
+    return lines
+
+
+def test_a_plan_of_another_numba_or_unreadable_is_not_used(tmp_path, capsys, monkeypatch):
+    """Not used, and said in one line on stderr: a plan of another Numba
+    version, one that does not unpickle; a missing plan is not used, and
+    nothing is said (a source tree before its first plan)."""
+    monkeypatch.setattr(compile_helper, "_PLAN_NOTICED", False)
     assert load_plan(_write_plan(tmp_path / "ok.pkl")) == {
         "probe path": {"before_s": 0.0, "stages": [(MODULE, NAME, ARGS, 1.0)]}}
+    assert _notices(capsys, monkeypatch) == []
     assert load_plan(_write_plan(tmp_path / "old.pkl", version="0.1.0")) == {}
+    [line] = _notices(capsys, monkeypatch)
+    assert line.startswith("ftc-mc: the compile plan (old.pkl) was written by Numba 0.1.0, "
+                           f"this is Numba {numba.__version__};")
     (tmp_path / "junk.pkl").write_bytes(b"not a pickle")
     assert load_plan(tmp_path / "junk.pkl") == {}
+    [line] = _notices(capsys, monkeypatch)
+    assert line.startswith("ftc-mc: the compile plan (junk.pkl) cannot be read")
     assert load_plan(tmp_path / "missing.pkl") == {}
+    assert _notices(capsys, monkeypatch) == []
+    # once per process
+    assert load_plan(tmp_path / "junk.pkl") == load_plan(tmp_path / "old.pkl") == {}
+    assert len(_notices(capsys, monkeypatch)) == 1
+
+
+def test_a_plan_naming_a_numba_type_class_that_is_gone_falls_back(tmp_path, capsys,
+                                                                  monkeypatch):
+    """A newer Numba may have moved or renamed a type class the plan pickled:
+    unpickling it raises, the plan is not used (no helper starts, this
+    process compiles everything itself), one line on stderr, no traceback."""
+    from numba.core.types import scalars
+
+    from ftc_mc.core.shared.paths import (LINEAR_PLANT, ONE_STEP_TEST, PAPER_FILTER,
+                                          RECONFIGURING, Path as Path_)
+
+    class Gone(numba.types.Integer):
+        pass
+
+    Gone.__module__, Gone.__qualname__ = scalars.__name__, "IntegerOfAnOlderNumba"
+    monkeypatch.setattr(scalars, "IntegerOfAnOlderNumba", Gone, raising=False)
+    plan = tmp_path / "plan.pkl"
+    plan.write_bytes(pickle.dumps({"numba": numba.__version__, "paths": {"probe path": {
+        "before_s": 0.0, "stages": [(MODULE, NAME, (Gone("int64"),), 1.0)]}}}, protocol=4))
+    monkeypatch.delattr(scalars, "IntegerOfAnOlderNumba")
+    monkeypatch.setattr(compile_helper, "_PLAN_NOTICED", False)
+    monkeypatch.setattr(compile_helper, "plan_key", lambda p: "probe path")
+    monkeypatch.setattr(compile_helper, "enabled", lambda: True)
+    path = Path_(LINEAR_PLANT, PAPER_FILTER, ONE_STEP_TEST, RECONFIGURING)
+    assert compile_helper.start(path, plan) == (None, [])
+    [line] = _notices(capsys, monkeypatch)
+    assert line.startswith("ftc-mc: the compile plan (plan.pkl) cannot be read with Numba ")
+    assert "IntegerOfAnOlderNumba" in line and line.endswith("(slower, same results)")
+    # the helper, given such a plan, does nothing and says why by its exit status
+    assert compile_helper.run("probe path", plan) == 1
 
 
 def test_a_stage_the_plan_names_that_no_longer_exists_is_skipped():

@@ -85,3 +85,23 @@ def test_a_failed_install_is_one_line_and_not_stamped(dev):
     dev.ensure_venv("")
     assert len(dev.calls) == 4  # tried again: upgrade, install, compile
 
+
+
+def test_the_test_command_runs_the_tier_and_all_runs_the_suite(dev):
+    """``python3 dev.py test`` runs the newcomer's tier; ``test --all`` the
+    whole suite (CI's command), with more pytest arguments after it; other
+    arguments go to pytest in place of either."""
+    both = ["-q", "-n", "auto", "--dist", "worksteal"]
+    assert dev.pytest_args([]) == both + ["--newcomer"]
+    assert dev.pytest_args(["--all"]) == both
+    assert dev.pytest_args(["--all", "-x"]) == both + ["-x"]
+    assert dev.pytest_args(["tests/test_golden.py", "-x"]) == ["tests/test_golden.py", "-x"]
+    assert dev.main(["test"]) == 0
+    assert dev.calls[-1][1:] == ["-m", "pytest"] + both + ["--newcomer"]
+    assert dev.main(["test", "--all"]) == 0
+    assert dev.calls[-1][1:] == ["-m", "pytest"] + both
+
+
+def test_ci_runs_the_whole_suite():
+    run = (ROOT / ".ci" / "run").read_text()
+    assert 'dev.py test --all' in run

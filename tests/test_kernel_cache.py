@@ -86,6 +86,7 @@ def _run(root: Path, cache: Path, **env) -> dict:
     assert out.returncode == 0, out.stderr
     res = json.loads(out.stdout.splitlines()[-1])
     assert Path(res["file"]).resolve().is_relative_to(root.resolve())  # the copy ran
+    res["stderr"] = out.stderr
     return res
 
 
@@ -120,6 +121,45 @@ def test_a_second_copy_loads_and_an_edit_compiles(tmp_path):
     other = _run(b, cache)
     assert other["digest"] not in (first["digest"], edited["digest"])
     assert other["needed"] is True and other["misses"] == 1
+
+
+@pytest.mark.skipif(not jit.CACHE, reason="FTC_MC_NUMBA_CACHE=0")
+def test_a_cache_of_another_numba_or_damaged_is_compiled_again_with_one_line(tmp_path):
+    """A kernel cache the installed Numba cannot use (an index written by
+    another Numba version, an index or a compiled kernel that cannot be
+    unpickled) is a cache miss: the kernel is compiled again, gives the same
+    value, is saved over it, and stderr holds one line saying so (no
+    traceback)."""
+    import pickle
+
+    root, cache = _copy(tmp_path / "a"), tmp_path / "cache"
+    first = _run(root, cache)
+    assert first["misses"] == 1 and first["stderr"] == ""
+    [index] = Path(first["cache"]).glob("probe.probe-*.nbi")
+    [data] = Path(first["cache"]).glob("probe.probe-*.nbc")
+    with open(index, "rb") as f:
+        version, body = pickle.load(f), f.read()
+
+    def again(expect: str, needed: bool = True) -> dict:
+        res = _run(root, cache)
+        assert res["needed"] is needed and res["misses"] == 1 and res["hits"] == 0
+        assert res["value"] == first["value"]
+        lines = res["stderr"].splitlines()
+        assert len(lines) == 1 and lines[0].startswith("ftc-mc: ") and expect in lines[0], lines
+        return res
+
+    # an index of another Numba version (which Numba reads as empty)
+    index.write_bytes(pickle.dumps("0.0.1") + body)
+    again(f"written by Numba 0.0.1, this is Numba {version}")
+    # an index that does not unpickle
+    index.write_bytes(pickle.dumps(version) + body[: len(body) // 2])
+    again("cannot be read with this Numba")
+    loaded = _run(root, cache)  # saved anew: loaded, nothing said
+    assert loaded["hits"] == 1 and loaded["stderr"] == ""
+    # a compiled kernel that does not unpickle (the index still lists it)
+    data.write_bytes(data.read_bytes()[:100])
+    again("cannot be read with this Numba", needed=False)
+    assert _run(root, cache)["hits"] == 1
 
 
 @pytest.mark.skipif(not jit.CACHE, reason="FTC_MC_NUMBA_CACHE=0")

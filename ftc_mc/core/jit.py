@@ -21,7 +21,10 @@ source tree's own ``tests/`` or ``scripts/`` is keyed the same way, on the kerne
 sources and on those folders' files (:class:`CloneFolderLocator`), so a new
 clone loads the test kernels too.  ``NUMBA_CACHE_DIR`` in the environment takes
 precedence over ``$FTC_MC_CACHE_DIR/numba`` (``$NUMBA_CACHE_DIR/<digest>``; the
-benchmarks point it at an empty folder), and ``FTC_MC_NUMBA_CACHE=0`` turns caching off.  ``fastmath`` stays
+benchmarks point it at an empty folder), and ``FTC_MC_NUMBA_CACHE=0`` turns caching off.
+A cache the installed Numba cannot use (an index of another Numba version, a
+file that does not unpickle) is a cache miss, said in one line on stderr
+(:class:`TolerantIndexFile`, :meth:`ContentFunctionCache.load_overload`).  ``fastmath`` stays
 off: it was no faster here (``scripts/benchmarks/bench_core.py``) and breaks bit-for-bit
 agreement with the NumPy references.
 """
@@ -409,25 +412,89 @@ def _native(key) -> bool:
     return True
 
 
+CACHE_MISMATCH_NOTICE = ("ftc-mc: the kernel cache in {} was written by Numba {}, this is "
+                         "Numba {}; its kernels are compiled again (same results)")
+"""Printed to stderr, once per process, when a kernel's cache index is of
+another Numba version (Numba itself then reads it as empty)."""
+
+CACHE_UNREADABLE_NOTICE = ("ftc-mc: a kernel cache file in {} cannot be read with this "
+                           "Numba ({}); its kernels are compiled again (same results)")
+"""Printed to stderr, once per process, when a kernel's cache index or
+compiled kernel cannot be read (damaged, or of a Numba whose classes moved):
+it is then a cache miss, and the kernel is compiled and saved anew."""
+
+_CACHE_NOTICED = False
+
+
+def _cache_notice(text: str) -> None:
+    """Print ``text`` to stderr, one line, unless a cache notice was printed
+    in this process already."""
+    global _CACHE_NOTICED
+    if _CACHE_NOTICED:
+        return
+    _CACHE_NOTICED = True
+    import sys
+    print(" ".join(text.split()), file=sys.stderr, flush=True)
+
+
+def _why(exc: BaseException) -> str:
+    """A short one-line description of ``exc`` for a notice."""
+    text = " ".join(f"{type(exc).__name__}: {exc}".split())
+    return text if len(text) <= 120 else text[:117] + "..."
+
+
 class TolerantIndexFile(caching.IndexDataCacheFile):
     """A kernel's cache index that stays readable in a process that cannot import
     a type some other process compiled the kernel for (the tests compile package
     kernels on types of their own modules; a process without ``tests/`` on its
     path failed to load such an index at all).  Those entries are left out of
     what this process reads, so they are a cache miss here and are dropped when
-    this process saves an overload of the kernel."""
+    this process saves an overload of the kernel.
+
+    An index that cannot be read at all (damaged, or pickled by a Numba whose
+    classes this one lacks) is read as empty, with one line on stderr
+    (:data:`CACHE_UNREADABLE_NOTICE`): its kernels are compiled and the index
+    written anew.  One of another Numba version, which Numba reads as empty,
+    is said so too (:data:`CACHE_MISMATCH_NOTICE`)."""
 
     def _load_index(self):
         try:
-            return super()._load_index()
+            overloads = super()._load_index()
         except (ImportError, AttributeError):
-            pass
+            try:
+                return self._load_tolerant()
+            except Exception as exc:  # noqa: BLE001 -- unreadable: a miss
+                return self._unreadable(exc)
+        except Exception as exc:  # noqa: BLE001 -- unreadable: a miss
+            return self._unreadable(exc)
+        if not overloads:
+            self._check_version()
+        return overloads
+
+    def _load_tolerant(self) -> dict:
+        """The index with the entries of types this process cannot import
+        left out (class docstring)."""
         with open(self._index_path, "rb") as f:
             pickle.load(f)  # the version, checked by the first attempt
             stamp, overloads = _TolerantUnpickler(io.BytesIO(f.read())).load()
         if stamp != self._source_stamp:
             return {}
         return {k: v for k, v in overloads.items() if _native(k)}
+
+    def _unreadable(self, exc: BaseException) -> dict:
+        _cache_notice(CACHE_UNREADABLE_NOTICE.format(self._cache_path, _why(exc)))
+        return {}
+
+    def _check_version(self) -> None:
+        """Say so (once) if the index on disk is of another Numba version."""
+        try:
+            with open(self._index_path, "rb") as f:
+                version = pickle.load(f)
+        except Exception:  # noqa: BLE001 -- no index (a miss) or unreadable: nothing to say
+            return
+        if version != self._version:
+            _cache_notice(CACHE_MISMATCH_NOTICE.format(self._cache_path, version,
+                                                       self._version))
 
 
 class ContentFunctionCache(caching.FunctionCache):
@@ -468,8 +535,17 @@ class ContentFunctionCache(caching.FunctionCache):
         return Path(self._cache_path) / f"{name}.{digest}.claim"
 
     def load_overload(self, sig, target_context):
+        """Numba's, after waiting for a claim (class docstring); a compiled
+        kernel that cannot be loaded (a damaged file, a Numba whose internals
+        moved) is a cache miss, said once on stderr
+        (:data:`CACHE_UNREADABLE_NOTICE`): the kernel is compiled, and saved
+        over it."""
         self._await_claim(sig)
-        return super().load_overload(sig, target_context)
+        try:
+            return super().load_overload(sig, target_context)
+        except Exception as exc:  # noqa: BLE001 -- unreadable: compile instead
+            _cache_notice(CACHE_UNREADABLE_NOTICE.format(self._cache_path, _why(exc)))
+            return None
 
     def _await_claim(self, sig) -> None:
         """Wait while another process holds the claim of ``sig`` (class docstring)."""

@@ -75,16 +75,42 @@ def plan_key(path) -> str:
     return describe(path)
 
 
+PLAN_NOTICE = ("ftc-mc: the compile plan ({}) {}; this process compiles the kernels "
+               "without its helper (slower, same results)")
+"""Printed to stderr, once per process, when the shipped plan cannot be used
+with the installed Numba (:func:`load_plan`)."""
+
+_PLAN_NOTICED = False
+
+
+def _plan_notice(plan_file: Path, why: str) -> None:
+    global _PLAN_NOTICED
+    if not _PLAN_NOTICED:
+        _PLAN_NOTICED = True
+        print(" ".join(PLAN_NOTICE.format(Path(plan_file).name, why).split()),
+              file=sys.stderr, flush=True)
+
+
 def load_plan(plan_file: Path = PLAN_FILE) -> dict:
     """The plan's paths: ``{key: {"before_s": s, "stages": [(module, qualname,
     argument types, seconds), ...]}}``; empty when the file is missing, cannot
-    be read, or was written by another Numba version (whose types may differ)."""
+    be read (a Numba whose type classes moved, a damaged file), or was written
+    by another Numba version (whose types may differ).  A plan that is there
+    but cannot be used is said once on stderr (:data:`PLAN_NOTICE`): the
+    compile then runs in this process alone."""
     try:
         with open(plan_file, "rb") as f:
             plan = pickle.load(f)
-    except Exception:  # noqa: BLE001 -- no plan: this process compiles alone
+    except FileNotFoundError:
+        return {}
+    except Exception as exc:  # noqa: BLE001 -- no plan: this process compiles alone
+        why = " ".join(f"{type(exc).__name__}: {exc}".split())[:120]
+        _plan_notice(plan_file, f"cannot be read with Numba {numba.__version__} ({why})")
         return {}
     if not isinstance(plan, dict) or plan.get("numba") != numba.__version__:
+        written = plan.get("numba") if isinstance(plan, dict) else None
+        _plan_notice(plan_file, f"was written by Numba {written}, this is Numba "
+                     f"{numba.__version__}")
         return {}
     return plan.get("paths", {})
 
