@@ -49,7 +49,7 @@ from .signature import signature_lanes
 from ..shared.glr import glr_lanes, glr_restart
 from .gustfilter import gust_correct_lanes, gust_predict_lanes
 from ..shared.belief import belief_update_lane
-from .control import (U_LEFT, U_RIGHT, U_THRUST, controller_command, feedback_lanes,
+from .control import (U_LEFT, U_RIGHT, U_THRUST, controller_commands_lanes, feedback_lanes,
                       select_controllers_lanes)
 from ..shared.excitation import (doublet, doublet_length, running, saturate, signal_3211,
                                  signal_3211_length)
@@ -75,18 +75,12 @@ def nominal_output(scheme, st, work):
 @kernel(internal=True)
 def reconfiguring_output(scheme, st, work):
     """The output of each lane's controller in use into ``work.u``
-    (:func:`ftc_mc.core.longitudinal.control.controller_command`: c0, c1 of eq. 44 or c2 of
-    eqs. 20-25); one-lane buffers ``xl``, ``Ul``."""
-    xa = st.xa
-    xl = work.xl
-    Ul = work.Ul
-    for l in range(xa.shape[1]):
-        for i in range(xa.shape[0]):
-            xl[i] = xa[i, l]
-        controller_command(st.cur[l], xl, scheme.controller.K, scheme.engine,
-                           scheme.filter.u0, Ul)
-        for i in range(N_U):
-            work.u[i, l] = Ul[i]
+    (:func:`ftc_mc.core.longitudinal.control.controller_commands_lanes`: c0,
+    c1 of eq. 44 or c2 of eqs. 20-25, each lane bit for bit
+    :func:`~ftc_mc.core.longitudinal.control.controller_command`, the nominal
+    feedback across lanes); one-lane buffers ``xl``, ``Ul``."""
+    controller_commands_lanes(st.cur, st.xa, scheme.controller.K, scheme.engine,
+                              scheme.filter.u0, work.u, work.xl, work.Ul)
 
 
 @on_path("control", {NOMINAL_CONTROL: nominal_output, RECONFIGURING: reconfiguring_output,
