@@ -18,13 +18,17 @@ minimising ``I(a) + sum_m b_{k+H}(m) (J^N(m, a) + P(c, a))`` (eqs. 46-47) is
 chosen.
 
 The trial loop selects for all its lanes at once
-(:func:`select_controllers_lanes`): each controller's horizon is predicted for
-every lane with the lane-interleaved filter kernels of :mod:`ftc_mc.core.longitudinal.batch`,
-then belief and objective follow per lane.  Per lane this is
-``tests/single_trajectory.py::select_controller`` bit for bit (``tests/test_stages.py``); measured on a
-chunk of 128 lanes of ``configs/paper_tables.yaml``, one core: 2.9 ms per
-selection against 9.3 ms one lane at a time (of which the measurement updates
-take about 60 %, the predictions 35 %).
+(:func:`select_controllers_lanes`) with the lane-interleaved filter kernels of
+:mod:`ftc_mc.core.longitudinal.batch`.  The state follows the model alone
+(the update's innovation is zero), so each controller's cost ``I(a)`` is
+predicted without the covariance, and it bounds the objective from below; the
+covariance's horizon, nearly all the work, is predicted for the controller in
+use and for the others whose bound does not rule them out
+(:func:`controller_objectives_lanes`): about 1.3 of 3 per lane on
+``configs/paper_tables.yaml``.  Per lane the choice, and every objective
+computed, is ``tests/single_trajectory.py::select_controller``'s bit for bit
+(``tests/test_stages.py``); ``docs/findings/performance.md`` lessons 7 and 18
+give the figures.
 
 Plain-NumPy twins: ``tests/naive.py`` (``controller_command_ref``,
 ``horizon_cost_ref``, ``controller_objectives_ref``), compared in

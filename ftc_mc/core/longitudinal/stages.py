@@ -715,8 +715,9 @@ def reconfigure(path, scheme, timing, inp, st, kn, period, work, rec):
     estimate's first 14 states (a design's gust states are left out), for every
     lane at once (:func:`ftc_mc.core.longitudinal.control.select_controllers_lanes`, per
     lane bit-identical to ``tests/single_trajectory.py::select_controller``; the
-    horizon predictions run lane-interleaved, about 4x faster than one lane at
-    a time); and the detection time: the
+    horizon predictions run lane-interleaved, and the covariance's only for
+    the controllers whose objective can be the smallest,
+    ``docs/findings/performance.md`` lesson 18); and the detection time: the
     first period end after the switch ``k_fault`` where the final mode is the
     most probable with at least ``detect_prob`` (live lanes only).
 
