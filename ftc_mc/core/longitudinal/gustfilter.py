@@ -504,19 +504,22 @@ def _gpredict(fkind, xa, P, Pn, u, fm, phi, T, xn, tw, st, fresh):
             xa[N_AUG + a, l] = xn[N_AUG + a, l]
     # T = F P
     if relin:
+        # lane loops innermost, sums in the per-lane order (the same bits)
         JA = st.JA
         jg = tw.jg
         for i in range(N_X):
             for c in range(n):
                 for l in range(L):
-                    acc = 0.0
-                    for j in range(N_X):
-                        acc += JA[i, j, l] * P[j, c, l]
-                    for j in range(N_F):
-                        acc += phi[i, j, l] * P[N_X + j, c, l]
-                    for g in range(ng):
-                        acc += jg[i, g, l] * P[N_AUG + g, c, l]
-                    T[i, c, l] = acc
+                    T[i, c, l] = 0.0
+                for j in range(N_X):
+                    for l in range(L):
+                        T[i, c, l] += JA[i, j, l] * P[j, c, l]
+                for j in range(N_F):
+                    for l in range(L):
+                        T[i, c, l] += phi[i, j, l] * P[N_X + j, c, l]
+                for g in range(ng):
+                    for l in range(L):
+                        T[i, c, l] += jg[i, g, l] * P[N_AUG + g, c, l]
     else:
         for i in range(N_X):
             for c in range(n):
@@ -545,14 +548,16 @@ def _gpredict(fkind, xa, P, Pn, u, fm, phi, T, xn, tw, st, fresh):
         for k in range(i, n):
             if k < N_X and relin:
                 for l in range(L):
-                    acc = 0.0
-                    for j in range(N_X):
-                        acc += T[i, j, l] * st.JA[k, j, l]
-                    for j in range(N_F):
-                        acc += T[i, N_X + j, l] * phi[k, j, l]
-                    for g in range(ng):
-                        acc += T[i, N_AUG + g, l] * tw.jg[k, g, l]
-                    Pn[i, k, l] = acc
+                    Pn[i, k, l] = 0.0
+                for j in range(N_X):
+                    for l in range(L):
+                        Pn[i, k, l] += T[i, j, l] * st.JA[k, j, l]
+                for j in range(N_F):
+                    for l in range(L):
+                        Pn[i, k, l] += T[i, N_X + j, l] * phi[k, j, l]
+                for g in range(ng):
+                    for l in range(L):
+                        Pn[i, k, l] += T[i, N_AUG + g, l] * tw.jg[k, g, l]
             elif k < N_X:
                 for l in range(L):
                     acc = 0.0
@@ -601,19 +606,25 @@ def gust_residuals_lanes(xa, P, z, fm, crow, hpred, res, innov, st, cl):
     n = xa.shape[0]
     L = xa.shape[1]
     if fm.relin > 0:
+        # lane loops innermost (sums in the per-lane order: the same bits);
+        # ``res[o]`` accumulates ``c P c^T``, ``innov[o]`` each ``(P c^T)_j``
         for o in range(len(RESIDUAL_OUTPUTS)):
             r = RESIDUAL_OUTPUTS[o]
             _c_rows_lanes(fm, st, r, cl)
             rr = fm.r_diag[r]
             for l in range(L):
-                s = 0.0
-                for j in range(n):
-                    acc = 0.0
-                    for k in range(n):
-                        acc += P[j, k, l] * cl[k, l]
-                    s += cl[j, l] * acc
+                res[o, l] = 0.0
+            for j in range(n):
+                for l in range(L):
+                    innov[o, l] = 0.0
+                for k in range(n):
+                    for l in range(L):
+                        innov[o, l] += P[j, k, l] * cl[k, l]
+                for l in range(L):
+                    res[o, l] += cl[j, l] * innov[o, l]
+            for l in range(L):
                 mu = z[r, l] - hpred[r, l]
-                s = s + rr
+                s = res[o, l] + rr
                 res[o, l] = mu * mu / s
                 innov[o, l] = mu / np.sqrt(s)
         return
@@ -665,25 +676,32 @@ def _gupdate(xa, P, z, fm, crow, h, v, gs, hpred, xp, st, cl):
     n = xa.shape[0]
     L = xa.shape[1]
     if fm.relin > 0:
+        # lane loops innermost, each sum in the order of the per-lane loops it
+        # replaced (so the same bits): a sum over j inside the lane loop did
+        # not vectorise (lesson 2)
         for r in range(z.shape[0]):
             _c_rows_lanes(fm, st, r, cl)
             rr = fm.r_diag[r]
             for a in range(n):
                 for l in range(L):
-                    acc = 0.0
-                    for j in range(n):
-                        if j < a:
-                            acc += P[j, a, l] * cl[j, l]
-                        else:
-                            acc += P[a, j, l] * cl[j, l]
-                    h[a, l] = acc
-            for l in range(L):
-                pred = hpred[r, l]
-                sv = rr
+                    h[a, l] = 0.0
                 for j in range(n):
-                    pred += cl[j, l] * (xa[j, l] - xp[j, l])
-                    sv += cl[j, l] * h[j, l]
-                gs[0, l] = (z[r, l] - pred) / sv
+                    if j < a:
+                        for l in range(L):
+                            h[a, l] += P[j, a, l] * cl[j, l]
+                    else:
+                        for l in range(L):
+                            h[a, l] += P[a, j, l] * cl[j, l]
+            for l in range(L):
+                gs[0, l] = hpred[r, l]
+                gs[1, l] = rr
+            for j in range(n):
+                for l in range(L):
+                    gs[0, l] += cl[j, l] * (xa[j, l] - xp[j, l])
+                    gs[1, l] += cl[j, l] * h[j, l]
+            for l in range(L):
+                sv = gs[1, l]
+                gs[0, l] = (z[r, l] - gs[0, l]) / sv
                 gs[1, l] = 1.0 / sv
             _apply_gain(xa, P, h, v, gs)
         return
