@@ -351,5 +351,6 @@ def make_work():
     return np.zeros((N_WORK, N_STATE))
 
 
-__all__ = ["air_forces", "derivatives_nb", "derivatives_partials_nb", "N_PARTIAL", "outputs_nb", "rk4_step", "propagate",
+__all__ = ["air_forces", "derivatives_nb", "derivatives_partials_nb", "N_PARTIAL",
+           "outputs_nb", "rk4_step", "propagate",
            "make_work", "N_WORK", "N_STATE", "N_OUTPUT", "N_PARAM"]
