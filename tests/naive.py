@@ -209,13 +209,60 @@ def predicted_outputs(X, model):
     return aug(model, np.zeros(3))[2] @ X
 
 
-def jacobians_ref(X, u, model):
-    """Forward finite differences of the extended filter's one-period map
-    ``x_{k+1} = rk4(x0 + x, u0 + e, C_d g)`` and of the outputs
-    ``h(x0 + x, C_d g)`` at the estimate ``X`` with the command ``u``
-    (``core/gustfilter.relinearise_lanes``): steps ``1e-6 max(1, |x0_i + x_i|)``
-    in the states, ``1e-6`` in the effects and the wind, each divided by the
-    step actually represented.  Returns ``JA, JB, JW, JC, JHW``."""
+def x8_jacobian_ref(x, cmd, p, wind):
+    """``[df/dx, df/dcmd, df/dwind]`` (9 x 15) of :func:`x8_derivatives_ref` by
+    central differences (steps ``1e-5 max(1, |v|)``: errors near 1e-10
+    relative, far below the forward differences the filter once used)."""
+    v = np.concatenate([x, cmd, wind]).astype(float)
+    J = np.zeros((N_X, v.size))
+    for j in range(v.size):
+        step = 1e-5 * max(1.0, abs(v[j]))
+        vp, vm = v.copy(), v.copy()
+        vp[j] += step
+        vm[j] -= step
+        fp = x8_derivatives_ref(vp[:N_X], vp[N_X:N_X + 3], p, vp[N_X + 3:])
+        fm_ = x8_derivatives_ref(vm[:N_X], vm[N_X:N_X + 3], p, vm[N_X + 3:])
+        J[:, j] = (fp - fm_) / (vp[j] - vm[j])
+    return J
+
+
+def rk4_jacobian_ref(x, cmd, p, wind, dt, n_sub):
+    """The derivative of :func:`rk4_ref`'s map in ``[x, cmd, wind]`` (9 x 15),
+    carried through the RK4 stages: ``K_s = J_f(x_s) [S_s; E]`` with the stage
+    tangents ``S_s`` formed as the stage points are and ``E`` the held
+    commands' and wind's unit columns."""
+    def f(s):
+        return x8_derivatives_ref(s, cmd, p, wind)
+
+    def slope(s, S):
+        return x8_jacobian_ref(s, cmd, p, wind) @ np.vstack([S, np.eye(6, 15, N_X)])
+
+    h = dt / n_sub
+    x = np.array(x, dtype=float)
+    S = np.eye(N_X, 15)
+    for _ in range(n_sub):
+        k1, K1 = f(x), slope(x, S)
+        x2, S2 = x + h / 2 * k1, S + h / 2 * K1
+        k2, K2 = f(x2), slope(x2, S2)
+        x3, S3 = x + h / 2 * k2, S + h / 2 * K2
+        k3, K3 = f(x3), slope(x3, S3)
+        x4, S4 = x + h * k3, S + h * K3
+        k4, K4 = f(x4), slope(x4, S4)
+        x = x + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+        S = S + h / 6 * (K1 + 2 * K2 + 2 * K3 + K4)
+    return S
+
+
+def jacobians_ref(X, u, model, exact=True):
+    """The extended filter's Jacobians at the estimate ``X`` with the command
+    ``u`` (``core/gustfilter.relinearise_lanes``, ``relinearise_outputs_lanes``):
+    of the one-period map ``x_{k+1} = rk4(x0 + x, u0 + e, C_d g)``, its
+    derivative carried through the RK4 stages (:func:`rk4_jacobian_ref`), and
+    of the outputs ``h(x0 + x, C_d g)`` by central differences (steps ``1e-5
+    max(1, |v|)``); with ``exact=False`` the forward differences the kernels
+    took before: steps ``1e-6 max(1, |x0_i + x_i|)`` in the states, ``1e-6`` in
+    the effects and the wind, each divided by the step actually represented.
+    Returns ``JA, JB, JW, JC, JHW``."""
     b0, b1 = X[N_X:N_X + 2], X[N_X + 2:N_AUG]
     cmd = model.u0 + u + np.array([b0[0], b0[1] / 2, b0[1] / 2]) - b1 * (u + model.u0)
     xs = model.x0 + X[:N_X]
@@ -244,6 +291,20 @@ def jacobians_ref(X, u, model):
         wp[j] = w[j] + 1e-6
         JW[:, j] = (f(xs, cmd, wp) - fb) / (wp[j] - w[j])
         JHW[:, j] = (h(xs, wp) - yb) / (wp[j] - w[j])
+    if exact:
+        S = rk4_jacobian_ref(xs, cmd, model.p, w, model.dt, model.n_sub)
+        JA, JB, JW = S[:, :N_X], S[:, N_X:N_X + 3], S[:, N_X + 3:]
+        v = np.concatenate([xs, w])
+        for j in range(v.size):
+            step = 1e-5 * max(1.0, abs(v[j]))
+            vp, vm = v.copy(), v.copy()
+            vp[j] += step
+            vm[j] -= step
+            col = ((h(vp[:N_X], vp[N_X:]) - h(vm[:N_X], vm[N_X:])) / (vp[j] - vm[j]))
+            if j < N_X:
+                JC[:, j] = col
+            else:
+                JHW[:, j - N_X] = col
     return JA, JB, JW, JC, JHW
 
 

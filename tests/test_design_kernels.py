@@ -360,15 +360,13 @@ def test_relinearised_filter_update(nonlinear_gusts, relin):
     """The extended filter stage re-linearising its covariance (the state map's
     Jacobians about each lane's estimate, the outputs' about its prediction;
     every step, and every 3 steps from step 10, so steps 10 and 13 re-compute
-    and the others keep them) against the twin with the same finite
-    differences (``naive.lane_jacobians_ref``).
+    and the others keep them) against the twin (``naive.lane_jacobians_ref``:
+    the state map's derivative through the RK4 stages, central differences of
+    the airframe's slopes and outputs).
 
-    Tolerances 1e-7 instead of 1e-9: the finite differences divide the RK4
-    results' rounding (1e-16 relative of states up to 18 m/s, which differs
-    between the compiled and the NumPy arithmetic) by steps of 1e-6, so kernel
-    and twin Jacobians agree to about 1e-8 relative only (measured at worst:
-    7e-9), and the residuals and estimates built on them likewise (1.5e-8 and
-    1.4e-8; covariances 2e-10)."""
+    Tolerances 1e-7 instead of 1e-9: the twin's central differences are
+    exact to about 1e-10 relative only, and the residuals and estimates built
+    on the Jacobians amplify it."""
     fm, P0, d = extended(nonlinear_gusts, relin)
     scheme = gust_scheme(nonlinear_gusts, fm, t_q=3.0, t_nx=3.0)
     rng = np.random.default_rng(66)
@@ -401,6 +399,53 @@ def test_relinearised_at_trim_is_the_trim_model(nonlinear_gusts):
         for l in range(L):
             err = np.abs(getattr(st, f)[:, :, l] - M[:, :, l]).max() / np.abs(M[:, :, l]).max()
             assert err <= 1e-4, (f, l, err)
+
+
+def test_relinearised_jacobians_are_exact(nonlinear_gusts):
+    """The Jacobians of :func:`relinearise_lanes` (the state map's derivative
+    carried through the RK4 stages) and :func:`relinearise_outputs_lanes`, the
+    airframe's partials analytic, against the twin, which carries central
+    differences of ``naive.x8_derivatives_ref`` through the stages and takes
+    those of ``naive.x8_outputs_ref``, to 1e-8 relative to each matrix's
+    largest entry, and against the forward differences the kernels once took,
+    to their own error (measured at worst 5e-7); the state map's RK4 leaves
+    the prediction of ``_nl_state`` to the bit, and ``derivatives_partials_nb``
+    the slopes of ``derivatives_nb``."""
+    from ftc_mc.core.longitudinal.gustfilter import (_nl_state, relinearise_lanes,
+                                                     relinearise_outputs_lanes)
+    from ftc_mc.core.longitudinal.nonlinear import (N_PARTIAL, P_GAMMA0, P_V0,
+                                                    derivatives_nb, derivatives_partials_nb)
+
+    fm, P0, d = extended(nonlinear_gusts, 1)
+    scheme = gust_scheme(nonlinear_gusts, fm, t_q=3.0, t_nx=3.0)
+    model = naive.ref_of(scheme)
+    rng = np.random.default_rng(68)
+    st = copy_nt(with_trim_jacobians(with_gust_states(random_lanes(nonlinear_gusts, rng, 10),
+                                                      rng, d, P0), fm))
+    work = new_trial_work(L, N)
+    work.u[:] = 0.05 * rng.standard_normal((3, L))
+    relinearise_lanes(st.xa, work.u, fm, st, work)
+    relinearise_outputs_lanes(st.xa, fm, st, work)  # here about the same point
+    worst = {}
+    for l in range(L):
+        exact = naive.jacobians_ref(st.xa[:, l], work.u[:, l], model)
+        diff = naive.jacobians_ref(st.xa[:, l], work.u[:, l], model, exact=False)
+        for f, J, D in zip(naive.JACOBIANS, exact, diff):
+            K = getattr(st, f)[:, :, l]
+            assert np.abs(K - J).max() <= 1e-8 * np.abs(J).max(), (f, l)
+            worst[f] = max(worst.get(f, 0.0), np.abs(K - D).max() / np.abs(D).max())
+    assert max(worst.values()) <= 2e-6, worst
+    xn = np.zeros((N, L))
+    _nl_state(st.xa, work.u, fm, xn, work)
+    np.testing.assert_array_equal(work.jx[0] - fm.x0[:, None], xn[:N_X])
+    dx, dxp, dp = np.zeros(N_X), np.zeros(N_X), np.zeros(N_PARTIAL)
+    for l in range(L):
+        x = fm.x0 + st.xa[:N_X, l]
+        cmd, wind = fm.u0 + work.u[:, l], 0.3 * rng.standard_normal(3)
+        derivatives_nb(x, cmd, fm.p, wind, dx)
+        derivatives_partials_nb(x, cmd, fm.p, wind, fm.p[P_V0] * np.cos(fm.p[P_GAMMA0]),
+                                fm.p[P_V0] * np.sin(fm.p[P_GAMMA0]), dxp, dp)
+        np.testing.assert_array_equal(dx, dxp)
 
 
 @pytest.mark.usefixtures("trial_kernel")

@@ -30,13 +30,19 @@ Plain-NumPy twin: ``tests/naive.py::gust_filter_step_ref``.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
-from ...conventions import N_AUG, N_B0, N_U, N_X, N_Z, RESIDUAL_OUTPUTS
+from ...conventions import (N_AUG, N_B0, N_U, N_X, N_Z, OUT_ALPHA, OUT_NX, OUT_NZ, OUT_VA,
+                             RESIDUAL_OUTPUTS)
 from ...conventions import N_FAULT as N_F
 from .batch import UPDATE_ROWS, project_lanes, reset_lanes
 from ..jit import kernel
-from .nonlinear import outputs_nb, propagate
+from .nonlinear import (D_CA, D_COS, D_ME, D_MQ, D_MU, D_MW, D_SA, D_SIN, D_VA, D_XE,
+                        D_XQ, D_XT, D_XU, D_XW, D_ZE, D_ZQ, D_ZU, D_ZW, N_DIRECT,
+                        N_PARTIAL, OUT_CAS, OUT_GAMMA, P_G, P_GAMMA0, P_TAUE, P_TAUT, P_V0,
+                        derivatives_partials_nb, outputs_nb, propagate)
 from ..shared.paths import EXTENDED_FILTER, on_path
 
 N_WIND = 3
@@ -53,14 +59,6 @@ def _c_row(fm, r, crow):
         crow[j] = fm.C[r, j]
     for g in range(n - N_AUG):
         crow[N_AUG + g] = fm.Dg[r, g]
-
-
-FD_X = 1e-6
-"""Relative step of the finite differences in the states: ``1e-6 max(1, |x0_i + x_i|)``."""
-FD_E = 1e-6
-"""Step of the finite differences in the actuator effects [throttle, rad]."""
-FD_W = 1e-6
-"""Step of the finite differences in the wind [m/s, rad/s]."""
 
 
 @kernel(internal=True)
@@ -106,109 +104,261 @@ def _c_rows_lanes(fm, st, r, cl):
             cl[N_AUG + g, l] = acc + fm.Dz[r, g]
 
 
+TAN_STATES = (0, 1, 2, 5, 6, 7, 8)
+"""The states the airframe's equations depend on (all but the positions ``x``,
+``z``): the first columns of the tangent of :func:`relinearise_lanes`."""
+N_TANGENT = len(TAN_STATES) + N_U + N_WIND
+"""Columns of that tangent: the states of :data:`TAN_STATES`, the three
+effects, the three wind components."""
+
+
 @kernel(inline="always")
-def _at_point(xabs, cmd, wl, xs, c0, w0):
-    """Set the one-lane buffers to the operating point: state ``xs``, commands
-    ``c0``, wind ``w0`` (each finite difference perturbs one entry of them)."""
-    for i in range(N_X):
-        xabs[i] = xs[i]
-    for j in range(N_U):
-        cmd[j] = c0[j]
-    for i in range(N_WIND):
-        wl[i] = w0[i]
+def _tangent_stage(S, St, Ks, K, D, xt, p, s, a):
+    """One RK4 stage of the tangent of every lane: the slope ``K = J_f(xt) St +
+    J_e e_c + J_w w_c`` of each column ``c`` (``e_c``, ``w_c``: the column's unit
+    effect or wind, else zero), from the partials ``D`` (N_PARTIAL, L) of
+    :func:`ftc_mc.core.longitudinal.nonlinear.derivatives_partials_nb` at the stage
+    points ``xt`` (9, L); sets (stage ``s`` 0) or adds to ``Ks`` ``K`` (stages
+    0, 3) or ``2 K`` and sets the next stage's tangent ``St = S + a K``.
+    ``K`` (9, L) is work.  One loop per row, each writing one array: loops
+    with several stores did not vectorise (lesson 2)."""
+    L = xt.shape[1]
+    g = p[P_G]
+    itt = 1.0 / p[P_TAUT]
+    ite = 1.0 / p[P_TAUE]
+    ns = len(TAN_STATES)
+    for c in range(N_TANGENT):
+        e0 = 1.0 if c == ns else 0.0
+        e1 = 1.0 if c == ns + 1 else 0.0
+        e2 = 1.0 if c == ns + 2 else 0.0
+        w0 = 1.0 if c == ns + N_U else 0.0
+        w1 = 1.0 if c == ns + N_U + 1 else 0.0
+        w2 = 1.0 if c == ns + N_U + 2 else 0.0
+        for l in range(L):
+            K[0, l] = (D[D_XU, l] * (St[0, c, l] - w0) + D[D_XW, l] * (St[1, c, l] - w1)
+                       + D[D_XQ, l] * (St[2, c, l] - w2)
+                       + D[D_XE, l] * (0.5 * (St[7, c, l] + St[8, c, l]))
+                       + D[D_XT, l] * St[6, c, l] - xt[2, l] * St[1, c, l]
+                       - xt[1, l] * St[2, c, l] - g * D[D_COS, l] * St[5, c, l])
+        for l in range(L):
+            K[1, l] = (D[D_ZU, l] * (St[0, c, l] - w0) + D[D_ZW, l] * (St[1, c, l] - w1)
+                       + D[D_ZQ, l] * (St[2, c, l] - w2)
+                       + D[D_ZE, l] * (0.5 * (St[7, c, l] + St[8, c, l]))
+                       + xt[2, l] * St[0, c, l] + xt[0, l] * St[2, c, l]
+                       - g * D[D_SIN, l] * St[5, c, l])
+        for l in range(L):
+            K[2, l] = (D[D_MU, l] * (St[0, c, l] - w0) + D[D_MW, l] * (St[1, c, l] - w1)
+                       + D[D_MQ, l] * (St[2, c, l] - w2)
+                       + D[D_ME, l] * (0.5 * (St[7, c, l] + St[8, c, l])))
+        for l in range(L):
+            K[3, l] = (D[D_COS, l] * St[0, c, l] + D[D_SIN, l] * St[1, c, l]
+                       + (xt[1, l] * D[D_COS, l] - xt[0, l] * D[D_SIN, l]) * St[5, c, l])
+        for l in range(L):
+            K[4, l] = (-D[D_SIN, l] * St[0, c, l] + D[D_COS, l] * St[1, c, l]
+                       - (xt[0, l] * D[D_COS, l] + xt[1, l] * D[D_SIN, l]) * St[5, c, l])
+        for l in range(L):
+            K[5, l] = St[2, c, l]
+        for l in range(L):
+            K[6, l] = (e0 - St[6, c, l]) * itt
+        for l in range(L):
+            K[7, l] = (e1 - St[7, c, l]) * ite
+        for l in range(L):
+            K[8, l] = (e2 - St[8, c, l]) * ite
+        for i in range(N_X):
+            if s == 0:
+                for l in range(L):
+                    Ks[i, c, l] = K[i, l]
+            elif s < 3:
+                for l in range(L):
+                    Ks[i, c, l] += 2.0 * K[i, l]
+            else:
+                for l in range(L):
+                    Ks[i, c, l] += K[i, l]
+            if s < 3:
+                for l in range(L):
+                    St[i, c, l] = S[i, c, l] + a * K[i, l]
 
 
 @kernel(internal=True)
 def relinearise_lanes(xa, u, fm, st, tw):
-    """Every lane's state-map Jacobians about its estimate ``X_{k|k}`` by
-    forward finite differences.
+    """Every lane's state-map Jacobians about its estimate ``X_{k|k}``, exact:
+    the derivative of the one-period RK4 map, carried through its stages.
 
     The one-period map ``x_{k+1} = f(x0 + x, u0 + e, w)`` (:func:`_nl_state`: RK4
     over ``fm.dt`` with ``fm.n_sub`` steps, effect ``e`` of eq. 2 under the
     estimated faults, wind ``w = C_d g`` held), differentiated at the lane's
-    estimate: in ``x_i`` with the step ``FD_X max(1, |x0_i + x_i|)`` (the step
-    actually represented, ``(x + s) - x``, divides), in the effects with
-    ``FD_E``, in the wind with ``FD_W``.  Writes ``st.JA`` (9, 9, L), ``JB``
-    (9, 3, L), ``JW`` (9, 3, L); uses the one-lane buffers of ``tw``.  The
-    outputs' Jacobians are taken about the prediction
+    estimate in forward mode: each RK4 stage's slope ``k = f(xt)`` gets the
+    tangent ``J_f(xt) St`` (plus the effect's or the wind's own column), with
+    the airframe's partials written out analytically
+    (:func:`ftc_mc.core.longitudinal.nonlinear.derivatives_partials_nb`), and the
+    tangents combine as the slopes do.  The positions enter no equation, so
+    their columns of ``JA`` are unit columns.  The nominal RK4 here does
+    :func:`_nl_state`'s arithmetic.  Writes ``st.JA`` (9, 9, L), ``JB`` (9, 3,
+    L), ``JW`` (9, 3, L); work ``tw.jx``, ``jd``, ``jcw``, ``jt`` and the one-lane
+    buffers of ``tw``.  The outputs' Jacobians are taken about the prediction
     (:func:`relinearise_outputs_lanes`).
+
+    Against the forward differences it replaced (steps ``1e-6 max(1, |x|)``,
+    16 RK4 periods per lane), it agrees to their own error, about 1e-6
+    relative (``tests/test_design_kernels.py``), in the cost of one period's
+    slopes and partials and the tangent's vector arithmetic.
     """
+    L = xa.shape[1]
+    x = tw.jx[0]
+    xt = tw.jx[1]
+    ks = tw.jx[2]
+    kk = tw.jx[3]
+    S = tw.jt[0]
+    St = tw.jt[1]
+    Ks = tw.jt[2]
+    D = tw.jd
+    cw = tw.jcw
     xabs = tw.xabs
     cmd = tw.cmd
     wl = tw.wl
-    xs = np.empty(N_X)
-    c0 = np.empty(N_U)
-    w0 = np.empty(N_WIND)
-    fb = np.empty(N_X)
-    for l in range(xa.shape[1]):
-        _lane_point(xa, u, fm, l, xs, c0, w0)
-        # the point itself
-        _at_point(xabs, cmd, wl, xs, c0, w0)
-        propagate(xabs, cmd, fm.p, wl, fm.dt, fm.n_sub, tw.rk4)
+    dxl = tw.rk4[0]
+    dl = tw.jl
+    for l in range(L):
+        _lane_point(xa, u, fm, l, xabs, cmd, wl)
         for i in range(N_X):
-            fb[i] = xabs[i]
-        # states
-        for j in range(N_X):
-            _at_point(xabs, cmd, wl, xs, c0, w0)
-            xabs[j] = xs[j] + FD_X * max(1.0, abs(xs[j]))
-            dx = xabs[j] - xs[j]
-            propagate(xabs, cmd, fm.p, wl, fm.dt, fm.n_sub, tw.rk4)
-            for i in range(N_X):
-                st.JA[i, j, l] = (xabs[i] - fb[i]) / dx
-        # effects
+            x[i, l] = xabs[i]
         for j in range(N_U):
-            _at_point(xabs, cmd, wl, xs, c0, w0)
-            cmd[j] = c0[j] + FD_E
-            de = cmd[j] - c0[j]
-            propagate(xabs, cmd, fm.p, wl, fm.dt, fm.n_sub, tw.rk4)
-            for i in range(N_X):
-                st.JB[i, j, l] = (xabs[i] - fb[i]) / de
-        # wind
+            cw[j, l] = cmd[j]
         for j in range(N_WIND):
-            _at_point(xabs, cmd, wl, xs, c0, w0)
-            wl[j] = w0[j] + FD_W
-            dw = wl[j] - w0[j]
-            propagate(xabs, cmd, fm.p, wl, fm.dt, fm.n_sub, tw.rk4)
+            cw[N_U + j, l] = wl[j]
+    for i in range(N_X):
+        for c in range(N_TANGENT):
+            for l in range(L):
+                S[i, c, l] = 0.0
+    for c in range(len(TAN_STATES)):
+        for l in range(L):
+            S[TAN_STATES[c], c, l] = 1.0
+    h = fm.dt / fm.n_sub
+    h6 = h / 6.0
+    vx0 = fm.p[P_V0] * math.cos(fm.p[P_GAMMA0])
+    vz0 = fm.p[P_V0] * math.sin(fm.p[P_GAMMA0])
+    for _ in range(fm.n_sub):
+        for s in range(4):
+            # the stage point, as nonlinear.rk4_step forms it
             for i in range(N_X):
-                st.JW[i, j, l] = (xabs[i] - fb[i]) / dw
+                for l in range(L):
+                    if s == 0:
+                        xt[i, l] = x[i, l]
+                    elif s < 3:
+                        xt[i, l] = x[i, l] + 0.5 * h * kk[i, l]
+                    else:
+                        xt[i, l] = x[i, l] + h * kk[i, l]
+            if s == 0:
+                for i in range(N_X):
+                    for c in range(N_TANGENT):
+                        for l in range(L):
+                            St[i, c, l] = S[i, c, l]
+            # slopes and partials, a lane at a time
+            for l in range(L):
+                for i in range(N_X):
+                    xabs[i] = xt[i, l]
+                for j in range(N_U):
+                    cmd[j] = cw[j, l]
+                for j in range(N_WIND):
+                    wl[j] = cw[N_U + j, l]
+                derivatives_partials_nb(xabs, cmd, fm.p, wl, vx0, vz0, dxl, dl)
+                for i in range(N_X):
+                    kk[i, l] = dxl[i]
+                for i in range(N_PARTIAL):
+                    D[i, l] = dl[i]
+            # the slopes' sum k1 + 2 k2 + 2 k3 + k4, in rk4_step's order
+            for i in range(N_X):
+                for l in range(L):
+                    if s == 0:
+                        ks[i, l] = kk[i, l]
+                    elif s < 3:
+                        ks[i, l] = ks[i, l] + 2.0 * kk[i, l]
+                    else:
+                        ks[i, l] = ks[i, l] + kk[i, l]
+            _tangent_stage(S, St, Ks, tw.jx[4], D, xt, fm.p, s, 0.5 * h if s < 2 else h)
+        for i in range(N_X):
+            for l in range(L):
+                x[i, l] += h6 * ks[i, l]
+            for c in range(N_TANGENT):
+                for l in range(L):
+                    S[i, c, l] += h6 * Ks[i, c, l]
+    ns = len(TAN_STATES)
+    for i in range(N_X):
+        for l in range(L):
+            st.JA[i, 3, l] = 1.0 if i == 3 else 0.0
+            st.JA[i, 4, l] = 1.0 if i == 4 else 0.0
+        for c in range(ns):
+            for l in range(L):
+                st.JA[i, TAN_STATES[c], l] = S[i, c, l]
+        for j in range(N_U):
+            for l in range(L):
+                st.JB[i, j, l] = S[i, ns + j, l]
+        for j in range(N_WIND):
+            for l in range(L):
+                st.JW[i, j, l] = S[i, ns + N_U + j, l]
 
 
 @kernel(internal=True)
 def relinearise_outputs_lanes(xa, fm, st, tw):
     """Every lane's output Jacobians ``st.JC`` (12, 9, L) and ``st.JHW`` (12, 3,
     L) about its prediction ``X_{k+1|k}`` (``xa``: state and gust), where the
-    update linearises the outputs, by the forward differences of
-    :func:`relinearise_lanes`.
+    update linearises the outputs, analytic from the airframe's partials
+    (:func:`ftc_mc.core.longitudinal.nonlinear.derivatives_partials_nb`): the
+    first six outputs are states; ``n_x = X / (m g)``, ``n_z = -Z / (m g)``,
+    ``alpha`` (``d alpha = (cos alpha dW - sin alpha dU) / Va``), ``gamma =
+    theta - alpha``, ``CAS = Va`` and ``Va`` (``d Va = cos alpha dU + sin
+    alpha dW``) are air-relative, so their wind columns are minus their ``u``,
+    ``w``, ``q`` columns.
 
     Taken about the estimate ``X_{k|k}`` instead, as before, they lagged the
     update by a step, and the re-linearised filter reset the thrust block 674
     times in 39.4 fault-free hours of moderate turbulence (38 about the
     prediction; ``docs/findings/turbulence-designs.md``)."""
-    xabs = tw.xabs
-    wl = tw.wl
-    y = tw.y
-    xs = np.empty(N_X)
-    w0 = np.empty(N_WIND)
-    yb = np.empty(N_Z)
-    for l in range(xa.shape[1]):
+    xs = tw.xabs
+    w0 = tw.wl
+    dxl = tw.rk4[0]
+    dl = tw.jl
+    D = tw.jd
+    L = xa.shape[1]
+    JC = st.JC
+    vx0 = fm.p[P_V0] * math.cos(fm.p[P_GAMMA0])
+    vz0 = fm.p[P_V0] * math.sin(fm.p[P_GAMMA0])
+    ig = 1.0 / fm.p[P_G]
+    for l in range(L):
         _lane_point(xa, None, fm, l, xs, tw.cmd, w0)
-        outputs_nb(xs, fm.p, w0, yb)
+        derivatives_partials_nb(xs, tw.cmd, fm.p, w0, vx0, vz0, dxl, dl)
+        for i in range(N_PARTIAL):
+            D[i, l] = dl[i]
+    for r in range(N_Z):
         for j in range(N_X):
-            for i in range(N_X):
-                xabs[i] = xs[i]
-            xabs[j] = xs[j] + FD_X * max(1.0, abs(xs[j]))
-            dx = xabs[j] - xs[j]
-            outputs_nb(xabs, fm.p, w0, y)
-            for r in range(N_Z):
-                st.JC[r, j, l] = (y[r] - yb[r]) / dx
+            v = 1.0 if r == j and r < N_DIRECT else 0.0
+            for l in range(L):
+                JC[r, j, l] = v
+    for l in range(L):
+        JC[OUT_NX, 0, l] = D[D_XU, l] * ig
+        JC[OUT_NX, 1, l] = D[D_XW, l] * ig
+        JC[OUT_NX, 2, l] = D[D_XQ, l] * ig
+        JC[OUT_NX, 6, l] = D[D_XT, l] * ig
+        JC[OUT_NX, 7, l] = 0.5 * D[D_XE, l] * ig
+        JC[OUT_NX, 8, l] = 0.5 * D[D_XE, l] * ig
+        JC[OUT_NZ, 0, l] = -D[D_ZU, l] * ig
+        JC[OUT_NZ, 1, l] = -D[D_ZW, l] * ig
+        JC[OUT_NZ, 2, l] = -D[D_ZQ, l] * ig
+        JC[OUT_NZ, 7, l] = -0.5 * D[D_ZE, l] * ig
+        JC[OUT_NZ, 8, l] = -0.5 * D[D_ZE, l] * ig
+        JC[OUT_ALPHA, 0, l] = -D[D_SA, l] / D[D_VA, l]
+        JC[OUT_ALPHA, 1, l] = D[D_CA, l] / D[D_VA, l]
+        JC[OUT_GAMMA, 0, l] = D[D_SA, l] / D[D_VA, l]
+        JC[OUT_GAMMA, 1, l] = -D[D_CA, l] / D[D_VA, l]
+        JC[OUT_GAMMA, 5, l] = 1.0
+        JC[OUT_CAS, 0, l] = D[D_CA, l]
+        JC[OUT_CAS, 1, l] = D[D_SA, l]
+        JC[OUT_VA, 0, l] = D[D_CA, l]
+        JC[OUT_VA, 1, l] = D[D_SA, l]
+    for r in range(N_Z):
         for j in range(N_WIND):
-            for i in range(N_WIND):
-                wl[i] = w0[i]
-            wl[j] = w0[j] + FD_W
-            dw = wl[j] - w0[j]
-            outputs_nb(xs, fm.p, wl, y)
-            for r in range(N_Z):
-                st.JHW[r, j, l] = (y[r] - yb[r]) / dw
+            for l in range(L):
+                st.JHW[r, j, l] = -JC[r, j, l] if r >= N_DIRECT else 0.0
 
 
 @kernel(internal=True)
@@ -279,7 +429,7 @@ def relinearise(fkind, xa, u, fm, st, tw):
 
 
 @kernel(internal=True)
-def _gpredict(fkind, xa, P, Pn, u, fm, phi, T, xn, tw, st):
+def _gpredict(fkind, xa, P, Pn, u, fm, phi, T, xn, tw, st, fresh):
     """Time update of every lane: ``X <- F X + B_aug u``, ``Pn <- F P F^T + Q``.
 
     ``F = [[A, Phi(u), G], [0, I, 0], [0, 0, A_d]]`` and ``Q`` block-diagonal
@@ -291,7 +441,9 @@ def _gpredict(fkind, xa, P, Pn, u, fm, phi, T, xn, tw, st):
     Jacobians at trim (``A``, ``Phi``, ``G``), or with ``fm.relin > 0`` takes
     each lane's (``st.JA``; ``Phi`` from ``st.JB``:
     ``[JB_0, (JB_1 + JB_2) / 2, -JB diag(u + u0)]``; ``G = st.JW C_d`` into
-    ``tw.jg``).
+    ``tw.jg``).  With ``fresh`` the state map was just re-linearised about this
+    ``X`` and ``u`` (:func:`relinearise_lanes`), whose RK4 left the nonlinear
+    prediction in ``tw.jx[0]``, the same to the bit: it is taken from there.
     """
     n = xa.shape[0]
     L = xa.shape[1]
@@ -338,7 +490,11 @@ def _gpredict(fkind, xa, P, Pn, u, fm, phi, T, xn, tw, st):
             for g in range(ng):
                 acc += fm.Ad[a, g] * xa[N_AUG + g, l]
             xn[N_AUG + a, l] = acc
-    if fm.nl != 0:
+    if fm.nl != 0 and fresh:
+        for i in range(N_X):
+            for l in range(L):
+                xn[i, l] = tw.jx[0, i, l] - fm.x0[i]
+    elif fm.nl != 0:
         nl_state(fkind, xa, u, fm, xn, tw)
     for i in range(N_X):
         for l in range(L):
@@ -348,19 +504,22 @@ def _gpredict(fkind, xa, P, Pn, u, fm, phi, T, xn, tw, st):
             xa[N_AUG + a, l] = xn[N_AUG + a, l]
     # T = F P
     if relin:
+        # lane loops innermost, sums in the per-lane order (the same bits)
         JA = st.JA
         jg = tw.jg
         for i in range(N_X):
             for c in range(n):
                 for l in range(L):
-                    acc = 0.0
-                    for j in range(N_X):
-                        acc += JA[i, j, l] * P[j, c, l]
-                    for j in range(N_F):
-                        acc += phi[i, j, l] * P[N_X + j, c, l]
-                    for g in range(ng):
-                        acc += jg[i, g, l] * P[N_AUG + g, c, l]
-                    T[i, c, l] = acc
+                    T[i, c, l] = 0.0
+                for j in range(N_X):
+                    for l in range(L):
+                        T[i, c, l] += JA[i, j, l] * P[j, c, l]
+                for j in range(N_F):
+                    for l in range(L):
+                        T[i, c, l] += phi[i, j, l] * P[N_X + j, c, l]
+                for g in range(ng):
+                    for l in range(L):
+                        T[i, c, l] += jg[i, g, l] * P[N_AUG + g, c, l]
     else:
         for i in range(N_X):
             for c in range(n):
@@ -389,14 +548,16 @@ def _gpredict(fkind, xa, P, Pn, u, fm, phi, T, xn, tw, st):
         for k in range(i, n):
             if k < N_X and relin:
                 for l in range(L):
-                    acc = 0.0
-                    for j in range(N_X):
-                        acc += T[i, j, l] * st.JA[k, j, l]
-                    for j in range(N_F):
-                        acc += T[i, N_X + j, l] * phi[k, j, l]
-                    for g in range(ng):
-                        acc += T[i, N_AUG + g, l] * tw.jg[k, g, l]
-                    Pn[i, k, l] = acc
+                    Pn[i, k, l] = 0.0
+                for j in range(N_X):
+                    for l in range(L):
+                        Pn[i, k, l] += T[i, j, l] * st.JA[k, j, l]
+                for j in range(N_F):
+                    for l in range(L):
+                        Pn[i, k, l] += T[i, N_X + j, l] * phi[k, j, l]
+                for g in range(ng):
+                    for l in range(L):
+                        Pn[i, k, l] += T[i, N_AUG + g, l] * tw.jg[k, g, l]
             elif k < N_X:
                 for l in range(L):
                     acc = 0.0
@@ -445,19 +606,25 @@ def gust_residuals_lanes(xa, P, z, fm, crow, hpred, res, innov, st, cl):
     n = xa.shape[0]
     L = xa.shape[1]
     if fm.relin > 0:
+        # lane loops innermost (sums in the per-lane order: the same bits);
+        # ``res[o]`` accumulates ``c P c^T``, ``innov[o]`` each ``(P c^T)_j``
         for o in range(len(RESIDUAL_OUTPUTS)):
             r = RESIDUAL_OUTPUTS[o]
             _c_rows_lanes(fm, st, r, cl)
             rr = fm.r_diag[r]
             for l in range(L):
-                s = 0.0
-                for j in range(n):
-                    acc = 0.0
-                    for k in range(n):
-                        acc += P[j, k, l] * cl[k, l]
-                    s += cl[j, l] * acc
+                res[o, l] = 0.0
+            for j in range(n):
+                for l in range(L):
+                    innov[o, l] = 0.0
+                for k in range(n):
+                    for l in range(L):
+                        innov[o, l] += P[j, k, l] * cl[k, l]
+                for l in range(L):
+                    res[o, l] += cl[j, l] * innov[o, l]
+            for l in range(L):
                 mu = z[r, l] - hpred[r, l]
-                s = s + rr
+                s = res[o, l] + rr
                 res[o, l] = mu * mu / s
                 innov[o, l] = mu / np.sqrt(s)
         return
@@ -509,25 +676,32 @@ def _gupdate(xa, P, z, fm, crow, h, v, gs, hpred, xp, st, cl):
     n = xa.shape[0]
     L = xa.shape[1]
     if fm.relin > 0:
+        # lane loops innermost, each sum in the order of the per-lane loops it
+        # replaced (so the same bits): a sum over j inside the lane loop did
+        # not vectorise (lesson 2)
         for r in range(z.shape[0]):
             _c_rows_lanes(fm, st, r, cl)
             rr = fm.r_diag[r]
             for a in range(n):
                 for l in range(L):
-                    acc = 0.0
-                    for j in range(n):
-                        if j < a:
-                            acc += P[j, a, l] * cl[j, l]
-                        else:
-                            acc += P[a, j, l] * cl[j, l]
-                    h[a, l] = acc
-            for l in range(L):
-                pred = hpred[r, l]
-                sv = rr
+                    h[a, l] = 0.0
                 for j in range(n):
-                    pred += cl[j, l] * (xa[j, l] - xp[j, l])
-                    sv += cl[j, l] * h[j, l]
-                gs[0, l] = (z[r, l] - pred) / sv
+                    if j < a:
+                        for l in range(L):
+                            h[a, l] += P[j, a, l] * cl[j, l]
+                    else:
+                        for l in range(L):
+                            h[a, l] += P[a, j, l] * cl[j, l]
+            for l in range(L):
+                gs[0, l] = hpred[r, l]
+                gs[1, l] = rr
+            for j in range(n):
+                for l in range(L):
+                    gs[0, l] += cl[j, l] * (xa[j, l] - xp[j, l])
+                    gs[1, l] += cl[j, l] * h[j, l]
+            for l in range(L):
+                sv = gs[1, l]
+                gs[0, l] = (z[r, l] - gs[0, l]) / sv
                 gs[1, l] = 1.0 / sv
             _apply_gain(xa, P, h, v, gs)
         return
@@ -598,10 +772,11 @@ def gust_predict_lanes(fkind, xa, P, fm, tw, st, k):
     for i in range(n):
         for l in range(xa.shape[1]):
             x_prev[i, l] = xa[i, l]
-    if fm.relin > 0 and k % fm.relin == 0:
+    fresh = fm.relin > 0 and k % fm.relin == 0
+    if fresh:
         relinearise(fkind, xa, tw.u, fm, st, tw)
-    _gpredict(fkind, xa, P, work[0:n], tw.u, fm, tw.phi, tw.T, work[n + 3], tw, st)
-    if fm.relin > 0 and k % fm.relin == 0:
+    _gpredict(fkind, xa, P, work[0:n], tw.u, fm, tw.phi, tw.T, work[n + 3], tw, st, fresh)
+    if fresh:
         relinearise_outputs(fkind, xa, fm, st, tw)
     if fm.nl != 0:
         nl_outputs(fkind, xa, fm, work[n + 4], work[n + 5], tw)
@@ -667,7 +842,7 @@ def gust_correct_lanes(fkind, xa, P, fm, det, tw, st):
         for i in range(n):
             for l in range(L):
                 xa[i, l] = x_prev[i, l]
-        _gpredict(fkind, xa, P, Pn, tw.u, fm, tw.phi, tw.T, work[n + 3], tw, st)
+        _gpredict(fkind, xa, P, Pn, tw.u, fm, tw.phi, tw.T, work[n + 3], tw, st, False)
         if fm.nl != 0:
             nl_outputs(fkind, xa, fm, work[n + 4], work[n + 5], tw)
     _gupdate(xa, Pn, tw.z, fm, tw.crow, work[n], work[n + 1], work[n + 2], work[n + 4],

@@ -76,6 +76,15 @@ N_PARAM = 25
 N_WORK = 5
 """Rows of the ``work`` array of :func:`propagate` (four RK4 slopes, one stage state)."""
 
+(D_XU, D_XW, D_XQ, D_XE, D_XT, D_ZU, D_ZW, D_ZQ, D_ZE, D_MU, D_MW, D_MQ, D_ME,
+ D_COS, D_SIN, D_CA, D_SA, D_VA) = range(18)
+N_PARTIAL = 18
+"""Entries written by :func:`derivatives_partials_nb`: the partials of ``X / m``,
+``Z / m`` and ``M / J_y`` in the air-relative ``u - u_g``, ``w - w_g``,
+``q - q_g`` (``U``, ``W``, ``Q``), the elevons' mean ``de`` (``E``) and, for
+``X`` only, the throttle state (``T``); then ``cos theta``, ``sin theta``,
+``U / Va``, ``W / Va`` (cosine and sine of the angle of attack) and ``Va``."""
+
 
 @kernel
 def air_forces(x, p, wind):
@@ -119,6 +128,38 @@ def air_forces(x, p, wind):
     return X, Z, M, alpha, Va, thrust
 
 
+@kernel(inline="always")
+def _kinematics(x, cmd, p, X, Z, M, dx):
+    """``dx`` from the body forces and moment ``X``, ``Z``, ``M`` (the equations
+    of :func:`derivatives_nb`); returns ``cos theta``, ``sin theta``."""
+    return _kinematics_at(x, cmd, p, X, Z, M, p[P_V0] * math.cos(p[P_GAMMA0]),
+                          p[P_V0] * math.sin(p[P_GAMMA0]), dx)
+
+
+@kernel(inline="always")
+def _kinematics_at(x, cmd, p, X, Z, M, vx0, vz0, dx):
+    """:func:`_kinematics` with the reference point's velocity ``V0 cos gamma0``,
+    ``V0 sin gamma0`` given (the same numbers, so the same ``dx``)."""
+    m = p[P_MASS]
+    g = p[P_G]
+    u = x[0]
+    w = x[1]
+    q = x[2]
+    th = x[5]
+    st = math.sin(th)
+    ct = math.cos(th)
+    dx[0] = -q * w + X / m - g * st
+    dx[1] = q * u + Z / m + g * ct
+    dx[2] = M / p[P_JY]
+    dx[3] = u * ct + w * st - vx0
+    dx[4] = -u * st + w * ct + vz0
+    dx[5] = q
+    dx[6] = (cmd[0] - x[6]) / p[P_TAUT]
+    dx[7] = (cmd[1] - x[7]) / p[P_TAUE]
+    dx[8] = (cmd[2] - x[8]) / p[P_TAUE]
+    return ct, st
+
+
 @kernel
 def derivatives_nb(x, cmd, p, wind, dx):
     """Time derivative ``dx = f(x, cmd, wind)`` (writes ``dx``, shape (9,)).
@@ -138,23 +179,101 @@ def derivatives_nb(x, cmd, p, wind, dx):
         Output [state units / s].
     """
     X, Z, M, alpha, Va, thrust = air_forces(x, p, wind)
-    m = p[P_MASS]
-    g = p[P_G]
-    u = x[0]
-    w = x[1]
-    q = x[2]
-    th = x[5]
-    st = math.sin(th)
-    ct = math.cos(th)
-    dx[0] = -q * w + X / m - g * st
-    dx[1] = q * u + Z / m + g * ct
-    dx[2] = M / p[P_JY]
-    dx[3] = u * ct + w * st - p[P_V0] * math.cos(p[P_GAMMA0])
-    dx[4] = -u * st + w * ct + p[P_V0] * math.sin(p[P_GAMMA0])
-    dx[5] = q
-    dx[6] = (cmd[0] - x[6]) / p[P_TAUT]
-    dx[7] = (cmd[1] - x[7]) / p[P_TAUE]
-    dx[8] = (cmd[2] - x[8]) / p[P_TAUE]
+    _kinematics(x, cmd, p, X, Z, M, dx)
+
+
+@kernel
+def derivatives_partials_nb(x, cmd, p, wind, vx0, vz0, dx, d):
+    """:func:`derivatives_nb` (the same arithmetic, so the same ``dx`` to the
+    bit) and the partials of its forces, analytic, for the Jacobian of ``f``.
+
+    With ``U = u - u_g``, ``W = w - w_g``, ``Q = q - q_g``, ``Va = sqrt(U^2 +
+    W^2)``, ``alpha = atan2(W, U)``, ``qhat = c Q / (2 Va)`` and the
+    coefficients of :func:`air_forces`, ``X = qS (-CD cos alpha + CL sin
+    alpha) + T``, ``Z = qS (-CD sin alpha - CL cos alpha)``, ``M = qS c Cm``
+    (``qS = rho Va^2 S / 2``, ``T`` the propeller's thrust).  The rows of ``f``
+    that use them are ``f_0 = -q w + X / m - g sin theta``, ``f_1 = q u + Z /
+    m + g cos theta``, ``f_2 = M / J_y``; the caller applies the chain rule
+    (``d U = d u - d u_g``, ``d de = (d dl + d dr) / 2``).
+
+    Parameters
+    ----------
+    x, cmd, p, wind, dx : ndarray
+        As :func:`derivatives_nb`.
+    vx0, vz0 : float
+        ``V0 cos gamma0``, ``V0 sin gamma0`` [m/s], computed once by the
+        caller (as :func:`derivatives_nb` computes them: the same ``dx``).
+    d : ndarray, shape (N_PARTIAL,)
+        Written: the ``D_*`` entries, ``d(X/m)/dU`` [1/s], ``d(X/m)/dW`` [1/s],
+        ``d(X/m)/dQ`` [m/s per rad], ``d(X/m)/d de`` [m/s^2 per rad],
+        ``d(X/m)/d throttle`` [m/s^2], the same of ``Z / m`` (no throttle),
+        of ``M / J_y`` [rad/s^2 per unit], then ``cos theta``, ``sin theta``,
+        ``U / Va``, ``W / Va`` and ``Va`` [m/s].
+    """
+    X, Z, M, alpha, Va, thrust = air_forces(x, p, wind)
+    ct, st = _kinematics_at(x, cmd, p, X, Z, M, vx0, vz0, dx)
+    U = x[0] - wind[0]
+    W = x[1] - wind[1]
+    Q = x[2] - wind[2]
+    de = 0.5 * (x[7] + x[8])
+    ca = U / Va
+    sa = W / Va
+    rho = p[P_RHO]
+    c = p[P_C]
+    qS = 0.5 * rho * Va * Va * p[P_S]
+    qS_v = rho * Va * p[P_S]
+    qhat = c * Q / (2.0 * Va)
+    qhat_v = -qhat / Va
+    qhat_q = c / (2.0 * Va)
+    CL = p[P_CL0] + p[P_CLA] * alpha + p[P_CLQ] * qhat + p[P_CLDE] * de
+    CD = p[P_CD0] + p[P_CDA] * alpha + p[P_CDA2] * alpha * alpha + p[P_CDDE2] * de * de
+    Cm = p[P_CM0] + p[P_CMA] * alpha + p[P_CMQ] * qhat + p[P_CMDE] * de
+    CD_a = p[P_CDA] + 2.0 * p[P_CDA2] * alpha
+    CD_e = 2.0 * p[P_CDDE2] * de
+    # aerodynamic coefficients along body x and z, and their partials
+    ax = -CD * ca + CL * sa
+    az = -CD * sa - CL * ca
+    ax_a = -CD_a * ca + CD * sa + p[P_CLA] * sa + CL * ca
+    az_a = -CD_a * sa - CD * ca - p[P_CLA] * ca + CL * sa
+    ax_v = p[P_CLQ] * qhat_v * sa
+    az_v = -p[P_CLQ] * qhat_v * ca
+    ax_q = p[P_CLQ] * qhat_q * sa
+    az_q = -p[P_CLQ] * qhat_q * ca
+    ax_e = -CD_e * ca + p[P_CLDE] * sa
+    az_e = -CD_e * sa - p[P_CLDE] * ca
+    # propeller: T = K Vd (Vd - Va), Vd = Va + throttle (k_motor - Va)
+    K = 0.5 * rho * p[P_SPROP] * p[P_CPROP]
+    dt_ = x[6]
+    Vd = Va + dt_ * (p[P_KMOTOR] - Va)
+    T_v = K * ((1.0 - dt_) * (Vd - Va) - dt_ * Vd)
+    T_t = K * (p[P_KMOTOR] - Va) * (2.0 * Vd - Va)
+    # in Va and alpha, then U and W: dVa = ca dU + sa dW, dalpha = (ca dW - sa dU) / Va
+    X_v = qS_v * ax + qS * ax_v + T_v
+    X_a = qS * ax_a
+    Z_v = qS_v * az + qS * az_v
+    Z_a = qS * az_a
+    M_v = c * (qS_v * Cm + qS * p[P_CMQ] * qhat_v)
+    M_a = qS * c * p[P_CMA]
+    im = 1.0 / p[P_MASS]
+    ij = 1.0 / p[P_JY]
+    d[D_XU] = (X_v * ca - X_a * sa / Va) * im
+    d[D_XW] = (X_v * sa + X_a * ca / Va) * im
+    d[D_XQ] = qS * ax_q * im
+    d[D_XE] = qS * ax_e * im
+    d[D_XT] = T_t * im
+    d[D_ZU] = (Z_v * ca - Z_a * sa / Va) * im
+    d[D_ZW] = (Z_v * sa + Z_a * ca / Va) * im
+    d[D_ZQ] = qS * az_q * im
+    d[D_ZE] = qS * az_e * im
+    d[D_MU] = (M_v * ca - M_a * sa / Va) * ij
+    d[D_MW] = (M_v * sa + M_a * ca / Va) * ij
+    d[D_MQ] = qS * c * p[P_CMQ] * qhat_q * ij
+    d[D_ME] = qS * c * p[P_CMDE] * ij
+    d[D_COS] = ct
+    d[D_SIN] = st
+    d[D_CA] = ca
+    d[D_SA] = sa
+    d[D_VA] = Va
 
 
 @kernel
@@ -232,5 +351,6 @@ def make_work():
     return np.zeros((N_WORK, N_STATE))
 
 
-__all__ = ["air_forces", "derivatives_nb", "outputs_nb", "rk4_step", "propagate",
+__all__ = ["air_forces", "derivatives_nb", "derivatives_partials_nb", "N_PARTIAL",
+           "outputs_nb", "rk4_step", "propagate",
            "make_work", "N_WORK", "N_STATE", "N_OUTPUT", "N_PARAM"]

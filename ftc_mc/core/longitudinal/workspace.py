@@ -23,7 +23,8 @@ from ...conventions import (N_AUG, N_CONTROLLERS, N_FAULT, N_MODES, N_U, N_X, N_
 from .batch import UPDATE_ROWS, step_rows
 from ..shared.dryden import N_GUST_NOISE, N_GUST_OUT, N_GUST_STATE
 from ..jit import kernel
-from .nonlinear import N_WORK
+from .gustfilter import N_TANGENT, N_WIND
+from .nonlinear import N_PARTIAL, N_WORK
 
 N_RES = len(RESIDUAL_NAMES)
 
@@ -82,6 +83,11 @@ TrialWork = namedtuple("TrialWork", [
     "finite",     # (L,) bool: the lane's estimate, variances and air data are finite
     "jg",         # (N_X, n - N_AUG, L) a re-linearised extended filter's G = JW C_d
     "jc",         # (n, L) a row of its C_aug per lane, [JC_r, 0, JHW_r C_d]
+    "jx",         # (5, N_X, L) its RK4 of the state map: state, stage point, slope sum,
+                  # slope, a tangent column's slope
+    "jd",         # (N_PARTIAL, L) the airframe's partials at the stage points
+    "jcw",        # (N_U + N_WIND, L) each lane's commands and wind held over the period
+    "jt",         # (3, N_X, N_TANGENT, L) the tangent: Jacobian so far, stage's, slope sum
     # one lane at a time
     "xl",         # (n,) a lane's estimate
     "Ul",         # (N_U,) a lane's command
@@ -93,6 +99,7 @@ TrialWork = namedtuple("TrialWork", [
     "xabs",       # (N_X,) a lane's absolute state (nonlinear plant)
     "cmd",        # (N_U,) a lane's absolute effective commands
     "y",          # (N_Z,) a lane's absolute outputs
+    "jl",         # (N_PARTIAL,) a lane's partials (nonlinear.derivatives_partials_nb)
     "rk4",        # (N_WORK, N_X) RK4 work (nonlinear.propagate)
     "bl",         # (N_MODES,) a lane's belief
     "bhat",       # (N_FAULT,) a lane's fault-parameter estimate
@@ -132,10 +139,12 @@ def new_trial_work(L, n):
         xsel=np.zeros((N_AUG, L)), Psel=np.zeros((N_AUG, N_AUG, L)),
         finite=np.zeros(L, dtype=np.bool_),
         jg=np.zeros((N_X, max(n - N_AUG, 0), L)), jc=np.zeros((n, L)),
+        jx=np.zeros((5, N_X, L)), jd=np.zeros((N_PARTIAL, L)),
+        jcw=np.zeros((N_U + N_WIND, L)), jt=np.zeros((3, N_X, N_TANGENT, L)),
         xl=np.zeros(n), Ul=np.zeros(N_U), chol=np.zeros((n, n)),
         crow=np.zeros(n),
         gust=np.zeros(N_GUST_STATE), eta=np.zeros(N_GUST_NOISE), wl=np.zeros(N_GUST_OUT),
-        xabs=np.zeros(N_X), cmd=np.zeros(N_U), y=np.zeros(N_Z),
+        xabs=np.zeros(N_X), cmd=np.zeros(N_U), y=np.zeros(N_Z), jl=np.zeros(N_PARTIAL),
         rk4=np.zeros((N_WORK, N_X)), bl=np.zeros(N_MODES), bhat=np.zeros(N_FAULT),
         bvar=np.zeros(N_FAULT), bwork=np.zeros(2 * N_MODES),
         lsel=new_lane_selection_work(L, N_AUG))
