@@ -476,7 +476,7 @@ def controller_objectives_lanes(cur, xa, P, belief, scheme, sw):
     Steps 1 and 3 run on the lanes that need them, gathered (``sw.lane``), and
     step 3 with a controller per gathered lane (``sw.cand``).  On the trials
     of ``configs/paper_tables.yaml`` about 1.3 of the 3 controllers per lane
-    get a full objective (``docs/findings/performance.md`` lesson 18).  Every
+    get a full objective (``docs/findings/performance.md`` lesson 19).  Every
     objective written equals ``controller_objectives(cur[l], xa[:, l],
     P[:, :, l], belief[:, l], ...)`` bit for bit, and the smallest is the same
     controller.

@@ -717,7 +717,7 @@ def reconfigure(path, scheme, timing, inp, st, kn, period, work, rec):
     lane bit-identical to ``tests/single_trajectory.py::select_controller``; the
     horizon predictions run lane-interleaved, and the covariance's only for
     the controllers whose objective can be the smallest,
-    ``docs/findings/performance.md`` lesson 18); and the detection time: the
+    ``docs/findings/performance.md`` lesson 19); and the detection time: the
     first period end after the switch ``k_fault`` where the final mode is the
     most probable with at least ``detect_prob`` (live lanes only).
 
