@@ -43,8 +43,9 @@ from collections import namedtuple
 
 import numpy as np
 
-from ..conventions import (ACTUATOR_NAMES, LONGITUDINAL, NO_SENSOR_FAULT, OUTPUT_NAMES,
-                           SENSOR_FAULT_KINDS)
+from ..conventions import (ACTUATOR_FAULT_KINDS, ACTUATOR_NAMES, FAULT_PARAM_NEUTRAL,
+                           KIND_NONE, LONGITUDINAL, N_FAULT_PARAM, N_U, NO_SENSOR_FAULT,
+                           OUTPUT_NAMES, SENSOR_FAULT_KINDS)
 from ..core.longitudinal.settings import TrialInputs
 from ..model.faults import estimator_params, mode_of
 
@@ -52,7 +53,12 @@ Schedule = namedtuple("Schedule", [
     "k_switch",  # (E,) int64 step from which each entry holds, k_switch[0] == 0
     "b0",        # (E, 3, L) per-actuator truth b0 of each entry (absolute lock position)
     "b1",        # (E, 3, L) per-actuator truth b1 of each entry
-])
+    "fp",        # (E, N_FAULT_PARAM, 3, L) the fault model's other parameters, or None:
+                 #   neutral (conventions.FAULT_PARAM_NEUTRAL) throughout
+    "kind",      # (E, 3, L) int64 conventions.ACTUATOR_FAULT_KINDS code of each
+                 #   actuator's fault, KIND_NONE when healthy; or None: from b0, b1
+    "mode",      # (E, L) int64 truth mode of each entry, or None: the box that holds b1
+], defaults=(None, None, None))
 """Per-lane fault schedule: the truth in force from each switch step on."""
 
 LaneDraws = namedtuple("LaneDraws", [
@@ -207,8 +213,32 @@ def draw_lanes(setup, trial_ids, seed: int, fault_range=None) -> LaneDraws:
 
 
 def entry_modes(schedule: Schedule, beta) -> np.ndarray:
-    """Mode of every schedule entry and lane, shape (E, L) (:func:`mode_of`)."""
+    """Mode of every schedule entry and lane, shape (E, L): the schedule's own
+    ``mode`` when it has one, else the box that holds its ``b1`` (:func:`mode_of`)."""
+    if schedule.mode is not None:
+        return np.asarray(schedule.mode, dtype=np.int64)
     return np.stack([mode_of(b1, *beta) for b1 in schedule.b1])
+
+
+def neutral_params(E: int, L: int) -> np.ndarray:
+    """The fault model's parameters of ``E`` entries of ``L`` lanes with every
+    actuator following eq. (2) alone (:data:`FAULT_PARAM_NEUTRAL`), shape
+    (E, N_FAULT_PARAM, 3, L)."""
+    fp = np.empty((E, N_FAULT_PARAM, N_U, L))
+    fp[:] = np.asarray(FAULT_PARAM_NEUTRAL)[None, :, None, None]
+    return fp
+
+
+def schedule_kinds(schedule: Schedule) -> np.ndarray:
+    """Kind code of every entry, actuator and lane, shape (E, 3, L): the
+    schedule's own ``kind``, else ``lock`` where ``b1 = 1``, ``loss`` where
+    ``0 < b1 < 1`` and :data:`KIND_NONE` where healthy."""
+    if schedule.kind is not None:
+        return np.asarray(schedule.kind, dtype=np.int64)
+    b1 = np.asarray(schedule.b1)
+    return np.where(b1 >= 1.0, ACTUATOR_FAULT_KINDS.index("lock"),
+                    np.where(b1 > 0.0, ACTUATOR_FAULT_KINDS.index("loss"),
+                             KIND_NONE)).astype(np.int64)
 
 
 def build_inputs(setup, schedule: Schedule, draws: LaneDraws,
@@ -232,6 +262,8 @@ def build_inputs(setup, schedule: Schedule, draws: LaneDraws,
     """
     E, _, L = schedule.b0.shape
     assert schedule.k_switch.shape == (E,) and schedule.k_switch[0] == 0
+    fp = neutral_params(E, L) if schedule.fp is None else schedule.fp
+    assert fp.shape == (E, N_FAULT_PARAM, N_U, L)
     assert draws.w.shape[2] == L
     modes = entry_modes(schedule, setup.beta)
     xa0 = np.zeros((LONGITUDINAL.n_aug, L))
@@ -242,7 +274,7 @@ def build_inputs(setup, schedule: Schedule, draws: LaneDraws,
                        P0=setup.P0, w=draws.w, v=draws.v, eta=draws.eta, g0=draws.g0,
                        sensor_out=sensor.out, sensor_kind=sensor.kind,
                        sensor_size=sensor.size, sensor_k=sensor.k, v_lat=draws.v_lat,
-                       eta_lat=draws.eta_lat, g0_lat=draws.g0_lat)
+                       eta_lat=draws.eta_lat, g0_lat=draws.g0_lat, fp=fp)
 
 
 def design_inputs(inp: TrialInputs, design) -> TrialInputs:
