@@ -22,7 +22,8 @@ from typing import Annotated, Literal
 from pydantic import (AfterValidator, BaseModel, BeforeValidator, ConfigDict, Field,
                       field_validator, model_validator)
 
-from ..conventions import (ACTUATOR_NAMES, BIASED_OUTPUTS, EXCITATION_POLICIES, OUTPUT_NAMES,
+from ..conventions import (ACTUATOR_NAMES, BIASED_OUTPUTS, EXCITATION_POLICIES,
+                           KIND_TRANSITIONS, KINDS_BEYOND, MAX_DELAY_STEPS, OUTPUT_NAMES,
                            PLANT_KINDS, S3211_UNITS, SENSOR_FAULT_KINDS, SENSOR_PREFIX,
                            STATE_NAMES, TRANSITIONS, TURBULENCE_LEVELS)
 from ..errors import UserError
@@ -369,6 +370,60 @@ class DrawsConfig(_Strict):
         return self
 
 
+PosRange = tuple[Pos, Pos]
+
+
+class KindDrawsConfig(_Strict):
+    """Per-trial draws of the fault kinds beyond lock and loss (the
+    ``<actuator>_<kind>`` transitions; docs/guides/fault-kinds.md gives each
+    range's source).  Every value is uniform over its ``[low, high]``; a sign
+    drawn with equal odds where a field says so."""
+
+    elevon_rate_limit_deg_s: PosRange = (5.0, 30.0)
+    """slow: the elevon's rate limit [deg/s] (nominal servo: 200 deg/s)."""
+    engine_rate_limit_per_s: PosRange = (0.05, 0.3)
+    """slow: the throttle's rate limit [1/s] (nominal: about 3 per s from its 0.3 s lag)."""
+    delay_s: PosRange = (0.2, 1.0)
+    """delayed: the transport delay [s], rounded to whole control periods."""
+    elevon_osc_amp_deg: PosRange = (1.0, 5.0)
+    """oscillatory: the elevon's limit-cycle amplitude [deg]."""
+    engine_osc_amp: PosRange = (0.05, 0.2)
+    """oscillatory: the throttle's limit-cycle amplitude [-]."""
+    osc_freq_hz: PosRange = (0.2, 2.0)
+    """oscillatory: the limit cycle's frequency [Hz] (below the Nyquist frequency of the control period); its phase is uniform."""
+    elevon_runaway_deg_s: PosRange = (0.5, 5.0)
+    """runaway: the elevon's drift rate from its command [deg/s], either sign."""
+    engine_runaway_per_s: PosRange = (0.01, 0.05)
+    """runaway: the throttle's drift rate [1/s], either sign."""
+    float_gain: tuple[Annotated[float, NoBool, Field(ge=-2, le=0)],
+                      Annotated[float, NoBool, Field(ge=-2, le=0)]] = (-1.0, -0.3)
+    """float: the floating angle's gain on the angle of attack, -C_h_alpha / C_h_delta [rad/rad]."""
+    float_angle_deg: tuple[Finite, Finite] = (-2.0, 2.0)
+    """float: the floating angle at zero angle of attack, -C_h_0 / C_h_delta [deg]."""
+    intermittent_on_s: PosRange = (0.5, 3.0)
+    """intermittent: how long each stuck spell lasts [s] (whole multiples of the 0.5 s grid)."""
+    intermittent_off_s: PosRange = (0.5, 3.0)
+    """intermittent: how long the actuator works between spells [s] (same grid)."""
+
+    @model_validator(mode="after")
+    def _ordered(self):
+        for name in type(self).model_fields:
+            lo, hi = getattr(self, name)
+            if not lo < hi:
+                raise ValueError(f"{name}: must be [low, high] with low < high, "
+                                 f"got {[lo, hi]}")
+        for name in ("intermittent_on_s", "intermittent_off_s"):
+            if getattr(self, name)[0] < INTERMITTENT_GRID_S:
+                raise ValueError(f"{name}: spells last at least the {INTERMITTENT_GRID_S:g} s "
+                                 f"grid, got {list(getattr(self, name))}")
+        return self
+
+
+INTERMITTENT_GRID_S = 0.5
+"""Grid of an intermittent fault's spells [s]: the switch steps of a schedule are
+shared by a chunk's lanes, so each lane's spells start and end on it."""
+
+
 class TimingConfig(_Strict):
     """Trial timing: the switch at fault_time_s, judged over the window after it."""
 
@@ -539,9 +594,11 @@ def parse_sensor_transition(name: str):
 
 
 def _transition_name(name: str) -> str:
-    if name in TRANSITIONS or parse_sensor_transition(name) is not None:
+    if name in TRANSITIONS or name in KIND_TRANSITIONS or parse_sensor_transition(name) is not None:
         return name
-    raise ValueError(f"unknown transition {name!r}: one of {list(TRANSITIONS)} or "
+    raise ValueError(f"unknown transition {name!r}: one of {list(TRANSITIONS)}, a fault "
+                     f"kind <elevon|right_elevon|engine>_<kind> (kinds {list(KINDS_BEYOND)}; "
+                     "float on the elevons only) or "
                      f"sensor_<kind>:<output> (kinds {list(SENSOR_FAULT_KINDS)})")
 
 
@@ -848,6 +905,7 @@ class Config(_Sampled):
     validity: ValidityConfig = Field(default_factory=ValidityConfig)
     monitor: MonitorConfig = Field(default_factory=MonitorConfig)
     sensor_draws: SensorDrawsConfig = Field(default_factory=SensorDrawsConfig)
+    kind_draws: KindDrawsConfig = Field(default_factory=KindDrawsConfig)
     designs: Designs = Field(default_factory=dict)
     """Detection designs compared on the same trials: name -> design; run them with campaign.designs or --design NAME."""
 
@@ -879,6 +937,16 @@ class Config(_Sampled):
             if r is not None and (r[0] < lower[a] or r[1] > upper[a]):
                 raise ValueError(f"draws.{name}: must lie within the {actuator} command "
                                  f"range [{lower[a]:g}, {upper[a]:g}], got {list(r)}")
+        kd = self.kind_draws
+        if kd.delay_s[1] > MAX_DELAY_STEPS * dt + 1e-12:
+            raise ValueError(f"kind_draws.delay_s: at most {MAX_DELAY_STEPS} control periods "
+                             f"({MAX_DELAY_STEPS * dt:g} s), got {list(kd.delay_s)}")
+        if round(kd.delay_s[0] / dt) < 1:
+            raise ValueError(f"kind_draws.delay_s: at least one control period ({dt:g} s), "
+                             f"got {list(kd.delay_s)}")
+        if kd.osc_freq_hz[1] >= 0.5 / dt:
+            raise ValueError(f"kind_draws.osc_freq_hz: below the Nyquist frequency "
+                             f"{0.5 / dt:g} Hz of the control period, got {list(kd.osc_freq_hz)}")
         for i, name in enumerate(self.campaign.transitions):
             sensor = parse_sensor_transition(name)
             if sensor and sensor[0] == "noise" and self.noise.measurement_scale == 0:
