@@ -263,3 +263,65 @@ def test_bad_fault_specifications_are_refused(tmp_path, over, field):
     lines = [ln for ln in r.output.splitlines() if ln.strip()]
     assert len(lines) == 1 and field in lines[0], r.output
     assert not out.exists()
+
+
+SCENARIO = {"scenario": {"duration_s": 40.0, "schedule": [
+    {"time_s": 0.0, "fault": "nominal"},
+    {"time_s": 5.0, "fault": "oscillatory", "actuator": "left_elevon", "duration_s": 3.0,
+     "amplitude": 0.05, "frequency_hz": 1.0, "phase_rad": 0.0},
+    {"time_s": 10.0, "fault": "lock", "actuator": "engine", "position": 0.3,
+     "duration_s": 2.0},
+    {"time_s": 20.0, "fault": "runaway", "actuator": "right_elevon", "rate": 0.02},
+    {"time_s": 30.0, "fault": "nominal"}]}}
+"""A scenario of faults that come and go (start, duration, parameters)."""
+
+
+def test_a_scenario_holds_faults_that_come_and_go():
+    """Durations written out as nominal entries; each entry's truth mode is its
+    actuator's; the commanded and the flown elevon differ only while it oscillates."""
+    from ftc_mc.config.schema import ScenarioConfig, expanded_schedule
+    from ftc_mc.sim.inputs import scenario_schedule
+
+    sc = ScenarioConfig.model_validate(SCENARIO)
+    ev = expanded_schedule(sc.scenario)
+    assert [(e.time_s, e.fault) for e in ev] == [
+        (0.0, "nominal"), (5.0, "oscillatory"), (8.0, "nominal"), (10.0, "lock"),
+        (12.0, "nominal"), (20.0, "runaway"), (30.0, "nominal")]
+    s = scenario_schedule(ev, np.array([0.3, 0.05, 0.05]), 0.1, np.zeros(3), np.ones(3))
+    assert list(s.k_switch) == [0, 50, 80, 100, 120, 200, 300]
+    assert list(s.mode[:, 0]) == [0, 2, 0, 1, 0, 3, 0]
+    assert s.fp[1, FP_OSC_AMP, 1, 0] == 0.05 and s.fp[2, FP_OSC_AMP, 1, 0] == 0.0
+    res = ftc_mc.run_scenario(SCENARIO | {"model": {"airframe": "x8-gryte2018"}})
+    seg = res.segments
+    assert list(seg["truth_mode"]) == ["nominal", "left_elevon", "nominal", "engine",
+                                       "nominal", "right_elevon", "nominal"]
+
+
+BAD_SCENARIOS = [
+    ({"time_s": 5.0, "fault": "float", "actuator": "engine", "float_angle": 0.0,
+      "float_gain": -0.5}, "actuator"),
+    ({"time_s": 5.0, "fault": "slow", "actuator": "engine"}, "rate_limit"),
+    ({"time_s": 5.0, "fault": "slow", "actuator": "engine", "rate_limit": 0.1, "b1": 0.5},
+     "b1"),
+    ({"time_s": 5.0, "fault": "runaway", "actuator": "engine", "rate": 0.1,
+      "duration_s": 30.0}, "duration_s"),
+    ({"time_s": 5.0, "fault": "delayed", "actuator": "engine", "delay_s": 3.0}, "delay_s"),
+    ({"time_s": 5.0, "fault": "oscillatory", "actuator": "engine", "amplitude": 0.1,
+      "frequency_hz": 6.0, "phase_rad": 0.0}, "frequency_hz"),
+    ({"time_s": 5.0, "fault": "wobble", "actuator": "engine"}, "fault"),
+]
+
+
+@pytest.mark.parametrize("entry,field", BAD_SCENARIOS)
+def test_bad_scenario_faults_are_refused(tmp_path, entry, field):
+    """A bad fault entry of a scenario: one line naming the field, exit 2, nothing written."""
+    cfg = {"scenario": {"duration_s": 40.0, "schedule": [
+        {"time_s": 0.0, "fault": "nominal"}, entry, {"time_s": 20.0, "fault": "nominal"}]}}
+    path = tmp_path / "bad.yaml"
+    path.write_text(json.dumps(cfg))
+    out = tmp_path / "out"
+    r = CliRunner().invoke(cli, ["scenario", str(path), "--out", str(out)])
+    assert r.exit_code == 2, r.output
+    lines = [ln for ln in r.output.splitlines() if ln.strip()]
+    assert len(lines) == 1 and field in lines[0] and "schedule" in lines[0], r.output
+    assert not out.exists()

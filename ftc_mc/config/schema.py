@@ -961,19 +961,52 @@ class Config(_Sampled):
         return self.steps(self.timing.duration_s) if m is None else m
 
 
+SCENARIO_KINDS = tuple(k for k in KINDS_BEYOND if k != "intermittent")
+"""Fault kinds a scenario entry may name besides nominal, lock and loss (an
+intermittent fault is a list of entries with durations)."""
+KIND_FIELDS = {"lock": ("position",), "loss": ("b1",), "hardover": ("side",),
+               "float": ("float_angle", "float_gain"), "slow": ("rate_limit",),
+               "delayed": ("delay_s",),
+               "oscillatory": ("amplitude", "frequency_hz", "phase_rad"),
+               "runaway": ("rate",), "nominal": ()}
+"""The parameters each fault of a scenario entry takes (all of them, no others)."""
+
+
 class FaultEvent(_Strict):
-    """One entry of a scenario's fault schedule."""
+    """One entry of a scenario's fault schedule: from ``time_s`` on (for
+    ``duration_s`` if given, RflyMAD's start and duration), one actuator's fault
+    with its parameters (docs/guides/fault-kinds.md)."""
 
     time_s: NonNeg
     """Time from which this entry holds [s]."""
-    fault: Literal["nominal", "lock", "loss"]
-    """``nominal`` (every actuator healthy), ``lock`` or ``loss`` (of effectiveness)."""
+    fault: Literal[("nominal", "lock", "loss") + SCENARIO_KINDS]
+    """``nominal`` (every actuator healthy), ``lock``, ``loss`` (of effectiveness), or a fault kind: hardover, float (elevons), slow, delayed, oscillatory, runaway."""
     actuator: Literal[ACTUATOR_NAMES] | None = None
     """Faulty actuator (``engine``, ``left_elevon``, ``right_elevon``); not for nominal."""
+    duration_s: Pos | None = None
+    """How long the fault acts [s]; then every actuator is healthy until the next entry (null: until the next entry)."""
     position: Finite | Literal["trim"] | None = None
     """Lock position (absolute command: throttle [-] or elevon [rad]) or ``trim``."""
     b1: Annotated[float, NoBool, Field(ge=0, le=1, allow_inf_nan=False)] | None = None
     """Effectiveness loss of a ``loss`` fault (0 healthy, 1 no effect)."""
+    side: Literal["upper", "lower"] | None = None
+    """hardover: the travel limit the actuator locks at."""
+    float_angle: Finite | None = None
+    """float: the floating angle at zero angle of attack [rad]."""
+    float_gain: Annotated[float, NoBool, Field(ge=-2, le=0, allow_inf_nan=False)] | None = None
+    """float: the floating angle's gain on the angle of attack [rad/rad]."""
+    rate_limit: Pos | None = None
+    """slow: the rate limit [command unit/s]."""
+    delay_s: Pos | None = None
+    """delayed: the transport delay [s] (whole control periods, at most 20)."""
+    amplitude: Pos | None = None
+    """oscillatory: the limit cycle's amplitude [command unit]."""
+    frequency_hz: Pos | None = None
+    """oscillatory: its frequency [Hz]."""
+    phase_rad: Finite | None = None
+    """oscillatory: its phase at the entry's start [rad]."""
+    rate: Finite | None = None
+    """runaway: the drift rate from the command [command unit/s], either sign."""
 
     @model_validator(mode="after")
     def _fields(self):
@@ -987,7 +1020,37 @@ class FaultEvent(_Strict):
                              "and no b1")
         elif self.fault == "loss" and (self.b1 is None or self.position is not None):
             raise ValueError("b1: a loss entry needs b1 in [0, 1] and no position")
+        if self.fault == "float" and self.actuator == "engine":
+            raise ValueError("actuator: a float entry is an elevon's (a throttle cannot float)")
+        wanted = KIND_FIELDS[self.fault]
+        for name in sorted({f for fs in KIND_FIELDS.values() for f in fs}):
+            given = getattr(self, name) is not None
+            if name in wanted and not given:
+                raise ValueError(f"{name}: a {self.fault} entry needs it")
+            if given and name not in wanted:
+                raise ValueError(f"{name}: a {self.fault} entry takes no {name}")
+        if self.fault == "nominal" and self.duration_s is not None:
+            raise ValueError("duration_s: a nominal entry takes no duration")
         return self
+
+
+def expanded_schedule(spec) -> list:
+    """A scenario's schedule with each duration written out: an entry with
+    ``duration_s`` is followed by a nominal entry at its end, unless the next
+    entry starts then (the result has no durations; a schedule without any
+    is returned as it is)."""
+    events = list(spec.schedule)
+    if all(e.duration_s is None for e in events):
+        return events
+    out = []
+    for i, e in enumerate(events):
+        out.append(e.model_copy(update={"duration_s": None}))
+        if e.duration_s is not None:
+            end = e.time_s + e.duration_s
+            nxt = events[i + 1].time_s if i + 1 < len(events) else spec.duration_s
+            if end < nxt - 1e-9:
+                out.append(FaultEvent(time_s=end, fault="nominal"))
+    return out
 
 
 class SensorFaultEvent(_Strict):
@@ -1053,6 +1116,11 @@ class ScenarioSpec(_Strict):
         if times[-1] >= self.duration_s:
             raise ValueError(f"schedule: entry at {times[-1]:g} s is not before the end "
                              f"of the run ({self.duration_s:g} s)")
+        for i, e in enumerate(self.schedule):
+            if e.duration_s is not None and i + 1 < len(times) \
+                    and e.time_s + e.duration_s > times[i + 1] + 1e-9:
+                raise ValueError(f"schedule.{i}.duration_s: the fault would outlast the next "
+                                 f"entry at {times[i + 1]:g} s")
         return self
 
 
@@ -1094,10 +1162,19 @@ class ScenarioConfig(_Sampled):
                                      f"outside the {e.actuator} command range "
                                      f"[{lower[a]:g}, {upper[a]:g}]")
         for i, e in enumerate(sc.schedule):
-            n = e.time_s / dt
-            if not math.isfinite(n) or abs(n - round(n)) > 1e-9 * max(1.0, n):
-                raise ValueError(f"scenario.schedule.{i}.time_s: must be a multiple of "
-                                 f"model.dt_s ({dt:g} s), got {e.time_s:g}")
+            for name in ("time_s", "duration_s", "delay_s"):
+                v = getattr(e, name)
+                n = math.nan if v is None else v / dt
+                if v is not None and (not math.isfinite(n)
+                                      or abs(n - round(n)) > 1e-9 * max(1.0, n)):
+                    raise ValueError(f"scenario.schedule.{i}.{name}: must be a multiple of "
+                                     f"model.dt_s ({dt:g} s), got {v:g}")
+            if e.delay_s is not None and round(e.delay_s / dt) > MAX_DELAY_STEPS:
+                raise ValueError(f"scenario.schedule.{i}.delay_s: at most {MAX_DELAY_STEPS} "
+                                 f"control periods, got {e.delay_s:g} s")
+            if e.frequency_hz is not None and e.frequency_hz >= 0.5 / dt:
+                raise ValueError(f"scenario.schedule.{i}.frequency_hz: below the Nyquist "
+                                 f"frequency {0.5 / dt:g} Hz, got {e.frequency_hz:g}")
         sf = sc.sensor_fault
         if sf is not None:
             n = sf.time_s / dt

@@ -44,7 +44,9 @@ from collections import namedtuple
 import numpy as np
 
 from ..conventions import (ACTUATOR_FAULT_KINDS, ACTUATOR_NAMES, FAULT_PARAM_NEUTRAL,
-                           KIND_NONE, LONGITUDINAL, N_FAULT_PARAM, N_U, NO_SENSOR_FAULT,
+                           FP_DELAY, FP_FLOAT, FP_FLOAT_ANGLE, FP_FLOAT_GAIN, FP_OSC_AMP,
+                           FP_OSC_FREQ, FP_OSC_PHASE, FP_RATE, FP_RUNAWAY, KIND_NONE,
+                           LONGITUDINAL, MODE_NAMES, N_FAULT_PARAM, N_U, NO_SENSOR_FAULT,
                            OUTPUT_NAMES, SENSOR_FAULT_KINDS)
 from ..core.longitudinal.settings import TrialInputs
 from ..model.faults import estimator_params, mode_of
@@ -332,31 +334,68 @@ def flight_inputs(setup, trial_ids, seed: int) -> TrialInputs:
                         draw_lanes(setup, trial_ids, seed, FLIGHT_FAULT_RANGE))
 
 
-def scenario_schedule(events, u0: np.ndarray, dt: float) -> Schedule:
+def scenario_schedule(events, u0: np.ndarray, dt: float, u_lower=None,
+                      u_upper=None) -> Schedule:
     """The schedule of a scenario (one lane).
 
     Parameters
     ----------
     events : list of FaultEvent
-        A validated ``scenario.schedule``.
+        A validated ``scenario.schedule`` with its durations written out
+        (:func:`ftc_mc.config.schema.expanded_schedule`).
     u0 : ndarray, shape (3,)
         Trim commands: the position of a lock ``at trim``.
     dt : float
         Control period [s].
+    u_lower, u_upper : ndarray, shape (3,), optional
+        Absolute travel limits: where a hard-over locks (needed only by one).
+
+    Returns
+    -------
+    Schedule
+        With the fault model's parameters, kinds and truth modes of each entry
+        when an entry names a kind beyond lock and loss (a kind's truth mode is
+        its actuator's); otherwise those of eq. (2) alone, as before.
     """
     k = np.array([int(round(e.time_s / dt)) for e in events], dtype=np.int64)
-    b0 = np.zeros((len(events), 3, 1))
-    b1 = np.zeros((len(events), 3, 1))
+    E = len(events)
+    b0 = np.zeros((E, 3, 1))
+    b1 = np.zeros((E, 3, 1))
+    beyond = any(e.fault not in ("nominal", "lock", "loss") for e in events)
+    fp = neutral_params(E, 1)
+    kind = np.full((E, 3, 1), KIND_NONE, dtype=np.int64)
+    mode = np.zeros((E, 1), dtype=np.int64)
     for i, e in enumerate(events):
         if e.fault == "nominal":
             continue
         a = ACTUATOR_NAMES.index(e.actuator)
+        kind[i, a, 0] = ACTUATOR_FAULT_KINDS.index(e.fault)
+        mode[i, 0] = MODE_NAMES.index(e.actuator)
         if e.fault == "lock":
             b1[i, a, 0] = 1.0
             b0[i, a, 0] = u0[a] if e.position == "trim" else float(e.position)
-        else:
+        elif e.fault == "loss":
             b1[i, a, 0] = e.b1
-    return Schedule(k_switch=k, b0=b0, b1=b1)
+        elif e.fault == "hardover":
+            b1[i, a, 0] = 1.0
+            b0[i, a, 0] = (u_upper if e.side == "upper" else u_lower)[a]
+        elif e.fault == "float":
+            fp[i, FP_FLOAT, a, 0] = 1.0
+            fp[i, FP_FLOAT_ANGLE, a, 0] = e.float_angle
+            fp[i, FP_FLOAT_GAIN, a, 0] = e.float_gain
+        elif e.fault == "slow":
+            fp[i, FP_RATE, a, 0] = e.rate_limit
+        elif e.fault == "delayed":
+            fp[i, FP_DELAY, a, 0] = round(e.delay_s / dt)
+        elif e.fault == "oscillatory":
+            fp[i, FP_OSC_AMP, a, 0] = e.amplitude
+            fp[i, FP_OSC_FREQ, a, 0] = e.frequency_hz
+            fp[i, FP_OSC_PHASE, a, 0] = e.phase_rad
+        elif e.fault == "runaway":
+            fp[i, FP_RUNAWAY, a, 0] = e.rate
+    if not beyond:
+        return Schedule(k_switch=k, b0=b0, b1=b1)
+    return Schedule(k_switch=k, b0=b0, b1=b1, fp=fp, kind=kind, mode=mode)
 
 
 def scenario_inputs(setup, spec) -> TrialInputs:
@@ -373,5 +412,8 @@ def scenario_inputs(setup, spec) -> TrialInputs:
     sensor = None if sf is None else sensor_faults(
         OUTPUT_NAMES.index(sf.output), SENSOR_FAULT_KINDS.index(sf.kind),
         [0.0 if sf.size is None else sf.size], int(round(sf.time_s / plant.dt)))
-    return build_inputs(setup, scenario_schedule(spec.schedule, plant.u0, plant.dt),
+    from ..config.schema import expanded_schedule
+
+    return build_inputs(setup, scenario_schedule(expanded_schedule(spec), plant.u0, plant.dt,
+                                                 plant.u_lower, plant.u_upper),
                         draw_lanes(setup, [0], spec.seed), sensor)
