@@ -980,7 +980,7 @@ class FaultEvent(_Strict):
     time_s: NonNeg
     """Time from which this entry holds [s]."""
     fault: Literal[("nominal", "lock", "loss") + SCENARIO_KINDS]
-    """``nominal`` (every actuator healthy), ``lock``, ``loss`` (of effectiveness), or a fault kind: hardover, float (elevons), slow, delayed, oscillatory, runaway."""
+    """``nominal`` (all healthy), ``lock``, ``loss`` (of effectiveness) or a kind: hardover, float (elevons), slow, delayed, oscillatory, runaway."""
     actuator: Literal[ACTUATOR_NAMES] | None = None
     """Faulty actuator (``engine``, ``left_elevon``, ``right_elevon``); not for nominal."""
     duration_s: Pos | None = None
