@@ -1075,11 +1075,14 @@ def advance_ref(scheme, flight, inp, rec, st, k0, k1):
     st = type(st)(*(np.array(a, copy=True) for a in st))
     rec = type(rec)(*(np.array(a, copy=True) for a in rec))
     every = flight.timing.reconf_every
+    alpha_last = np.zeros(st.x.shape[1])  # a fresh work area's (the float reads it)
     for k in range(k0, k1):
         kn = k + 1
         u, exc = commands_ref(scheme, st, k)
-        tr = truth_step_ref(scheme, flight, inp, k, st, u)
+        tr = truth_step_ref(scheme, flight, inp, k, st, u, alpha_last)
+        alpha_last = tr["alpha"]
         st.x[:], st.gust[:], st.zhold[:] = tr["x"], tr["gust"], tr["zhold"]
+        st.uhist[:], st.uprev[:] = tr["uhist"], tr["uprev"]
         rec.cost[:], rec.z_switch_last[:] = record_cost_ref(
             flight.track, flight.timing.k_fault, kn, st.x, u, st.alive, rec.cost,
             rec.z_switch_last)

@@ -713,7 +713,7 @@ def _signals(spec: ChunkSpec, name: str, runs, trial_ids, inp, recs) -> pd.DataF
     from .signals import signals_frame
     tim = spec.setup.tim
     kind = None
-    if not is_sensor(name) and isinstance(tr := transition_of(name), KindTransition):
+    if isinstance(tr := TRANSITION_TABLE.get(name), KindTransition):
         neutral = neutral_params(1, 1)[0, :, :1]  # (N_FAULT_PARAM, 1, 1)
         acting = (np.asarray(inp.b1) != 0) | np.any(np.asarray(inp.fp) != neutral, axis=1)
         kind = np.where(acting, tr.kind_code, KIND_NONE)
