@@ -66,7 +66,7 @@ def schedule_entry(k_switch, k):
     return ev
 
 
-@kernel(inline="always")
+@kernel(internal=True)
 def actuator_effect(u0, lo, hi, b0, b1, fp, k_on, k, dt, alpha, uhist, uprev, u, e):
     """Effect of the actuators on every lane: the generic fault model, then eq. (2).
 
@@ -89,7 +89,8 @@ def actuator_effect(u0, lo, hi, b0, b1, fp, k_on, k, dt, alpha, uhist, uprev, u,
 
     With the neutral parameters (:data:`~ftc_mc.conventions.FAULT_PARAM_NEUTRAL`:
     no delay, an infinite rate limit, every other term zero) ``c = u`` and the
-    arithmetic is eq. (2)'s, bit for bit.
+    arithmetic is eq. (2)'s, bit for bit.  A kernel of its own (not inlined):
+    compiled once for the truth of both plant families.
 
     Parameters
     ----------
