@@ -196,6 +196,49 @@ PLANT_KINDS = ("linear", "nonlinear")
 TURBULENCE_LEVELS = ("none", "light", "moderate", "severe")
 """Truth plants and MIL-F-8785C turbulence levels (W20 = 0, 15, 30, 45 kt)."""
 
+# ------------------------------------------------------------------ actuator fault kinds
+ACTUATOR_FAULT_KINDS = ("lock", "loss", "hardover", "float", "slow", "delayed",
+                        "oscillatory", "runaway", "intermittent")
+"""Actuator fault kinds (``docs/guides/fault-kinds.md``): the paper's ``lock`` and
+``loss`` (``b0``, ``b1`` of eq. 2), and the kinds beyond them, each a setting
+of the per-actuator parameters :data:`FAULT_PARAM_NAMES` the truth reads each
+step (``ftc_mc/core/longitudinal/plant.py``, ``actuator_effect``)."""
+KIND_NONE = -1
+"""The kind code of an actuator without a fault (signals' ``kind_*`` columns)."""
+
+FAULT_PARAM_NAMES = ("delay_steps", "rate_limit", "osc_amp", "osc_freq_hz", "osc_phase",
+                     "runaway_rate", "float_weight", "float_angle", "float_gain")
+"""Per-actuator parameters of the generic fault model beside ``b0`` and ``b1``
+(``TrialInputs.fp``): transport delay [steps]; rate limit [unit/s]; limit-cycle
+amplitude [unit], frequency [Hz] and phase [rad]; runaway rate [unit/s]; the
+weight of the floating angle in the surface's command [-], the floating angle
+at zero angle of attack [rad] and its gain on the angle of attack [rad/rad].
+The unit is the actuator's command unit (throttle [-], elevon [rad])."""
+N_FAULT_PARAM = len(FAULT_PARAM_NAMES)
+(FP_DELAY, FP_RATE, FP_OSC_AMP, FP_OSC_FREQ, FP_OSC_PHASE, FP_RUNAWAY, FP_FLOAT,
+ FP_FLOAT_ANGLE, FP_FLOAT_GAIN) = range(N_FAULT_PARAM)
+FAULT_PARAM_NEUTRAL = (0.0, float("inf"), 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+"""The parameters of a healthy actuator (and of a lock or loss): the truth's
+arithmetic is then eq. (2) exactly."""
+MAX_DELAY_STEPS = 20
+"""Longest transport delay the truth keeps commands for [steps] (2 s at 0.1 s)."""
+N_CMD_HIST = MAX_DELAY_STEPS + 1
+"""Length of each lane's command ring (``LaneState.uhist``)."""
+
+KIND_PREFIXES = {"elevon": "left_elevon", "right_elevon": "right_elevon",
+                 "engine": "engine"}
+"""Name prefix of a fault-kind transition -> its actuator (``elevon_*`` is the
+left one, as the paper's rows)."""
+KINDS_BEYOND = ACTUATOR_FAULT_KINDS[2:]
+"""The kinds beyond the paper's lock and loss."""
+KIND_ACTUATORS = {"float": ("left_elevon", "right_elevon")}
+"""Actuators a kind applies to when not all (a throttle cannot float)."""
+KIND_TRANSITIONS = tuple(
+    f"{prefix}_{kind}" for prefix, actuator in KIND_PREFIXES.items()
+    for kind in KINDS_BEYOND if actuator in KIND_ACTUATORS.get(kind, ACTUATOR_NAMES))
+"""Onset rows (nominal -> faulty) of the kinds beyond lock and loss, e.g.
+``elevon_oscillatory``, ``right_elevon_runaway``, ``engine_slow``."""
+
 # ------------------------------------------------------------------ sensor faults
 OUTPUT_UNITS = ("m/s", "m/s", "rad/s", "m", "m", "rad", "g", "g", "rad", "rad", "m/s",
                 "m/s")

@@ -815,17 +815,53 @@ def dryden_ref(turb, Ad, Bd, Cd, state, eta):
     return Cd @ state, nxt, Cd @ nxt
 
 
-def truth_step_ref(scheme, flight, inp, k, st, u):
+def actuator_model_ref(u, u0, lo, hi, b0, b1, fp, k_on, k, dt, alpha, uhist, uprev):
+    """The actuators' generic fault model and eq. (2) on every lane, vectorised
+    over actuators and lanes (``docs/guides/fault-kinds.md``): the command
+    ``d`` steps ago (trim before step 0), plus ``A sin(2 pi f t + phi) + r t``,
+    blended toward the floating angle ``delta_f0 + k_f alpha`` with weight
+    ``w`` and held in the travel when any of these acts, then within
+    ``R dt`` of the last followed command.  Returns ``(e, uhist, uprev)``
+    (updated copies)."""
+    from ftc_mc.conventions import FAULT_PARAM_NAMES
+
+    P = dict(zip(FAULT_PARAM_NAMES, fp))  # each (3, L)
+    uhist = uhist.copy()
+    H = uhist.shape[0]
+    uhist[k % H] = u
+    d = P["delay_steps"].astype(int)
+    past = np.take_along_axis(uhist, ((k - d) % H)[None], axis=0)[0]
+    c = np.where(d > 0, np.where(k - d >= 0, past, 0.0), u)
+    t = (k - k_on) * dt
+    amp, run, w = P["osc_amp"], P["runaway_rate"], P["float_weight"]
+    acts = (amp != 0) | (run != 0) | (w != 0)
+    moved = c + (amp * np.sin(2 * np.pi * P["osc_freq_hz"] * t + P["osc_phase"]) + run * t)
+    floating = P["float_angle"] + P["float_gain"] * alpha[None, :] - u0[:, None]
+    moved = np.where(w != 0, (1 - w) * moved + w * floating, moved)
+    moved = np.clip(moved, lo[:, None], hi[:, None])
+    c = np.where(acts, moved, c)
+    step = P["rate_limit"] * dt
+    c = np.where(c > uprev + step, uprev + step, np.where(c < uprev - step, uprev - step, c))
+    e = b0 + (1.0 - b1) * c - b1 * u0[:, None]
+    return e, uhist, c
+
+
+def truth_step_ref(scheme, flight, inp, k, st, u, alpha_last=None):
     """The truth over step ``k``: effect (eq. 2), Dryden gust, linear (eq. 1) or
-    nonlinear (RK4) plant, measurement and air data.  Returns a dict with ``x``,
-    ``gust``, ``e``, ``wind``, ``wind_next``, ``z``, ``va``, ``alpha``."""
+    nonlinear (RK4) plant, measurement and air data; ``alpha_last`` the true
+    angle of attack of the last sample (zeros when omitted, as a fresh work
+    area's).  Returns a dict with ``x``, ``gust``, ``e``, ``wind``,
+    ``wind_next``, ``z``, ``va``, ``alpha``, ``zhold``, ``uhist``, ``uprev``."""
     from ftc_mc.model.faults import effect
 
     fm, pl, val = scheme.filter, flight.plant, flight.validity
     L = st.x.shape[1]
     ev = int(np.searchsorted(inp.k_switch, k, side="right")) - 1
-    e = np.column_stack([effect(u[:, l], fm.u0, inp.b0[ev][:, l], inp.b1[ev][:, l])
-                         for l in range(L)])
+    e, uhist, uprev = actuator_model_ref(
+        u, fm.u0, scheme.controller.lo_dev, scheme.controller.hi_dev, inp.b0[ev],
+        inp.b1[ev], inp.fp[ev], inp.k_switch[ev], k, pl.dt,
+        np.zeros(L) if alpha_last is None else alpha_last, st.uhist,
+        st.uprev)
     wind, gust, wind_next = dryden_ref(pl.turb, pl.Ad, pl.Bd, pl.Cd, st.gust,
                                        inp.eta[k] if pl.turb else None)
     if pl.kind == 0:
@@ -850,7 +886,8 @@ def truth_step_ref(scheme, flight, inp, k, st, u):
             z[:, l], inp.v[k][:, l], zhold[l], k, pl.dt, int(inp.sensor_out[l]),
             int(inp.sensor_kind[l]), float(inp.sensor_size[l]), int(inp.sensor_k[l]))
     return dict(x=x, gust=gust, e=e, wind=wind, wind_next=wind_next, z=z, va=va,
-                alpha=alpha, zhold=zhold)
+                alpha=alpha, zhold=zhold, uhist=uhist, uprev=uprev)
+
 
 
 def sensor_fault_ref(z, v, zhold, k, dt, out, kind, size, k_onset):
@@ -1099,11 +1136,14 @@ def advance_ref(scheme, flight, inp, rec, st, k0, k1):
     st = type(st)(*(np.array(a, copy=True) for a in st))
     rec = type(rec)(*(np.array(a, copy=True) for a in rec))
     every = flight.timing.reconf_every
+    alpha_last = np.zeros(st.x.shape[1])  # a fresh work area's (the float reads it)
     for k in range(k0, k1):
         kn = k + 1
         u, exc = commands_ref(scheme, st, k)
-        tr = truth_step_ref(scheme, flight, inp, k, st, u)
+        tr = truth_step_ref(scheme, flight, inp, k, st, u, alpha_last)
+        alpha_last = tr["alpha"]
         st.x[:], st.gust[:], st.zhold[:] = tr["x"], tr["gust"], tr["zhold"]
+        st.uhist[:], st.uprev[:] = tr["uhist"], tr["uprev"]
         rec.cost[:], rec.z_switch_last[:] = record_cost_ref(
             flight.track, flight.timing.k_fault, kn, st.x, u, st.alive, rec.cost,
             rec.z_switch_last)

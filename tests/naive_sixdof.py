@@ -185,7 +185,7 @@ def sixdof_truth_ref(scheme, flight, inp, k, st, rec, u):
     ``z``, ``va``, ``alpha``, ``bank``, ``sq_lat``.
     """
     from ftc_mc.conventions import LONGITUDINAL
-    from ftc_mc.model.faults import effect
+    from naive import actuator_model_ref
     from naive import B0_T, B1_T, C0, C1, dryden_ref, engine_gain_ref, sensor_fault_ref
 
     fm, ctl, pl = scheme.filter, scheme.controller, flight.plant
@@ -210,8 +210,9 @@ def sixdof_truth_ref(scheme, flight, inp, k, st, rec, u):
             c = LAYOUT.commands.index(side)
             lat[row, l] = pl.a_act * st.lat[row, l] + (1 - pl.a_act) * (u[c, l] - pl.u_ff[c])
     ev = int(np.searchsorted(inp.k_switch, k, side="right")) - 1
-    e = np.column_stack([effect(u[:, l], fm.u0, inp.b0[ev][:, l], inp.b1[ev][:, l])
-                         for l in range(L)])
+    e, uhist, uprev = actuator_model_ref(
+        u, fm.u0, ctl.lo_dev, ctl.hi_dev, inp.b0[ev], inp.b1[ev], inp.fp[ev],
+        inp.k_switch[ev], k, pl.dt, np.zeros(L), st.uhist, st.uprev)
     eta, eta_lat = (inp.eta[k], inp.eta_lat[k]) if pl.turb else (None, None)
     lon_w, gust, lon_wn = dryden_ref(pl.turb, pl.Ad, pl.Bd, pl.Cd, st.gust, eta)
     lat_w, glat, lat_wn = dryden_ref(pl.turb, pl.Adl, pl.Bdl, pl.Cdl, st.glat, eta_lat)
@@ -261,7 +262,7 @@ def sixdof_truth_ref(scheme, flight, inp, k, st, rec, u):
             z[:, l], inp.v[k][:, l], zhold[l], k, pl.dt, int(inp.sensor_out[l]),
             int(inp.sensor_kind[l]), float(inp.sensor_size[l]), int(inp.sensor_k[l]))
     return dict(u=u, e=e, x=x, gust=gust, glat=glat, lat=lat, z=z, va=va, alpha=alpha,
-                bank=bank, sq_lat=sq, zhold=zhold)
+                bank=bank, sq_lat=sq, zhold=zhold, uhist=uhist, uprev=uprev)
 
 
 class SideMonitorRef:

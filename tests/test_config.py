@@ -16,7 +16,7 @@ def test_shipped_configs_say_what_they_run_and_how():
     command, then only the fields it sets (what they resolve to:
     tests/test_config_equivalence.py)."""
     files = sorted((ROOT / "configs").glob("*.yaml"))
-    assert len(files) == 21
+    assert len(files) == 23
     for path in files:
         text = path.read_text(encoding="utf-8")
         head = text.split("\n\n")[0]

@@ -160,8 +160,9 @@ def test_learned_example(recorded, tmp_path, monkeypatch):
 
 
 def test_truth_columns_are_the_truth():
-    """One definition of the truth: the mode and every actuator's b0, b1."""
-    assert TRUTH_COLUMNS == ("mode", *(f"b{i}_{a}" for i in (0, 1) for a in LAY.actuators))
+    """One definition of the truth: the mode and every actuator's b0, b1 and fault kind."""
+    assert TRUTH_COLUMNS == ("mode", *(f"b{i}_{a}" for i in (0, 1) for a in LAY.actuators),
+                             *(f"kind_{a}" for a in LAY.actuators))
     assert set(TRUTH_COLUMNS) <= set(signal_columns())
     seen = [c for c in signal_columns() if c not in TRUTH_COLUMNS]
     assert not [c for c in seen if c == "mode" or c[:3] in ("b0_", "b1_")]

@@ -15,7 +15,8 @@ from ftc_mc.cli import TERMINAL_WIDTH, cli, terminal_table
 from ftc_mc.config import Config
 from ftc_mc.conventions import (ACTUATOR_NAMES, MODE_LEFT_ELEVON, MODE_NOMINAL,
                                 MODE_RIGHT_ELEVON, PAPER_TRANSITIONS, RESET_ELEVONS,
-                                RIGHT_ELEVON_TRANSITIONS, STATUS_AIRSPEED, TRANSITIONS)
+                                RIGHT_ELEVON_TRANSITIONS, STATUS_AIRSPEED, TRANSITIONS,
+                                KIND_TRANSITIONS)
 from ftc_mc.sim.lanes import new_record
 from ftc_mc.stats import wilson
 from test_campaign import small_config
@@ -31,7 +32,7 @@ def spec():
 
 def test_the_twelve_rows_and_the_paper_default():
     assert TRANSITIONS == PAPER_TRANSITIONS + RIGHT_ELEVON_TRANSITIONS
-    assert tuple(TRANSITION_TABLE) == TRANSITIONS
+    assert tuple(TRANSITION_TABLE) == TRANSITIONS + KIND_TRANSITIONS  # then the fault kinds
     for name in RIGHT_ELEVON_TRANSITIONS:
         tr, left = TRANSITION_TABLE[name], TRANSITION_TABLE[name[len("right_"):]]
         assert (tr.actuator, tr.fault_mode, tr.correct_block) == (

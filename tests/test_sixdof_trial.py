@@ -55,7 +55,8 @@ def lateral_state(setup, rng, st, inp, k):
 def test_sixdof_truth_matches_its_twin(kind, coupling):
     """One truth step of every lane against ``naive_sixdof.sixdof_truth_ref``:
     random states, lateral loop states, gusts, commands at and beyond the
-    limits, faults of every kind and sensor faults; with the coupled c0 and
+    limits, faults of every kind (the fault model's delay, rate limit, limit
+    cycle, runaway and float among them) and sensor faults; with the coupled c0 and
     c1 (``controller.coupling: coupled``) on the lanes flying them (two
     thirds) and the separate loops on the lanes flying c2."""
     from ftc_mc.core.sixdof.truth import sixdof_truth
@@ -83,7 +84,7 @@ def test_sixdof_truth_matches_its_twin(kind, coupling):
     sixdof_truth(SIXDOF_PLANT, scheme, flight, inp, k, st, work, rec)
     got = dict(u=work.u, e=work.e, x=st.x, gust=st.gust, glat=st.glat, lat=st.lat,
                z=work.z, va=work.va, alpha=work.alpha, bank=work.bank, sq_lat=rec.sq_lat,
-               zhold=st.zhold)
+               zhold=st.zhold, uhist=st.uhist, uprev=st.uprev)
     for key, ref in want.items():
         np.testing.assert_allclose(got[key], ref, rtol=1e-10, atol=1e-12, err_msg=key)
     assert np.abs(work.bank).max() > 0  # a bank was flown, and compared

@@ -19,15 +19,17 @@ import pandas as pd
 
 from ..config.schema import Config
 from ..conventions import (BLOCK_NAMES, C_NOMINAL, COST_TRACK_MAX, COST_TRACK_SQ, COST_U2,
-                           LONGITUDINAL, MODE_NAMES, MODE_NOMINAL, STATUS_AIRSPEED,
+                           KIND_NONE, LONGITUDINAL, MODE_NAMES, MODE_NOMINAL, STATUS_AIRSPEED,
                            STATUS_ALPHA, STATUS_NAMES, STATUS_NONFINITE, STATUS_NOT_PSD)
 from ..core.longitudinal.settings import TrialInputs, TrialRecord
 from ..core.longitudinal.trial import advance
 from ..sim.compiling import compiled_once
 from ..sim.paths import path_of
-from ..sim.inputs import build_inputs, draw_lanes, flight_inputs, sensor_faults
+from ..sim.inputs import (FLIGHT_FAULT_RANGE, build_inputs, draw_lanes, flight_inputs,
+                          neutral_params, sensor_faults)
 from ..sim.lanes import simulate
 from ..sim.setup import SimSetup, build_setup, runs_of
+from .kinds import KindRanges, KindTransition, kind_draws, kind_ranges, kind_schedule
 from .side import side_columns
 from .transitions import (ELEVON_MODES, ENGINE, TRANSITION_TABLE, FaultRanges,
                           SensorTransition, fault_ranges, is_sensor, transition_of)
@@ -72,6 +74,8 @@ class ChunkSpec:
     record : bool
         Keep every step and return the ``signals`` table too
         (``campaign.record``, :mod:`ftc_mc.campaign.signals`).
+    kind_ranges : KindRanges or None
+        Ranges of the fault kinds' draws (``kind_draws``, :mod:`ftc_mc.campaign.kinds`).
     """
 
     setup: SimSetup
@@ -85,6 +89,7 @@ class ChunkSpec:
     sensor_ranges: dict = dataclasses.field(default_factory=dict)
     resets_kept: int | None = None
     record: bool = False
+    kind_ranges: KindRanges | None = None
 
     @property
     def tables(self) -> tuple:
@@ -118,6 +123,8 @@ def chunk_spec(cfg: Config, setup: SimSetup | None = None, points=None) -> Chunk
                                     for name in cfg.campaign.transitions if is_sensor(name)
                                     for tr in [transition_of(name)]},
                      resets_kept=cfg.campaign.resets_kept(),
+                     kind_ranges=kind_ranges(cfg, setup, fault_ranges(
+                         cfg.draws, plant.u_lower, plant.u_upper).lock),
                      record=cfg.campaign.record == "signals" and points is None)
 
 
@@ -127,9 +134,10 @@ def trial_inputs(spec: ChunkSpec, tr_name: str, trial_ids):
     Returns
     -------
     inp : TrialInputs
-    values : ndarray, shape (L,)
+    values : ndarray, shape (L,) or (L, 2)
         The fault value of each trial (lock position or b1; for a sensor
-        transition the sensor fault's size, NaN when stuck).
+        transition the sensor fault's size, NaN when stuck; for a fault kind
+        its two parameters, ``ftc_mc/campaign/kinds.py``).
     """
     tr = transition_of(tr_name)
     setup = spec.setup
@@ -140,6 +148,15 @@ def trial_inputs(spec: ChunkSpec, tr_name: str, trial_ids):
                                setup.tim.k_fault)
         return (build_inputs(setup, tr.schedule(draws.fault, setup.tim.k_fault), draws,
                              sensor), sizes)
+    if isinstance(tr, KindTransition):
+        # the main stream's first draw as a flight's (ignored): the same noise
+        # and gusts as every other row; the kind's parameters from its own stream
+        draws = draw_lanes(setup, trial_ids, spec.seed, FLIGHT_FAULT_RANGE)
+        lanes = kind_draws(tr, trial_ids, spec.seed, spec.kind_ranges, setup.tim.k_fault,
+                           setup.tim.n_steps)
+        values = np.array([lane[3] for lane in lanes], dtype=float).reshape(-1, 2)
+        return (build_inputs(setup, kind_schedule(tr, lanes, setup.tim.k_fault,
+                                                  setup.plant.dt), draws), values)
     draws = draw_lanes(setup, trial_ids, spec.seed, spec.ranges.of(tr))
     return build_inputs(setup, tr.schedule(draws.fault, setup.tim.k_fault), draws), draws.fault
 
@@ -181,8 +198,9 @@ def classify(spec: ChunkSpec, tr_name: str, variant: str, trial_ids, values,
     tr_name : str
     variant : str
     trial_ids : ndarray, shape (L,)
-    values : ndarray, shape (L,)
-        The trials' fault values (lock position or ``b1``).
+    values : ndarray, shape (L,) or (L, 2)
+        The trials' fault values (lock position or ``b1``; a fault kind's two
+        parameters, ``ftc_mc/campaign/kinds.py``'s ``PARAM_COLUMNS``).
     inp : TrialInputs
     rec : TrialRecord
 
@@ -218,7 +236,10 @@ def classify(spec: ChunkSpec, tr_name: str, variant: str, trial_ids, values,
     beta = setup.beta[0 if a == ENGINE else 1]  # (engine, elevon)
     near = spec.near_trim[0 if a == ENGINE else 1]
     is_lock = tr.kind == "lock"
-    small_b1 = np.zeros(L, dtype=bool) if is_lock else values < beta
+    is_loss = tr.kind == "loss"
+    kind_values = values if values.ndim == 2 else None  # a fault kind's two parameters
+    values = values[:, 0] if kind_values is not None else values
+    small_b1 = values < beta if is_loss else np.zeros(L, dtype=bool)
     near_trim = np.abs(values - u0) < near if is_lock else np.zeros(L, dtype=bool)
     truncated = rec.n_resets > R
     # A trial is judged when it stayed valid through the whole window: numerical
@@ -234,7 +255,7 @@ def classify(spec: ChunkSpec, tr_name: str, variant: str, trial_ids, values,
         "trial_id": np.asarray(trial_ids, dtype=np.int64),
         "lock_position": values if is_lock else np.full(L, np.nan),
         "lock_offset": values - u0 if is_lock else np.full(L, np.nan),
-        "loss_b1": np.full(L, np.nan) if is_lock else values,
+        "loss_b1": values if is_loss else np.full(L, np.nan),
         "mode_pre": np.array([MODE_NAMES[m] for m in inp.mode_pre], dtype=object),
         "mode_post": np.array([MODE_NAMES[m] for m in inp.mode_post], dtype=object),
         "correct": correct,
@@ -262,6 +283,10 @@ def classify(spec: ChunkSpec, tr_name: str, variant: str, trial_ids, values,
         "correct_side": correct_side(tr, inp.mode_post, rec.belief, judged & ~truncated,
                                      kf + window_steps, setup.tim.reconf_every),
     }
+    if kind_values is not None:  # a fault kind: its name and parameters (kinds.PARAM_COLUMNS)
+        trials["fault_kind"] = np.full(L, tr.kind, dtype=object)
+        trials["fault_param"] = kind_values[:, 0].copy()
+        trials["fault_param2"] = kind_values[:, 1].copy()
     if rec.mon_b.shape[0]:  # the 6-DOF side monitor flew beside the design
         trials.update(side_columns(rec, a, tr.onset, kf, window_steps, dt))
     return trials, resets
@@ -687,8 +712,13 @@ def _signals(spec: ChunkSpec, name: str, runs, trial_ids, inp, recs) -> pd.DataF
     (:func:`ftc_mc.campaign.signals.signals_frame`)."""
     from .signals import signals_frame
     tim = spec.setup.tim
+    kind = None
+    if isinstance(tr := TRANSITION_TABLE.get(name), KindTransition):
+        neutral = neutral_params(1, 1)[0, :, :1]  # (N_FAULT_PARAM, 1, 1)
+        acting = (np.asarray(inp.b1) != 0) | np.any(np.asarray(inp.fp) != neutral, axis=1)
+        kind = np.where(acting, tr.kind_code, KIND_NONE)
     df = pd.concat([signals_frame(name, v, trial_ids, inp, rec, tim.k_fault,
-                                  tim.reconf_every)
+                                  tim.reconf_every, kind)
                     for (_, _, v, _), rec in zip(runs, recs)], ignore_index=True)
     df["variant"] = pd.Categorical(df["variant"], categories=[r[2] for r in runs])
     return df

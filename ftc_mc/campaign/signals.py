@@ -36,6 +36,7 @@ import pandas as pd
 from ..conventions import LONGITUDINAL as LAY
 from ..conventions import MODE_NAMES
 from ..core.longitudinal.workspace import EXC_3211, EXC_DOUBLET
+from ..sim.inputs import Schedule, schedule_kinds
 
 FOLDER = "signals"
 """The folder of a run's recorded signals, beside ``trials.parquet``."""
@@ -49,10 +50,15 @@ def innovation_names() -> tuple:
     return tuple("innov_" + r.partition("_")[2] for r in LAY.residuals)
 
 
+KIND_COLUMNS = tuple(f"kind_{a}" for a in LAY.actuators)
+"""The truth's fault kind of each actuator during the step: its code in
+:data:`~ftc_mc.conventions.ACTUATOR_FAULT_KINDS`, ``-1`` while the actuator
+is healthy (an intermittent fault's off-spells included)."""
+
 TRUTH_COLUMNS = (("mode",) + tuple(f"b0_{a}" for a in LAY.actuators)
-                 + tuple(f"b1_{a}" for a in LAY.actuators))
+                 + tuple(f"b1_{a}" for a in LAY.actuators) + KIND_COLUMNS)
 """The signal columns that hold the truth, not what the aircraft sees: the true
-mode and each actuator's ``b0``, ``b1``.  A detector scored by ``ftc-mc score``
+mode, each actuator's ``b0``, ``b1`` and fault kind.  A detector scored by ``ftc-mc score``
 reads them only when it names them (:mod:`ftc_mc.campaign.detector`); every
 other signal column is observable on board."""
 
@@ -81,7 +87,7 @@ def _rows(a: np.ndarray, keep: np.ndarray) -> np.ndarray:
 
 
 def signals_frame(tr_name: str, variant: str, trial_ids, inp, rec, k_fault: int,
-                  every: int) -> pd.DataFrame:
+                  every: int, kind=None) -> pd.DataFrame:
     """The signals rows of one design's record of a chunk.
 
     Parameters
@@ -97,6 +103,9 @@ def signals_frame(tr_name: str, variant: str, trial_ids, inp, rec, k_fault: int,
         Step of the switch to the final mode.
     every : int
         Steps per reconfiguration period.
+    kind : ndarray of int, shape (E, 3, L), optional
+        The schedule's fault kind per entry and actuator (``Schedule.kind``);
+        omitted: lock or loss as ``b1`` says (:func:`ftc_mc.sim.inputs.schedule_kinds`).
 
     Returns
     -------
@@ -131,6 +140,10 @@ def signals_frame(tr_name: str, variant: str, trial_ids, inp, rec, k_fault: int,
     for name, arr in (("b0", inp.b0), ("b1", inp.b1)):
         for a, act in enumerate(LAY.actuators):
             cols[f"{name}_{act}"] = np.asarray(arr)[e, a, lane].astype(f4)
+    kinds = (schedule_kinds(Schedule(inp.k_switch, inp.b0, inp.b1)) if kind is None
+             else np.asarray(kind))
+    for a, nm in enumerate(KIND_COLUMNS):
+        cols[nm] = kinds[e, a, lane].astype(np.int8)
     exc = _rows(rec.hist_exc, keep)
     cols["exc_doublet"] = exc[:, EXC_DOUBLET].astype(f4)
     cols["exc_3211"] = exc[:, EXC_3211].astype(f4)

@@ -20,8 +20,9 @@ from ..config.schema import parse_sensor_transition
 from ..conventions import (ACTUATOR_NAMES, LONGITUDINAL, MODE_LEFT_ELEVON, MODE_NAMES,
                            MODE_RIGHT_ELEVON, OUTPUT_NAMES, PAPER_TRANSITIONS,
                            RESET_ELEVONS, RESET_THRUST, SENSOR_FAULT_KINDS, SENSOR_PREFIX,
-                           TRANSITIONS)
+                           KIND_TRANSITIONS, TRANSITIONS)
 from ..sim.inputs import Schedule
+from .kinds import KindTransition, is_kind, kind_transition  # noqa: F401
 
 ENGINE, LEFT, RIGHT = (ACTUATOR_NAMES.index(n) for n in ("engine", "left_elevon",
                                                          "right_elevon"))
@@ -130,9 +131,12 @@ TRANSITION_TABLE.update(
     (f"right_{t.name}", dataclasses.replace(t, name=f"right_{t.name}", actuator=RIGHT,
                                             label=t.label.replace("Elevon", "Right elevon")))
     for t in list(TRANSITION_TABLE.values()) if t.actuator == LEFT)
+# the fault kinds beyond lock and loss, onsets on each actuator (ftc_mc/campaign/kinds.py)
+TRANSITION_TABLE.update((name, kind_transition(name)) for name in KIND_TRANSITIONS)
 """Every actuator transition by name, the paper's eight rows first (their order in
-tables), then the right elevon's (:data:`~ftc_mc.conventions.TRANSITIONS`)."""
-assert tuple(TRANSITION_TABLE) == TRANSITIONS
+tables), then the right elevon's (:data:`~ftc_mc.conventions.TRANSITIONS`), then the
+fault kinds' (:data:`~ftc_mc.conventions.KIND_TRANSITIONS`, :class:`KindTransition`)."""
+assert tuple(TRANSITION_TABLE) == TRANSITIONS + KIND_TRANSITIONS
 
 PAPER_TABLES = {
     # name: (simulations, inappropriate resets, no reset) -- paper Tables 2 and 3
@@ -251,7 +255,8 @@ class SensorTransition:
 
 
 def transition_of(name: str):
-    """The :class:`Transition` or :class:`SensorTransition` named ``name`` (validated)."""
+    """The :class:`Transition`, :class:`KindTransition` or :class:`SensorTransition`
+    named ``name`` (validated)."""
     if name in TRANSITION_TABLE:
         return TRANSITION_TABLE[name]
     kind, output = parse_sensor_transition(name)

@@ -22,7 +22,8 @@ from typing import Annotated, Literal
 from pydantic import (AfterValidator, BaseModel, BeforeValidator, ConfigDict, Field,
                       field_validator, model_validator)
 
-from ..conventions import (ACTUATOR_NAMES, BIASED_OUTPUTS, EXCITATION_POLICIES, OUTPUT_NAMES,
+from ..conventions import (ACTUATOR_NAMES, BIASED_OUTPUTS, EXCITATION_POLICIES,
+                           KIND_TRANSITIONS, KINDS_BEYOND, MAX_DELAY_STEPS, OUTPUT_NAMES,
                            PLANT_KINDS, S3211_UNITS, SENSOR_FAULT_KINDS, SENSOR_PREFIX,
                            STATE_NAMES, TRANSITIONS, TURBULENCE_LEVELS)
 from ..errors import UserError
@@ -369,6 +370,60 @@ class DrawsConfig(_Strict):
         return self
 
 
+PosRange = tuple[Pos, Pos]
+
+
+class KindDrawsConfig(_Strict):
+    """Per-trial draws of the fault kinds beyond lock and loss (the
+    ``<actuator>_<kind>`` transitions; docs/guides/fault-kinds.md gives each
+    range's source).  Every value is uniform over its ``[low, high]``; a sign
+    drawn with equal odds where a field says so."""
+
+    elevon_rate_limit_deg_s: PosRange = (5.0, 30.0)
+    """slow: the elevon's rate limit [deg/s] (nominal servo: 200 deg/s)."""
+    engine_rate_limit_per_s: PosRange = (0.05, 0.3)
+    """slow: the throttle's rate limit [1/s] (nominal: about 3 per s from its 0.3 s lag)."""
+    delay_s: PosRange = (0.2, 1.0)
+    """delayed: the transport delay [s], rounded to whole control periods."""
+    elevon_osc_amp_deg: PosRange = (1.0, 5.0)
+    """oscillatory: the elevon's limit-cycle amplitude [deg]."""
+    engine_osc_amp: PosRange = (0.05, 0.2)
+    """oscillatory: the throttle's limit-cycle amplitude [-]."""
+    osc_freq_hz: PosRange = (0.2, 2.0)
+    """oscillatory: the limit cycle's frequency [Hz] (below the Nyquist frequency of the control period); its phase is uniform."""
+    elevon_runaway_deg_s: PosRange = (0.5, 5.0)
+    """runaway: the elevon's drift rate from its command [deg/s], either sign."""
+    engine_runaway_per_s: PosRange = (0.01, 0.05)
+    """runaway: the throttle's drift rate [1/s], either sign."""
+    float_gain: tuple[Annotated[float, NoBool, Field(ge=-2, le=0)],
+                      Annotated[float, NoBool, Field(ge=-2, le=0)]] = (-1.0, -0.3)
+    """float: the floating angle's gain on the angle of attack, -C_h_alpha / C_h_delta [rad/rad]."""
+    float_angle_deg: tuple[Finite, Finite] = (-2.0, 2.0)
+    """float: the floating angle at zero angle of attack, -C_h_0 / C_h_delta [deg]."""
+    intermittent_on_s: PosRange = (0.5, 3.0)
+    """intermittent: how long each stuck spell lasts [s] (whole multiples of the 0.5 s grid)."""
+    intermittent_off_s: PosRange = (0.5, 3.0)
+    """intermittent: how long the actuator works between spells [s] (same grid)."""
+
+    @model_validator(mode="after")
+    def _ordered(self):
+        for name in type(self).model_fields:
+            lo, hi = getattr(self, name)
+            if not lo < hi:
+                raise ValueError(f"{name}: must be [low, high] with low < high, "
+                                 f"got {[lo, hi]}")
+        for name in ("intermittent_on_s", "intermittent_off_s"):
+            if getattr(self, name)[0] < INTERMITTENT_GRID_S:
+                raise ValueError(f"{name}: spells last at least the {INTERMITTENT_GRID_S:g} s "
+                                 f"grid, got {list(getattr(self, name))}")
+        return self
+
+
+INTERMITTENT_GRID_S = 0.5
+"""Grid of an intermittent fault's spells [s]: the switch steps of a schedule are
+shared by a chunk's lanes, so each lane's spells start and end on it."""
+
+
 class TimingConfig(_Strict):
     """Trial timing: the switch at fault_time_s, judged over the window after it."""
 
@@ -539,9 +594,11 @@ def parse_sensor_transition(name: str):
 
 
 def _transition_name(name: str) -> str:
-    if name in TRANSITIONS or parse_sensor_transition(name) is not None:
+    if name in TRANSITIONS or name in KIND_TRANSITIONS or parse_sensor_transition(name) is not None:
         return name
-    raise ValueError(f"unknown transition {name!r}: one of {list(TRANSITIONS)} or "
+    raise ValueError(f"unknown transition {name!r}: one of {list(TRANSITIONS)}, a fault "
+                     f"kind <elevon|right_elevon|engine>_<kind> (kinds {list(KINDS_BEYOND)}; "
+                     "float on the elevons only) or "
                      f"sensor_<kind>:<output> (kinds {list(SENSOR_FAULT_KINDS)})")
 
 
@@ -848,6 +905,7 @@ class Config(_Sampled):
     validity: ValidityConfig = Field(default_factory=ValidityConfig)
     monitor: MonitorConfig = Field(default_factory=MonitorConfig)
     sensor_draws: SensorDrawsConfig = Field(default_factory=SensorDrawsConfig)
+    kind_draws: KindDrawsConfig = Field(default_factory=KindDrawsConfig)
     designs: Designs = Field(default_factory=dict)
     """Detection designs compared on the same trials: name -> design; run them with campaign.designs or --design NAME."""
 
@@ -879,6 +937,16 @@ class Config(_Sampled):
             if r is not None and (r[0] < lower[a] or r[1] > upper[a]):
                 raise ValueError(f"draws.{name}: must lie within the {actuator} command "
                                  f"range [{lower[a]:g}, {upper[a]:g}], got {list(r)}")
+        kd = self.kind_draws
+        if kd.delay_s[1] > MAX_DELAY_STEPS * dt + 1e-12:
+            raise ValueError(f"kind_draws.delay_s: at most {MAX_DELAY_STEPS} control periods "
+                             f"({MAX_DELAY_STEPS * dt:g} s), got {list(kd.delay_s)}")
+        if round(kd.delay_s[0] / dt) < 1:
+            raise ValueError(f"kind_draws.delay_s: at least one control period ({dt:g} s), "
+                             f"got {list(kd.delay_s)}")
+        if kd.osc_freq_hz[1] >= 0.5 / dt:
+            raise ValueError(f"kind_draws.osc_freq_hz: below the Nyquist frequency "
+                             f"{0.5 / dt:g} Hz of the control period, got {list(kd.osc_freq_hz)}")
         for i, name in enumerate(self.campaign.transitions):
             sensor = parse_sensor_transition(name)
             if sensor and sensor[0] == "noise" and self.noise.measurement_scale == 0:
@@ -893,19 +961,52 @@ class Config(_Sampled):
         return self.steps(self.timing.duration_s) if m is None else m
 
 
+SCENARIO_KINDS = tuple(k for k in KINDS_BEYOND if k != "intermittent")
+"""Fault kinds a scenario entry may name besides nominal, lock and loss (an
+intermittent fault is a list of entries with durations)."""
+KIND_FIELDS = {"lock": ("position",), "loss": ("b1",), "hardover": ("side",),
+               "float": ("float_angle", "float_gain"), "slow": ("rate_limit",),
+               "delayed": ("delay_s",),
+               "oscillatory": ("amplitude", "frequency_hz", "phase_rad"),
+               "runaway": ("rate",), "nominal": ()}
+"""The parameters each fault of a scenario entry takes (all of them, no others)."""
+
+
 class FaultEvent(_Strict):
-    """One entry of a scenario's fault schedule."""
+    """One entry of a scenario's fault schedule: from ``time_s`` on (for
+    ``duration_s`` if given, RflyMAD's start and duration), one actuator's fault
+    with its parameters (docs/guides/fault-kinds.md)."""
 
     time_s: NonNeg
     """Time from which this entry holds [s]."""
-    fault: Literal["nominal", "lock", "loss"]
-    """``nominal`` (every actuator healthy), ``lock`` or ``loss`` (of effectiveness)."""
+    fault: Literal[("nominal", "lock", "loss") + SCENARIO_KINDS]
+    """``nominal`` (all healthy), ``lock``, ``loss`` (of effectiveness) or a kind: hardover, float (elevons), slow, delayed, oscillatory, runaway."""
     actuator: Literal[ACTUATOR_NAMES] | None = None
     """Faulty actuator (``engine``, ``left_elevon``, ``right_elevon``); not for nominal."""
+    duration_s: Pos | None = None
+    """How long the fault acts [s]; then every actuator is healthy until the next entry (null: until the next entry)."""
     position: Finite | Literal["trim"] | None = None
     """Lock position (absolute command: throttle [-] or elevon [rad]) or ``trim``."""
     b1: Annotated[float, NoBool, Field(ge=0, le=1, allow_inf_nan=False)] | None = None
     """Effectiveness loss of a ``loss`` fault (0 healthy, 1 no effect)."""
+    side: Literal["upper", "lower"] | None = None
+    """hardover: the travel limit the actuator locks at."""
+    float_angle: Finite | None = None
+    """float: the floating angle at zero angle of attack [rad]."""
+    float_gain: Annotated[float, NoBool, Field(ge=-2, le=0, allow_inf_nan=False)] | None = None
+    """float: the floating angle's gain on the angle of attack [rad/rad]."""
+    rate_limit: Pos | None = None
+    """slow: the rate limit [command unit/s]."""
+    delay_s: Pos | None = None
+    """delayed: the transport delay [s] (whole control periods, at most 20)."""
+    amplitude: Pos | None = None
+    """oscillatory: the limit cycle's amplitude [command unit]."""
+    frequency_hz: Pos | None = None
+    """oscillatory: its frequency [Hz]."""
+    phase_rad: Finite | None = None
+    """oscillatory: its phase at the entry's start [rad]."""
+    rate: Finite | None = None
+    """runaway: the drift rate from the command [command unit/s], either sign."""
 
     @model_validator(mode="after")
     def _fields(self):
@@ -919,7 +1020,37 @@ class FaultEvent(_Strict):
                              "and no b1")
         elif self.fault == "loss" and (self.b1 is None or self.position is not None):
             raise ValueError("b1: a loss entry needs b1 in [0, 1] and no position")
+        if self.fault == "float" and self.actuator == "engine":
+            raise ValueError("actuator: a float entry is an elevon's (a throttle cannot float)")
+        wanted = KIND_FIELDS[self.fault]
+        for name in sorted({f for fs in KIND_FIELDS.values() for f in fs}):
+            given = getattr(self, name) is not None
+            if name in wanted and not given:
+                raise ValueError(f"{name}: a {self.fault} entry needs it")
+            if given and name not in wanted:
+                raise ValueError(f"{name}: a {self.fault} entry takes no {name}")
+        if self.fault == "nominal" and self.duration_s is not None:
+            raise ValueError("duration_s: a nominal entry takes no duration")
         return self
+
+
+def expanded_schedule(spec) -> list:
+    """A scenario's schedule with each duration written out: an entry with
+    ``duration_s`` is followed by a nominal entry at its end, unless the next
+    entry starts then (the result has no durations; a schedule without any
+    is returned as it is)."""
+    events = list(spec.schedule)
+    if all(e.duration_s is None for e in events):
+        return events
+    out = []
+    for i, e in enumerate(events):
+        out.append(e.model_copy(update={"duration_s": None}))
+        if e.duration_s is not None:
+            end = e.time_s + e.duration_s
+            nxt = events[i + 1].time_s if i + 1 < len(events) else spec.duration_s
+            if end < nxt - 1e-9:
+                out.append(FaultEvent(time_s=end, fault="nominal"))
+    return out
 
 
 class SensorFaultEvent(_Strict):
@@ -985,6 +1116,11 @@ class ScenarioSpec(_Strict):
         if times[-1] >= self.duration_s:
             raise ValueError(f"schedule: entry at {times[-1]:g} s is not before the end "
                              f"of the run ({self.duration_s:g} s)")
+        for i, e in enumerate(self.schedule):
+            if e.duration_s is not None and i + 1 < len(times) \
+                    and e.time_s + e.duration_s > times[i + 1] + 1e-9:
+                raise ValueError(f"schedule.{i}.duration_s: the fault would outlast the next "
+                                 f"entry at {times[i + 1]:g} s")
         return self
 
 
@@ -1026,10 +1162,19 @@ class ScenarioConfig(_Sampled):
                                      f"outside the {e.actuator} command range "
                                      f"[{lower[a]:g}, {upper[a]:g}]")
         for i, e in enumerate(sc.schedule):
-            n = e.time_s / dt
-            if not math.isfinite(n) or abs(n - round(n)) > 1e-9 * max(1.0, n):
-                raise ValueError(f"scenario.schedule.{i}.time_s: must be a multiple of "
-                                 f"model.dt_s ({dt:g} s), got {e.time_s:g}")
+            for name in ("time_s", "duration_s", "delay_s"):
+                v = getattr(e, name)
+                n = math.nan if v is None else v / dt
+                if v is not None and (not math.isfinite(n)
+                                      or abs(n - round(n)) > 1e-9 * max(1.0, n)):
+                    raise ValueError(f"scenario.schedule.{i}.{name}: must be a multiple of "
+                                     f"model.dt_s ({dt:g} s), got {v:g}")
+            if e.delay_s is not None and round(e.delay_s / dt) > MAX_DELAY_STEPS:
+                raise ValueError(f"scenario.schedule.{i}.delay_s: at most {MAX_DELAY_STEPS} "
+                                 f"control periods, got {e.delay_s:g} s")
+            if e.frequency_hz is not None and e.frequency_hz >= 0.5 / dt:
+                raise ValueError(f"scenario.schedule.{i}.frequency_hz: below the Nyquist "
+                                 f"frequency {0.5 / dt:g} Hz, got {e.frequency_hz:g}")
         sf = sc.sensor_fault
         if sf is not None:
             n = sf.time_s / dt

@@ -18,14 +18,14 @@ import math
 import numpy as np
 import pandas as pd
 
-from ..config.schema import ScenarioConfig
+from ..config.schema import KIND_FIELDS, ScenarioConfig, expanded_schedule
 from ..conventions import LONGITUDINAL, MODE_NAMES, STATUS_NAMES
 from ..core.longitudinal.trial import advance
 from ..core.longitudinal.workspace import EXC_3211, EXC_3211_START, EXC_DOUBLET, EXC_DOUBLET_START
 from ..model.faults import estimator_params, mode_of
 from ..sim.compiling import compiled_once
 from ..sim.paths import path_of
-from ..sim.inputs import scenario_inputs
+from ..sim.inputs import entry_modes, scenario_inputs, scenario_schedule
 from ..sim.lanes import HISTORY_RESETS, run_alone
 from ..sim.setup import SimSetup, build_setup, controller_names, runs_of
 from ..paper import PAPER_TIMELINE
@@ -86,7 +86,9 @@ def run_scenario(sc: ScenarioConfig, seed: int | None = None,
     with compiled_once(advance, path_of(setup.scheme(name), setup.flight)):
         rec = run_alone(setup, name, setup.det[name], inp, HISTORY_RESETS, history=True)
     k_sw, b0, b1 = inp.k_switch, inp.b0[:, :, 0], inp.b1[:, :, 0]
-    modes = np.array([int(mode_of(b, *setup.beta)) for b in b1], dtype=np.int64)
+    sched = scenario_schedule(expanded_schedule(sc.scenario), setup.plant.u0, setup.plant.dt,
+                              setup.plant.u_lower, setup.plant.u_upper)
+    modes = entry_modes(sched, setup.beta)[:, 0]
     ts = _timeseries(setup, sc, rec, k_sw, b0, b1)
     events = _events(ts, sc, rec, setup)
     segments = _segments(ts, sc, modes, setup)
@@ -172,10 +174,12 @@ def _timeseries(setup, sc, rec, k_sw, b0, b1) -> pd.DataFrame:
 def _events(ts: pd.DataFrame, sc: ScenarioConfig, rec, setup) -> pd.DataFrame:
     rows = []
     dt = setup.plant.dt  # a signal applied during step k is logged at (k + 1) dt
-    for e in sc.scenario.schedule:
+    for e in expanded_schedule(sc.scenario):
+        params = ", ".join(f"{f}={getattr(e, f)}" for f in KIND_FIELDS[e.fault])
         what = ("nominal" if e.fault == "nominal" else
                 f"{e.actuator} {e.fault} " + (f"at {e.position}" if e.fault == "lock"
-                                               else f"b1={e.b1:g}"))
+                                               else f"b1={e.b1:g}" if e.fault == "loss"
+                                               else params))
         rows.append((e.time_s, "fault_switch", what))
     sf = sc.scenario.sensor_fault
     if sf is not None:
@@ -213,7 +217,7 @@ def _segments(ts: pd.DataFrame, sc: ScenarioConfig, modes, setup) -> pd.DataFram
     """Detection delay and tracking per schedule entry."""
     dt = setup.plant.dt
     p_det = sc.scenario.detection_probability
-    entries = sc.scenario.schedule
+    entries = expanded_schedule(sc.scenario)
     t = ts.time_s.to_numpy()
     bel = np.stack([ts[f"belief_{m}"].to_numpy() for m in MODE_NAMES], axis=1)
     rows = []

@@ -43,8 +43,11 @@ from collections import namedtuple
 
 import numpy as np
 
-from ..conventions import (ACTUATOR_NAMES, LONGITUDINAL, NO_SENSOR_FAULT, OUTPUT_NAMES,
-                           SENSOR_FAULT_KINDS)
+from ..conventions import (ACTUATOR_FAULT_KINDS, ACTUATOR_NAMES, FAULT_PARAM_NEUTRAL,
+                           FP_DELAY, FP_FLOAT, FP_FLOAT_ANGLE, FP_FLOAT_GAIN, FP_OSC_AMP,
+                           FP_OSC_FREQ, FP_OSC_PHASE, FP_RATE, FP_RUNAWAY, KIND_NONE,
+                           LONGITUDINAL, MODE_NAMES, N_FAULT_PARAM, N_U, NO_SENSOR_FAULT,
+                           OUTPUT_NAMES, SENSOR_FAULT_KINDS)
 from ..core.longitudinal.settings import TrialInputs
 from ..model.faults import estimator_params, mode_of
 
@@ -52,7 +55,12 @@ Schedule = namedtuple("Schedule", [
     "k_switch",  # (E,) int64 step from which each entry holds, k_switch[0] == 0
     "b0",        # (E, 3, L) per-actuator truth b0 of each entry (absolute lock position)
     "b1",        # (E, 3, L) per-actuator truth b1 of each entry
-])
+    "fp",        # (E, N_FAULT_PARAM, 3, L) the fault model's other parameters, or None:
+                 #   neutral (conventions.FAULT_PARAM_NEUTRAL) throughout
+    "kind",      # (E, 3, L) int64 conventions.ACTUATOR_FAULT_KINDS code of each
+                 #   actuator's fault, KIND_NONE when healthy; or None: from b0, b1
+    "mode",      # (E, L) int64 truth mode of each entry, or None: the box that holds b1
+], defaults=(None, None, None))
 """Per-lane fault schedule: the truth in force from each switch step on."""
 
 LaneDraws = namedtuple("LaneDraws", [
@@ -207,8 +215,32 @@ def draw_lanes(setup, trial_ids, seed: int, fault_range=None) -> LaneDraws:
 
 
 def entry_modes(schedule: Schedule, beta) -> np.ndarray:
-    """Mode of every schedule entry and lane, shape (E, L) (:func:`mode_of`)."""
+    """Mode of every schedule entry and lane, shape (E, L): the schedule's own
+    ``mode`` when it has one, else the box that holds its ``b1`` (:func:`mode_of`)."""
+    if schedule.mode is not None:
+        return np.asarray(schedule.mode, dtype=np.int64)
     return np.stack([mode_of(b1, *beta) for b1 in schedule.b1])
+
+
+def neutral_params(E: int, L: int) -> np.ndarray:
+    """The fault model's parameters of ``E`` entries of ``L`` lanes with every
+    actuator following eq. (2) alone (:data:`FAULT_PARAM_NEUTRAL`), shape
+    (E, N_FAULT_PARAM, 3, L)."""
+    fp = np.empty((E, N_FAULT_PARAM, N_U, L))
+    fp[:] = np.asarray(FAULT_PARAM_NEUTRAL)[None, :, None, None]
+    return fp
+
+
+def schedule_kinds(schedule: Schedule) -> np.ndarray:
+    """Kind code of every entry, actuator and lane, shape (E, 3, L): the
+    schedule's own ``kind``, else ``lock`` where ``b1 = 1``, ``loss`` where
+    ``0 < b1 < 1`` and :data:`KIND_NONE` where healthy."""
+    if schedule.kind is not None:
+        return np.asarray(schedule.kind, dtype=np.int64)
+    b1 = np.asarray(schedule.b1)
+    return np.where(b1 >= 1.0, ACTUATOR_FAULT_KINDS.index("lock"),
+                    np.where(b1 > 0.0, ACTUATOR_FAULT_KINDS.index("loss"),
+                             KIND_NONE)).astype(np.int64)
 
 
 def build_inputs(setup, schedule: Schedule, draws: LaneDraws,
@@ -232,6 +264,8 @@ def build_inputs(setup, schedule: Schedule, draws: LaneDraws,
     """
     E, _, L = schedule.b0.shape
     assert schedule.k_switch.shape == (E,) and schedule.k_switch[0] == 0
+    fp = neutral_params(E, L) if schedule.fp is None else schedule.fp
+    assert fp.shape == (E, N_FAULT_PARAM, N_U, L)
     assert draws.w.shape[2] == L
     modes = entry_modes(schedule, setup.beta)
     xa0 = np.zeros((LONGITUDINAL.n_aug, L))
@@ -242,7 +276,7 @@ def build_inputs(setup, schedule: Schedule, draws: LaneDraws,
                        P0=setup.P0, w=draws.w, v=draws.v, eta=draws.eta, g0=draws.g0,
                        sensor_out=sensor.out, sensor_kind=sensor.kind,
                        sensor_size=sensor.size, sensor_k=sensor.k, v_lat=draws.v_lat,
-                       eta_lat=draws.eta_lat, g0_lat=draws.g0_lat)
+                       eta_lat=draws.eta_lat, g0_lat=draws.g0_lat, fp=fp)
 
 
 def design_inputs(inp: TrialInputs, design) -> TrialInputs:
@@ -300,31 +334,68 @@ def flight_inputs(setup, trial_ids, seed: int) -> TrialInputs:
                         draw_lanes(setup, trial_ids, seed, FLIGHT_FAULT_RANGE))
 
 
-def scenario_schedule(events, u0: np.ndarray, dt: float) -> Schedule:
+def scenario_schedule(events, u0: np.ndarray, dt: float, u_lower=None,
+                      u_upper=None) -> Schedule:
     """The schedule of a scenario (one lane).
 
     Parameters
     ----------
     events : list of FaultEvent
-        A validated ``scenario.schedule``.
+        A validated ``scenario.schedule`` with its durations written out
+        (:func:`ftc_mc.config.schema.expanded_schedule`).
     u0 : ndarray, shape (3,)
         Trim commands: the position of a lock ``at trim``.
     dt : float
         Control period [s].
+    u_lower, u_upper : ndarray, shape (3,), optional
+        Absolute travel limits: where a hard-over locks (needed only by one).
+
+    Returns
+    -------
+    Schedule
+        With the fault model's parameters, kinds and truth modes of each entry
+        when an entry names a kind beyond lock and loss (a kind's truth mode is
+        its actuator's); otherwise those of eq. (2) alone, as before.
     """
     k = np.array([int(round(e.time_s / dt)) for e in events], dtype=np.int64)
-    b0 = np.zeros((len(events), 3, 1))
-    b1 = np.zeros((len(events), 3, 1))
+    E = len(events)
+    b0 = np.zeros((E, 3, 1))
+    b1 = np.zeros((E, 3, 1))
+    beyond = any(e.fault not in ("nominal", "lock", "loss") for e in events)
+    fp = neutral_params(E, 1)
+    kind = np.full((E, 3, 1), KIND_NONE, dtype=np.int64)
+    mode = np.zeros((E, 1), dtype=np.int64)
     for i, e in enumerate(events):
         if e.fault == "nominal":
             continue
         a = ACTUATOR_NAMES.index(e.actuator)
+        kind[i, a, 0] = ACTUATOR_FAULT_KINDS.index(e.fault)
+        mode[i, 0] = MODE_NAMES.index(e.actuator)
         if e.fault == "lock":
             b1[i, a, 0] = 1.0
             b0[i, a, 0] = u0[a] if e.position == "trim" else float(e.position)
-        else:
+        elif e.fault == "loss":
             b1[i, a, 0] = e.b1
-    return Schedule(k_switch=k, b0=b0, b1=b1)
+        elif e.fault == "hardover":
+            b1[i, a, 0] = 1.0
+            b0[i, a, 0] = (u_upper if e.side == "upper" else u_lower)[a]
+        elif e.fault == "float":
+            fp[i, FP_FLOAT, a, 0] = 1.0
+            fp[i, FP_FLOAT_ANGLE, a, 0] = e.float_angle
+            fp[i, FP_FLOAT_GAIN, a, 0] = e.float_gain
+        elif e.fault == "slow":
+            fp[i, FP_RATE, a, 0] = e.rate_limit
+        elif e.fault == "delayed":
+            fp[i, FP_DELAY, a, 0] = round(e.delay_s / dt)
+        elif e.fault == "oscillatory":
+            fp[i, FP_OSC_AMP, a, 0] = e.amplitude
+            fp[i, FP_OSC_FREQ, a, 0] = e.frequency_hz
+            fp[i, FP_OSC_PHASE, a, 0] = e.phase_rad
+        elif e.fault == "runaway":
+            fp[i, FP_RUNAWAY, a, 0] = e.rate
+    if not beyond:
+        return Schedule(k_switch=k, b0=b0, b1=b1)
+    return Schedule(k_switch=k, b0=b0, b1=b1, fp=fp, kind=kind, mode=mode)
 
 
 def scenario_inputs(setup, spec) -> TrialInputs:
@@ -341,5 +412,8 @@ def scenario_inputs(setup, spec) -> TrialInputs:
     sensor = None if sf is None else sensor_faults(
         OUTPUT_NAMES.index(sf.output), SENSOR_FAULT_KINDS.index(sf.kind),
         [0.0 if sf.size is None else sf.size], int(round(sf.time_s / plant.dt)))
-    return build_inputs(setup, scenario_schedule(spec.schedule, plant.u0, plant.dt),
+    from ..config.schema import expanded_schedule
+
+    return build_inputs(setup, scenario_schedule(expanded_schedule(spec), plant.u0, plant.dt,
+                                                 plant.u_lower, plant.u_upper),
                         draw_lanes(setup, [0], spec.seed), sensor)

@@ -4,8 +4,11 @@ Stage 2 of :func:`ftc_mc.core.longitudinal.trial.advance`.  With the commands ``
 step (deviations from trim, ``TrialWork.u``):
 
 1. the fault schedule's entry in force at step ``k`` gives the truth ``b0``,
-   ``b1`` per actuator, and the actuators' effect is eq. (2)
-   ``e_k = b0 + (1 - b1) u_k - b1 u0`` (:func:`actuator_effect`);
+   ``b1`` and the other fault parameters ``fp`` per actuator; each actuator
+   follows its command through the generic fault model (delay, limit cycle,
+   runaway, float, rate limit) and the effect is eq. (2)
+   ``e_k = b0 + (1 - b1) c_k - b1 u0`` (:func:`actuator_effect`; ``c_k = u_k``
+   with neutral parameters);
 2. in turbulence the Dryden filter gives the gust ``g_k`` held over the step and
    advances (:func:`gust_lanes`, :mod:`ftc_mc.core.shared.dryden`);
 3. linear plant (the filter's model, eq. 1):
@@ -28,8 +31,12 @@ Plain-NumPy twins: ``tests/naive.py::truth_step_ref``, ``sensor_fault_ref``.
 
 from __future__ import annotations
 
-from ...conventions import (N_U, N_X, N_Z, OUT_ALPHA, OUT_VA, SENSOR_BIAS, SENSOR_DRIFT,
-                            SENSOR_NOISE, SENSOR_STUCK)
+import math
+
+from ...conventions import (FP_DELAY, FP_FLOAT, FP_FLOAT_ANGLE, FP_FLOAT_GAIN, FP_OSC_AMP,
+                            FP_OSC_FREQ, FP_OSC_PHASE, FP_RATE, FP_RUNAWAY, N_U, N_X, N_Z,
+                            OUT_ALPHA, OUT_VA, SENSOR_BIAS, SENSOR_DRIFT, SENSOR_NOISE,
+                            SENSOR_STUCK)
 from ..shared.dryden import N_GUST_OUT, N_GUST_STATE, gust_step
 from ..jit import kernel
 from .nonlinear import outputs_nb, propagate
@@ -59,28 +66,91 @@ def schedule_entry(k_switch, k):
     return ev
 
 
-@kernel(inline="always")
-def actuator_effect(u0, b0, b1, u, e):
-    """Effect of the actuators on every lane (eq. 2): ``e = b0 + (1 - b1) u - b1 u0``.
+@kernel(internal=True)
+def actuator_effect(u0, lo, hi, b0, b1, fp, k_on, k, dt, alpha, uhist, uprev, u, e):
+    """Effect of the actuators on every lane: the generic fault model, then eq. (2).
+
+    Each actuator ``i`` of lane ``l`` follows a command ``c`` (deviation from
+    trim) built from the commanded ``u`` by the parameters ``fp`` of the
+    schedule entry in force (``docs/guides/fault-kinds.md``):
+
+    1. transport delay of ``d = fp[FP_DELAY]`` steps: ``c = u_{k-d}`` (trim
+       before the first step), from the ring ``uhist``;
+    2. limit cycle and runaway, ``t = (k - k_on) dt`` the time since the
+       entry's start: ``c += A sin(2 pi f t + phi) + r t``;
+    3. float: ``c = (1 - w) c + w (delta_f0 + k_f alpha - u0)``, the
+       surface trailing at its floating angle, linear in the true angle of
+       attack ``alpha`` of the last sample;
+    4. steps 2-3 (when any of ``A``, ``r``, ``w`` is nonzero) stop at the
+       travel limits ``[lo, hi]``;
+    5. rate limit ``R = fp[FP_RATE]``: ``c`` moves at most ``R dt`` from the
+       last step's ``uprev``;
+    6. eq. (2): ``e = b0 + (1 - b1) c - b1 u0``.
+
+    With the neutral parameters (:data:`~ftc_mc.conventions.FAULT_PARAM_NEUTRAL`:
+    no delay, an infinite rate limit, every other term zero) ``c = u`` and the
+    arithmetic is eq. (2)'s, bit for bit.  A kernel of its own (not inlined):
+    compiled once for the truth of both plant families.
 
     Parameters
     ----------
     u0 : ndarray, shape (3,)
         Trim commands (absolute).
+    lo, hi : ndarray, shape (3,)
+        Travel limits as deviations from trim.
     b0, b1 : ndarray, shape (3, L)
         Truth fault parameters per actuator (``b0`` the absolute lock position
         when locked).
+    fp : ndarray, shape (N_FAULT_PARAM, 3, L)
+        The entry's other parameters (:data:`~ftc_mc.conventions.FAULT_PARAM_NAMES`).
+    k_on : int
+        Step at which the entry took over.
+    k : int
+        Step.
+    dt : float
+        Control period [s].
+    alpha : ndarray, shape (L,)
+        True angle of attack at the last sample [rad] (0 before the first step).
+    uhist : ndarray, shape (N_CMD_HIST, 3, L)
+        Command ring, written with ``u`` at slot ``k % N_CMD_HIST``.
+    uprev : ndarray, shape (3, L)
+        The command followed last step, overwritten with this step's.
     u : ndarray, shape (3, L)
         Command deviations from trim.
     e : ndarray, shape (3, L)
         Written with the effect (deviation from trim).
     """
     L = u.shape[1]
+    H = uhist.shape[0]
+    slot = k % H
+    t = (k - k_on) * dt
     for i in range(N_U):
         u0i = u0[i]
         for l in range(L):
+            c = u[i, l]
+            uhist[slot, i, l] = c
+            d = int(fp[FP_DELAY, i, l])
+            if d > 0:
+                c = uhist[(k - d) % H, i, l] if k >= d else 0.0
+            amp = fp[FP_OSC_AMP, i, l]
+            run = fp[FP_RUNAWAY, i, l]
+            wf = fp[FP_FLOAT, i, l]
+            if amp != 0.0 or run != 0.0 or wf != 0.0:
+                c += amp * math.sin(2.0 * math.pi * fp[FP_OSC_FREQ, i, l] * t
+                                    + fp[FP_OSC_PHASE, i, l]) + run * t
+                if wf != 0.0:
+                    fl = fp[FP_FLOAT_ANGLE, i, l] + fp[FP_FLOAT_GAIN, i, l] * alpha[l] - u0i
+                    c = (1.0 - wf) * c + wf * fl
+                c = min(hi[i], max(lo[i], c))
+            lim = fp[FP_RATE, i, l] * dt
+            p = uprev[i, l]
+            if c > p + lim:
+                c = p + lim
+            elif c < p - lim:
+                c = p - lim
+            uprev[i, l] = c
             b1il = b1[i, l]
-            e[i, l] = b0[i, l] + (1.0 - b1il) * u[i, l] - b1il * u0i
+            e[i, l] = b0[i, l] + (1.0 - b1il) * c - b1il * u0i
 
 
 @kernel(inline="always")
@@ -302,7 +372,7 @@ def plant_step(path, model, flight, w, v, x, work):
 
 
 @kernel(inline="always")
-def truth_step(path, model, flight, inp, k, st, work):
+def truth_step(path, model, ctl, flight, inp, k, st, work):
     """Stage 2: the truth plant over step ``k -> k+1`` on every lane (module docstring).
 
     Parameters
@@ -311,24 +381,29 @@ def truth_step(path, model, flight, inp, k, st, work):
         The compile path (``core/shared/paths.py``): its ``plant``.
     model : FilterModel
         The linear model (``A``, ``B``, ``C``) and the trim commands ``u0``.
+    ctl : Controller
+        ``lo_dev``, ``hi_dev``: the actuators' travel (command limits) from trim.
     flight : Flight
         ``plant`` (TruthPlant) and ``validity`` (trim air data).
     inp : TrialInputs
-        Fault schedule (``k_switch``, ``b0``, ``b1``), the noise and gust
+        Fault schedule (``k_switch``, ``b0``, ``b1``, ``fp``), the noise and gust
         draws of step ``k`` and the lanes' sensor faults.
     k : int
         Step.
     st : LaneState
         ``x`` (true state, deviation from trim) and ``gust`` (gust filter
         states; untouched in still air) advanced in place; ``zhold`` (the last
-        healthy value of a faulty output) kept up to the onset.
+        healthy value of a faulty output) kept up to the onset; ``uhist``,
+        ``uprev`` (the actuators' command ring and last command) advanced.
     work : TrialWork
         Reads ``u``; writes ``e``, ``wind``, ``wind_next``, ``z``, ``va``,
         ``alpha`` (and ``x_next`` on the linear plant).
     """
     pl = flight.plant
     ev = schedule_entry(inp.k_switch, k)
-    actuator_effect(model.u0, inp.b0[ev], inp.b1[ev], work.u, work.e)
+    actuator_effect(model.u0, ctl.lo_dev, ctl.hi_dev, inp.b0[ev], inp.b1[ev], inp.fp[ev],
+                    inp.k_switch[ev], k, pl.dt, work.alpha, st.uhist, st.uprev, work.u,
+                    work.e)
     if pl.turb != 0:
         gust_lanes(pl, inp.eta[k], st.gust, work.wind, work.wind_next, work)
     plant_step(path, model, flight, inp.w[k], inp.v[k], st.x, work)
@@ -339,7 +414,7 @@ def truth_step(path, model, flight, inp, k, st, work):
 def longitudinal_truth(plant, scheme, flight, inp, k, st, work, rec):
     """:func:`truth_step` on a longitudinal plant (``plant`` its marker), as a
     kernel of its own."""
-    truth_step(plant, scheme.filter, flight, inp, k, st, work)
+    truth_step(plant, scheme.filter, scheme.controller, flight, inp, k, st, work)
 
 
 @on_path("plant", {LINEAR_PLANT: longitudinal_truth, NONLINEAR_PLANT: longitudinal_truth,

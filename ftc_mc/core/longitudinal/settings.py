@@ -193,6 +193,9 @@ TrialInputs = namedtuple("TrialInputs", [
     "v_lat",      # (n_steps, 5, L) noise of the measured lateral states, scaled, or (0, 5, L)
     "eta_lat",    # (n_steps, 4, L) lateral Dryden draws, or (0, 4, L) in still air
     "g0_lat",     # (4, L) initial lateral gust state (stationary draw, or zeros), or (0, L)
+    "fp",         # (E, N_FAULT_PARAM, 3, L) the fault model's other parameters per
+                  #           actuator from each switch on (conventions.FAULT_PARAM_NAMES;
+                  #           FAULT_PARAM_NEUTRAL: eq. 2 alone)
 ])
 """Per-lane inputs of :func:`ftc_mc.sim.lanes.run_trials` (a fault schedule)."""
 
@@ -337,6 +340,10 @@ LaneState = namedtuple("LaneState", [
     "JW",       # (9, 3, L)  d x_{k+1} / d wind (u_g, w_g [m/s], q_g [rad/s])
     "JC",       # (12, 9, L) d h / d x of the outputs
     "JHW",      # (12, 3, L) d h / d wind
+    # the truth's actuators (core/longitudinal/plant.py::actuator_effect)
+    "uhist",    # (N_CMD_HIST, 3, L) the commands of the last steps, step k at k % N_CMD_HIST
+    "uprev",    # (3, L) the command each actuator followed last step (after delay,
+                #        limit cycle, runaway, float and rate limit) [deviation from trim]
 ])
 """Everything a trial carries from one step to the next (core/longitudinal/trial.py)."""
 

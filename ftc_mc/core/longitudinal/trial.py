@@ -41,7 +41,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...conventions import (N_AUG, N_MODES, N_U, N_X, N_Z, STATUS_AIRSPEED,  # noqa: F401
+from ...conventions import (N_AUG, N_CMD_HIST, N_MODES, N_U, N_X, N_Z, STATUS_AIRSPEED,  # noqa: F401
                            STATUS_ALPHA, STATUS_NAMES, STATUS_NONFINITE,
                            STATUS_NOT_PSD, STATUS_OK, C_NOMINAL, RESIDUAL_OUTPUTS)
 from ..shared.dryden import N_GUST_STATE
@@ -192,6 +192,10 @@ def init_state(inp, st, rec):
         for i in range(st.gust.shape[0]):
             st.gust[i, l] = inp.g0[i, l]
         st.zhold[l] = 0.0
+        for i in range(N_U):
+            st.uprev[i, l] = 0.0
+            for j in range(st.uhist.shape[0]):
+                st.uhist[j, i, l] = 0.0
         for i in range(st.glat.shape[0]):
             st.glat[i, l] = inp.g0_lat[i, l]
         for i in range(st.lat.shape[0]):
@@ -248,7 +252,8 @@ def new_state(L, n, window, n_x, n_lat, n_glat, n_m, window_m):
                      mlast=np.zeros(L, dtype=np.int64),
                      JA=np.zeros((N_X, N_X, L)), JB=np.zeros((N_X, N_U, L)),
                      JW=np.zeros((N_X, N_WIND, L)), JC=np.zeros((N_Z, N_X, L)),
-                     JHW=np.zeros((N_Z, N_WIND, L)))
+                     JHW=np.zeros((N_Z, N_WIND, L)),
+                     uhist=np.zeros((N_CMD_HIST, N_U, L)), uprev=np.zeros((N_U, L)))
 
 
 @kernel

@@ -43,8 +43,11 @@ One step ``k -> k+1`` on every lane, with the longitudinal commands ``u_k``
    the commands stage saturated it (with room for a running excitation), and
    the sum is clipped again: where the paper's command saturates, the lane
    flies that clipped sum, not the coupled law's own saturation.
-2. **Faults.** Eq. (2) per actuator, ``e = b0 + (1 - b1) u - b1 u0``; the
-   absolute command is ``u0 + e`` (a lock holds ``b0``).  A left and a right
+2. **Faults.** The generic fault model and eq. (2) per actuator, as on the
+   longitudinal plants (:func:`ftc_mc.core.longitudinal.plant.actuator_effect`:
+   delay, limit cycle, runaway, float, rate limit, then
+   ``e = b0 + (1 - b1) c - b1 u0``); the absolute command is ``u0 + e`` (a
+   lock holds ``b0``).  A left and a right
    elevon fault are different faults here: elevator = (left + right)/2,
    aileron = (left - right)/2 (PyFly's mixing).
 3. **Gusts.** The longitudinal Dryden gusts ``u_g, w_g, q_g``
@@ -241,7 +244,8 @@ def sixdof_truth(plant, scheme, flight, inp, k, st, work, rec):
         st.lat[LAT_RIGHT, l] = elevon_model(lag, st.lat[LAT_RIGHT, l], u[U_RIGHT, l],
                                             pl.u_ff[U_RIGHT])
     ev = schedule_entry(inp.k_switch, k)
-    actuator_effect(u0, inp.b0[ev], inp.b1[ev], u, work.e)
+    actuator_effect(u0, ctl.lo_dev, ctl.hi_dev, inp.b0[ev], inp.b1[ev], inp.fp[ev],
+                    inp.k_switch[ev], k, pl.dt, work.alpha, st.uhist, st.uprev, u, work.e)
     wlat = np.zeros((3, L))
     wlat_next = np.zeros((3, L))
     if pl.turb != 0:
