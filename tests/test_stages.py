@@ -845,22 +845,8 @@ def test_reconfigure(fixture, request):
 
 
 # ================================================================== the whole loop
-SELECTION_DISAGREES = pytest.mark.xfail(strict=True, reason=(
-    "eq. 12 in the far tail: on lane 2 at the first period the horizon's fault estimate "
-    "lies in no mode's box (both elevons' b1 near 0.55), 41-61 standard deviations out; "
-    "the kernel's log_normal_interval (core/shared/belief.py) floors each factor at "
-    "LOG_TINY = -745 where erfc underflows, so modes 1-3 tie at -1484..-1490 and the prior "
-    "keeps the right elevon (c0, c1 objectives 586), while the twin's exact log tail "
-    "(log_ndtr) ranks the engine mode first by about 950 (c0 0.43); the kernel picks c2, "
-    "the twin c0.  The same at cbf2806, before the selection's rework.  The exact tail "
-    "in the kernel passes this case but moves the three golden scenarios' beliefs "
-    "(values below 2e-126 only): left for a decision on the golden files"))
-
-
 @pytest.mark.usefixtures("trial_kernel")
-@pytest.mark.parametrize("fixture,policy", [("linear", "none"),
-                                            pytest.param("nonlinear_gusts", "none",
-                                                         marks=SELECTION_DISAGREES),
+@pytest.mark.parametrize("fixture,policy", [("linear", "none"), ("nonlinear_gusts", "none"),
                                             ("linear", "periodic"), ("linear", "ambiguous")])
 def test_advance_matches_the_chained_twins(fixture, policy, request):
     """The trial loop against the twins chained in NumPy over 25 steps (two

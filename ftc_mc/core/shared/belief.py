@@ -9,8 +9,15 @@ Eq. (12) is then a product of normal-CDF differences::
 
     p(omega | m) = prod_j (Phi((hi_mj - b_j)/s_j) - Phi((lo_mj - b_j)/s_j)) / (hi_mj - lo_mj)
 
-computed in logarithms, with complementary error functions in the tails so a
-mode many standard deviations away still gets a finite, ordered likelihood.
+computed in logarithms, with complementary error functions in the tails, and
+beyond them (an interval whose probability is below the smallest normal
+float64, about 37.5 standard deviations out) with the asymptotic series of the
+normal tail's logarithm (:func:`log_upper_tail`), so a mode many standard
+deviations away still gets a finite likelihood in the right order: a mode
+1000 standard deviations out is less likely than one 40 out.  (A floor at the
+smallest subnormal's logarithm instead made every such factor equal, and an
+estimate far from every box then ranked a mode with one parameter far out
+as likely as one with two.)
 """
 
 from __future__ import annotations
@@ -21,6 +28,17 @@ from ...conventions import N_MODES  # noqa: F401
 from ..jit import kernel
 
 LOG_TINY = -745.0  # log of the smallest subnormal float64
+
+TINY_P = 2.2250738585072014e-308
+"""The smallest normal float64: an interval probability below it (subnormal,
+few significant digits, or zero) is computed from the tails' logarithms."""
+
+TAIL_MIN = 20.0
+"""Where :func:`log_upper_tail`'s series is used (scipy's ``log_ndtr`` switches
+to its series at the same point); below it an interval's probability is far
+above :data:`TINY_P` unless its bounds coincide."""
+
+LOG_SQRT_2PI = 0.5 * math.log(2.0 * math.pi)
 
 
 @kernel(internal=True)
@@ -35,7 +53,9 @@ def log_normal_interval(a, b):
     Returns
     -------
     float
-        The log-probability; ``LOG_TINY`` when it underflows.
+        The log-probability: from complementary error functions, or, when
+        that probability is below :data:`TINY_P`, from the tails' logarithms
+        (:func:`log_tail_interval`).
     """
     r2 = math.sqrt(2.0)
     if a > 0.0:
@@ -44,9 +64,54 @@ def log_normal_interval(a, b):
         p = 0.5 * (math.erfc(-b / r2) - math.erfc(-a / r2))
     else:
         p = 1.0 - 0.5 * (math.erfc(b / r2) + math.erfc(-a / r2))
-    if p <= 0.0:
-        return LOG_TINY
+    if p < TINY_P:
+        return log_tail_interval(a, b)
     return math.log(p)
+
+
+@kernel(internal=True)
+def log_upper_tail(u):
+    """``log(1 - Phi(u))`` for ``u >= TAIL_MIN``: the asymptotic series
+    ``-u^2/2 - log(u) - log(sqrt(2 pi)) + log(1 - 1/u^2 + 3/u^4 - 15/u^6 + ...)``
+    summed until its terms stop mattering (under 1e-17; at ``u = 20`` after
+    10 terms, at ``u = 40`` after 6).  ``-inf`` at ``u = inf``.
+    """
+    r = 1.0 / (u * u)
+    term = 1.0
+    s = 1.0
+    for n in range(1, 40):
+        term *= -(2 * n - 1) * r
+        s += term
+        if abs(term) < 1e-17:
+            break
+    return -0.5 * u * u - math.log(u) - LOG_SQRT_2PI + math.log(s)
+
+
+@kernel(internal=True)
+def log_tail_interval(a, b):
+    """``log(Phi(b) - Phi(a))`` for an interval ``a < b`` in one tail, at
+    least ``TAIL_MIN`` standard deviations out (mirrored to the upper tail:
+    ``log(Q(u) - Q(v)) = log Q(u) + log(1 - Q(v)/Q(u))``, ``Q = 1 - Phi``,
+    ``u < v`` the near and far bounds); ``LOG_TINY`` for any other interval
+    whose probability is below :data:`TINY_P` (bounds that coincide, or a
+    near bound beyond 1e154 standard deviations, whose square overflows)."""
+    if a > 0.0:
+        u = a
+        v = b
+    elif b < 0.0:
+        u = -b
+        v = -a
+    else:
+        return LOG_TINY
+    if not (u >= TAIL_MIN and v > u):
+        return LOG_TINY
+    lu = log_upper_tail(u)
+    d = log_upper_tail(v) - lu
+    if not d < 0.0:
+        return LOG_TINY
+    if d > -0.6931471805599453:  # log(-expm1(d)) is exact where 1 - e^d cancels
+        return lu + math.log(-math.expm1(d))
+    return lu + math.log1p(-math.exp(d))
 
 
 @kernel(internal=True)
