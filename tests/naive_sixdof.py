@@ -291,8 +291,9 @@ class SideMonitorRef:
     ``y0``, ``dt``).
     """
 
-    def __init__(self, mon, k_fault, plant=None):
+    def __init__(self, mon, k_fault, plant=None, threshold=30.0):
         self.mon, self.kf, self.plant = mon, k_fault, plant
+        self.threshold = threshold  # the design's GLR threshold
         n = mon.P0.shape[0]
         self.X, self.P = np.zeros(n), np.zeros((n, n))
         self.hist = []  # direction projections since the last restart, oldest first
@@ -300,6 +301,7 @@ class SideMonitorRef:
         self.b = np.zeros(9)
         self.side, self.pos = 0, 0.0  # the first elevon named and its position estimate
         self.last = 0  # its latest decision
+        self.now = 0  # its decision at this step
         self.turn_k = -1  # the step from which the lock-turn law may fly (k + 1 of that decision)
 
     def step(self, k, u, z, alive):
@@ -344,6 +346,7 @@ class SideMonitorRef:
         X[ns + nu:] = np.clip(X[ns + nu:], 0.0, 1.0)
         self.X, self.P = X, P
         kn = k + 1
+        self.now = 0
         if kn <= mon.startup:
             self.hist = []
             return
@@ -351,13 +354,13 @@ class SideMonitorRef:
         self.hist = (self.hist + [d])[-mon.window:]
         stat = glr_ref(self.hist[::-1], mon.min_window)  # three directions
         block = 0
-        if stat.max() > mon.threshold:
+        if stat.max() > self.threshold:
             block = int(np.argmax(stat)) + 1
             for i in (ns + block - 1, ns + nu + block - 1):
                 self.P[i, :] = 0.0
                 self.P[:, i] = 0.0
                 self.P[i, i] = mon.reset_var[i - ns]
-            self.last = block
+            self.last = self.now = block
             if block > 1 and self.side == 0:
                 self.side, self.turn_k = block, kn
             if alive:
@@ -640,14 +643,18 @@ def guarded_law_ref(tab, pl, s, p, x, lo_dev, hi_dev):
     return np.clip(tab.ro_u[s, c, 0], lo_dev[tab.cmd[s]], hi_dev[tab.cmd[s]]), (c, h)
 
 
-def side_blocks_ref(kind, mside, mlast, block):
+def side_blocks_ref(kind, mside, mlast, block, source=0, mnow=None):
     """Twin of ``core/sixdof/lockturn.side_blocks``, from its docstring: in a
     ``lock_turn`` or ``lock_turn_selected`` design (``kind`` 2 or 3) each lane's Table 1 reset (``block`` 1
     thrust or 2 elevons) goes to the block of the elevon the lane flies the
     law about (``mside`` > 0), else of the monitor's latest decision
     (``mlast``: 1 the throttle, 2 and 3 the elevons; 0 none: Table 1's
-    stays).  Returns the new blocks."""
+    stays).  With resets from the monitor (``source`` 1) every lane resets
+    the block of the monitor's decision at this step (``mnow``; 0: none),
+    whatever Table 1 and the kind.  Returns the new blocks."""
     out = np.array(block, copy=True)
+    if source == 1:
+        return np.array([0 if m == 0 else 1 if m == 1 else 2 for m in mnow], dtype=np.int64)
     if kind < 2:  # lock_turn (2) and lock_turn_selected (3) only
         return out
     for l in range(len(out)):

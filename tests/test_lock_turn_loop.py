@@ -100,23 +100,32 @@ def test_side_blocks_match_their_twin():
     ``lock_turn`` design's move."""
     from collections import namedtuple
 
+    from ftc_mc.conventions import RESETS_SIDE_MONITOR, RESETS_TABLE1
     from ftc_mc.core.shared.paths import SIXDOF_PLANT
     from ftc_mc.core.sixdof.lockturn import LOCK_TURN, side_blocks
 
     grid = np.array([(b, s, m) for b in (0, 1, 2) for s in (-3, -2, 0, 2, 3)
                      for m in (0, 1, 2, 3)], dtype=np.int64).T
     Reconfig = namedtuple("Reconfig", ["kind"])
-    Scheme = namedtuple("Scheme", ["reconfig"])
-    State = namedtuple("State", ["mside", "mlast"])
-    st = State(mside=grid[1].copy(), mlast=grid[2].copy())
+    Det = namedtuple("Det", ["source"])
+    Scheme = namedtuple("Scheme", ["detection", "reconfig"])
+    State = namedtuple("State", ["mside", "mlast", "mnow"])
+    # this step's decision: none or each actuator, on every combination above
+    now = np.resize(np.array([0, 1, 2, 3], dtype=np.int64), grid.shape[1])
+    st = State(mside=grid[1].copy(), mlast=grid[2].copy(), mnow=now[::-1].copy())
     moved = 0
-    for kind in (0, 1, LOCK_TURN):
-        block = grid[0].copy()
-        side_blocks(SIXDOF_PLANT, Scheme(Reconfig(kind)), st, block)
-        np.testing.assert_array_equal(block, side_blocks_ref(kind, st.mside, st.mlast, grid[0]))
-        moved += int((block != grid[0]).sum())
-        if kind != LOCK_TURN:
-            np.testing.assert_array_equal(block, grid[0])
+    for source in (RESETS_TABLE1, RESETS_SIDE_MONITOR):
+        for kind in (0, 1, LOCK_TURN):
+            block = grid[0].copy()
+            side_blocks(SIXDOF_PLANT, Scheme(Det(source), Reconfig(kind)), st, block)
+            np.testing.assert_array_equal(block, side_blocks_ref(
+                kind, st.mside, st.mlast, grid[0], source, st.mnow))
+            if source == RESETS_TABLE1:
+                moved += int((block != grid[0]).sum())
+                if kind != LOCK_TURN:
+                    np.testing.assert_array_equal(block, grid[0])
+            else:  # the monitor's decision alone, whatever Table 1 and the kind
+                np.testing.assert_array_equal(block != 0, st.mnow != 0)
     assert moved > 0
     # the decision codes follow the monitor's directions, named as the
     # longitudinal commands

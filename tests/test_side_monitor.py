@@ -111,8 +111,13 @@ def flown_data(setup, mon, n_steps, rng, faults):
     return u, z
 
 
-def run_kernel(setup, mon, st, rec, u, z, k):
+def run_kernel(setup, mon, st, rec, u, z, k, threshold=None):
+    """One step of the monitor kernel (``threshold``: the design's GLR
+    threshold, ``None`` the config's)."""
     scheme = setup.scheme("paper")
+    if threshold is not None:
+        scheme = scheme._replace(
+            detection=scheme.detection._replace(side_threshold=threshold))
     flight = setup.flight._replace(plant=setup.truth._replace(monitor=mon))
     work = new_trial_work(L, 14)
     nz = work.z.shape[0]
@@ -156,7 +161,9 @@ def test_monitor_matches_its_twin(setup):
     # (about 0.1 s per lane and step): there, one lane of each fault, the
     # fault-free one and the stopped one are compared (the others repeat a fault)
     compared = (0, 1, 2, 5, L - 1) if mon.nonlinear == EXTENDED else tuple(range(L))
-    refs = {l: SideMonitorRef(mon, setup.tim.k_fault, setup.truth) for l in compared}
+    refs = {l: SideMonitorRef(mon, setup.tim.k_fault, setup.truth,
+                              setup.scheme("paper").detection.side_threshold)
+            for l in compared}
     # relative errors in the norm: the order of the sums differs; the extended
     # filter's forward differences (step 1e-6) turn the rounding of two
     # implementations of the equations (1e-16) into 1e-10 in its Jacobians,
@@ -166,6 +173,7 @@ def test_monitor_matches_its_twin(setup):
         run_kernel(setup, mon, st, rec, u, z, k)
         for l, ref in refs.items():
             ref.step(k, u[k, :, l], z[k, :, l], bool(st.alive[l]))
+            assert st.mnow[l] == ref.now, f"this step's decision, step {k}, lane {l}"
             for got, want, what in ((st.mx[:, l], ref.X, "X"), (st.mP[:, :, l], ref.P, "P")):
                 err = np.linalg.norm(got - want) / np.linalg.norm(want)
                 assert err < tol, f"{what}, step {k}, lane {l}: {err:.1e}"
@@ -265,7 +273,7 @@ def test_direction_projections_are_standard_normal_without_fault(setup, request)
     equations predicting it fails (35 steps, expected: known limits, below)."""
     from scipy.stats import chi2
 
-    mon = setup.truth.monitor._replace(threshold=np.inf, startup=0)
+    mon = setup.truth.monitor._replace(startup=0)
     n_steps, transient = 150, 20
     if mon.nonlinear and mon.A.shape[0] > len(MONITOR_STATES):
         # Known limits (docs/findings/sixdof-side-monitor.md, scripts/studies/study_monitor_consistency.py):
@@ -288,7 +296,7 @@ def test_direction_projections_are_standard_normal_without_fault(setup, request)
     st, rec = lanes(setup, mon)
     d = []
     for k in range(n_steps):
-        run_kernel(setup, mon, st, rec, u, z, k)
+        run_kernel(setup, mon, st, rec, u, z, k, threshold=np.inf)
         if k >= transient:  # past the filter's transient from P0
             d.append(st.mbuf[k % mon.window].copy())
     d = np.array(d)

@@ -154,6 +154,7 @@ def random_lanes(setup, rng, k, L=L):
                      mcount=np.zeros(L, dtype=np.int64), mside=np.zeros(L, dtype=np.int64),
                      mpos=np.zeros(L),
                      mturn=np.full(L, -1, dtype=np.int64), mlast=np.zeros(L, dtype=np.int64),
+                     mnow=np.zeros(L, dtype=np.int64),
                      **trim_jacobians(fm, L), **random_actuator_state(setup, k, L))
 
 
@@ -261,6 +262,7 @@ def new_rec(tim, L=L, max_resets=4, history=True):
         hist_res=np.zeros((n_hist, 3, L)), hist_exc=np.zeros((n_hist, 4, L)),
         hist_block=np.zeros((n_hist, L), i8), hist_wind=np.zeros((n_hist, 3, L)),
         hist_z=np.zeros((n_hist, 12, L)), hist_innov=np.zeros((n_hist, 3, L)),
+        hist_lat=np.zeros((n_hist, 0, L)), hist_mon=np.zeros((n_hist, 0, L)),
         sq_lat=np.zeros((2, L)), cost=np.zeros((N_COST, L)), z_switch_last=np.zeros((2, L)),
         side_k=np.full(L, -1, i8), side_block=np.zeros(L, i8), side_pre=np.zeros(L, i8),
         side_n=np.zeros(L, i8), mon_b=np.zeros((0, L)))

@@ -793,3 +793,93 @@ def table1_detector(variant: str = "paper", t_q: float | None = None,
     table1.columns = tuple(LAY.residuals)
     table1.__name__ = f"table1_{variant}"
     return table1
+
+
+def side_monitor_decisions(d: np.ndarray, window: int, min_window: int, threshold: float,
+                           startup: int) -> np.ndarray:
+    """The 6-DOF side monitor's decisions re-run on its recorded projections.
+
+    The same test as the kernel (:func:`ftc_mc.core.sixdof.monitor.monitor_decide`
+    with :func:`ftc_mc.core.shared.glr.glr_lanes`), in NumPy and in the kernel's
+    order of sums, so that it decides bit for bit as the closed loop did: each
+    step appends the projections to a window of the last ``window`` steps; each
+    direction's statistic is ``max_m (sum of its newest m) ** 2 / m`` over
+    ``min_window <= m <=`` the window's length; the direction whose statistic
+    is largest, if above ``threshold``, is decided, and the window restarts.
+    Until the step ``startup`` the window stays empty.
+
+    Parameters
+    ----------
+    d : ndarray, shape (trials, steps, 3)
+        ``side_d_*`` of the signals (row ``j``: step ``j + 1``); NaN after a
+        trial stopped (no decision there).
+    window, min_window, startup : int
+        The monitor's GLR window, shortest change and start-up [steps]
+        (``monitor`` section).
+    threshold : float
+        The design's monitor threshold.
+
+    Returns
+    -------
+    ndarray of int64, shape (trials, steps)
+        0: no decision; else the direction's index plus one (throttle, left,
+        right elevon: ``layout.MONITOR_DIRECTIONS``).
+    """
+    d = np.asarray(d, dtype=np.float64)
+    n, steps, nd = d.shape
+    buf = np.zeros((n, window, nd))  # newest first
+    count = np.zeros(n, dtype=np.int64)
+    m = np.arange(1, window + 1, dtype=np.float64)
+    out = np.zeros((n, steps), dtype=np.int64)
+    for j in range(steps):
+        if j + 1 <= startup:
+            count[:] = 0
+            continue
+        buf = np.concatenate([d[:, j][:, None, :], buf[:, :-1]], axis=1)
+        count = np.minimum(count + 1, window)
+        acc = np.cumsum(buf, axis=1)  # sequential: the kernel's sums
+        g = acc * acc / m[None, :, None]
+        valid = (m[None, :] <= count[:, None]) & (m[None, :] >= min_window)
+        stat = np.where(valid[..., None], g, 0.0).max(axis=1)  # (n, nd)
+        best = np.argmax(stat, axis=1)  # the first of equal ones, as the kernel
+        hit = stat[np.arange(n), best] > threshold
+        out[hit, j] = best[hit] + 1
+        count[hit] = 0
+    return out
+
+
+def side_monitor_detector(threshold: float | None = None):
+    """The 6-DOF side monitor as a detector of recorded signals (open loop): its
+    first decision, naming the actuator (``engine``, ``left_elevon``,
+    ``right_elevon``), from the projections recorded on the 6-DOF plant
+    (``side_d_*``) with the ``monitor`` section's defaults
+    (:func:`side_monitor_decisions`).  On signals flown with those settings it
+    decides at every step as the closed loop's monitor did, which is the
+    6-DOF recording's test (``tests/test_detector.py``).
+
+    Parameters
+    ----------
+    threshold : float, optional
+        The GLR threshold (default: ``monitor.threshold``'s default).
+    """
+    from ..config.schema import MonitorConfig
+    from .signals import MONITOR_COLUMNS
+    mc = MonitorConfig()
+    thr = mc.threshold if threshold is None else float(threshold)
+
+    def side_monitor(signals, names, dt):
+        steps = lambda s: int(round(s / dt))  # noqa: E731
+        dec = side_monitor_decisions(signals[..., [names.index(c) for c in MONITOR_COLUMNS]],
+                                     steps(mc.window_s), steps(mc.min_window_s), thr,
+                                     steps(mc.startup_s))
+        fired = dec != 0
+        first = np.argmax(fired, axis=1)
+        any_ = fired.any(axis=1)
+        alarm = np.where(any_, (first + 1) * dt, np.nan)
+        named = dec[np.arange(len(first)), first]
+        block = np.where(any_, np.array(("",) + LAY.actuators, dtype=object)[named], "")
+        return alarm, block
+
+    side_monitor.columns = MONITOR_COLUMNS
+    side_monitor.__name__ = "side_monitor"
+    return side_monitor

@@ -36,6 +36,7 @@ import pandas as pd
 from ..conventions import LONGITUDINAL as LAY
 from ..conventions import MODE_NAMES
 from ..core.longitudinal.workspace import EXC_3211, EXC_DOUBLET
+from ..core.sixdof.layout import MONITOR_DIRECTIONS, MONITOR_LATERAL
 from ..sim.inputs import Schedule, schedule_kinds
 
 FOLDER = "signals"
@@ -63,14 +64,28 @@ reads them only when it names them (:mod:`ftc_mc.campaign.detector`); every
 other signal column is observable on board."""
 
 
-def signal_columns(n_z: int = LAY.n_z) -> tuple:
+LATERAL_COLUMNS = tuple(f"z_{o}" for o in MONITOR_LATERAL)
+"""The 6-DOF plant's lateral sensors (bank, side velocity, roll and yaw rates,
+heading; deviations from the 6-DOF trim)."""
+
+MONITOR_COLUMNS = tuple(f"side_d_{d}" for d in MONITOR_DIRECTIONS)
+"""The 6-DOF side monitor's projection of each fault direction (throttle, left,
+right elevon): standard normal under no fault, the input of its GLR
+(``ftc_mc/core/sixdof/monitor.py``)."""
+
+
+def signal_columns(n_z: int = LAY.n_z, sixdof: bool = False) -> tuple:
     """Names of the signal columns of a signals row (after :data:`KEYS`), in file
-    order (``docs/reference/outputs.md``); :data:`TRUTH_COLUMNS` among them."""
+    order (``docs/reference/outputs.md``); :data:`TRUTH_COLUMNS` among them.
+    ``sixdof``: a recording on the 6-DOF plant with its side monitor, which
+    adds :data:`LATERAL_COLUMNS` and :data:`MONITOR_COLUMNS`."""
     outs = LAY.outputs if n_z == LAY.n_z else tuple(str(i) for i in range(n_z))
-    return (tuple(f"z_{o}" for o in outs) + tuple(f"u_{i}" for i in LAY.inputs)
+    return (tuple(f"z_{o}" for o in outs) + (LATERAL_COLUMNS if sixdof else ())
+            + tuple(f"u_{i}" for i in LAY.inputs)
             + TRUTH_COLUMNS + ("exc_doublet", "exc_3211")
             + innovation_names() + tuple(LAY.residuals) + ("reset",)
-            + tuple(f"belief_{m}" for m in MODE_NAMES))
+            + tuple(f"belief_{m}" for m in MODE_NAMES)
+            + (MONITOR_COLUMNS if sixdof else ()))
 
 
 def is_truth(column: str) -> bool:
@@ -123,8 +138,11 @@ def signals_frame(tr_name: str, variant: str, trial_ids, inp, rec, k_fault: int,
             "variant": pd.Categorical.from_codes(same, [variant]),
             "trial_id": np.asarray(trial_ids, dtype=np.int64)[lane],
             "step": (k + 1).astype(np.int32)}
-    names = signal_columns(rec.hist_z.shape[1])
+    sixdof = rec.hist_mon.shape[1] > 0
+    names = signal_columns(rec.hist_z.shape[1], sixdof)
     z = _rows(rec.hist_z, keep).astype(f4)
+    if sixdof:
+        z = np.hstack([z, _rows(rec.hist_lat, keep).astype(f4)])
     u = _rows(rec.hist_u, keep).astype(f4)
     i = 0
     for j in range(z.shape[1]):
@@ -161,6 +179,10 @@ def signals_frame(tr_name: str, variant: str, trial_ids, inp, rec, k_fault: int,
     bel = np.concatenate([init[None], rec.belief], axis=0)  # row 0: before any update
     for m, nm in enumerate(MODE_NAMES):
         cols[f"belief_{nm}"] = bel[p + 1, m, lane].astype(f4)
+    if sixdof:  # float64: the monitor's GLR re-run offline decides as it did
+        mon = _rows(rec.hist_mon, keep)
+        for j, nm in enumerate(MONITOR_COLUMNS):
+            cols[nm] = np.ascontiguousarray(mon[:, j], dtype=np.float64)
     return pd.DataFrame(cols)
 
 

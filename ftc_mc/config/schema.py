@@ -24,7 +24,7 @@ from pydantic import (AfterValidator, BaseModel, BeforeValidator, ConfigDict, Fi
 
 from ..conventions import (ACTUATOR_NAMES, BIASED_OUTPUTS, EXCITATION_POLICIES,
                            KIND_TRANSITIONS, KINDS_BEYOND, MAX_DELAY_STEPS, OUTPUT_NAMES,
-                           PLANT_KINDS, S3211_UNITS, SENSOR_FAULT_KINDS, SENSOR_PREFIX,
+                           PLANT_KINDS, RESETS_NAMES, S3211_UNITS, SENSOR_FAULT_KINDS, SENSOR_PREFIX,
                            STATE_NAMES, TRANSITIONS, TURBULENCE_LEVELS)
 from ..errors import UserError
 from ..model.source import (DEFAULT_AIRFRAME, check_airframe, check_condition,
@@ -202,8 +202,19 @@ def _check_coupling(cfg, runs) -> None:
 
 
 def _check_lock_turn(cfg, runs) -> None:
-    """A ``lock_turn`` controller needs the 6-DOF plant and its side monitor;
-    the error names the field that asks for it."""
+    """A ``lock_turn`` controller, and resets from the side monitor, need the
+    6-DOF plant and its side monitor; the error names the field that asks
+    for it."""
+    for r in runs:
+        dc = cfg.designs.get(r)
+        if dc is not None and dc.resets == "side_monitor":
+            if cfg.plant.dof != 6:
+                raise ValueError(f"designs.{r}.resets: side_monitor reads the 6-DOF "
+                                 f"plant's side monitor (plant.dof: 6), got plant.dof "
+                                 f"{cfg.plant.dof}")
+            if not cfg.monitor.enabled:
+                raise ValueError(f"designs.{r}.resets: side_monitor reads the side "
+                                 "monitor, but monitor.enabled is false")
     for r in runs:
         kind = cfg.controller_of(r)
         if kind not in LOCK_TURN_KINDS:
@@ -699,6 +710,10 @@ class DesignConfig(_Strict):
     """Clip each normalised innovation to [-c, c] in the GLR window (glr only); null: no clip (docs/reference/config.md#detection-designs)."""
     signature: Literal["paper", "swapped"] = "swapped"
     """Table 1 as printed (paper) or with its third clause swapped."""
+    resets: Literal[RESETS_NAMES] = "table1"
+    """What resets the blocks: table1 (Table 1) or side_monitor (the 6-DOF side monitor; docs/reference/config.md#detection-designs)."""
+    monitor_threshold: Pos | None = None
+    """The 6-DOF side monitor's GLR threshold on this design's flights; null: monitor.threshold."""
     t_q: Pos = 25.0
     """Threshold on r_q (Table 1)."""
     t_nx: Pos = 25.0

@@ -75,7 +75,7 @@ import scipy.linalg
 
 from ..config.schema import BUILTIN_DESIGNS, DesignConfig, EstimatorConfig
 from ..conventions import (EXCITATION_POLICIES, EXCITE_NONE, OUTPUT_NAMES, RESET_ELEVONS,
-                           RESET_THRUST, STATE_NAMES, TEST_GLR, TEST_NAMES, TEST_ONE_STEP)
+                           RESETS_NAMES, RESET_THRUST, STATE_NAMES, TEST_GLR, TEST_NAMES, TEST_ONE_STEP)
 from ..core.longitudinal.settings import Detection, FilterModel
 from ..model.linear import LinearPlant
 from ..model.turbulence import dryden_model
@@ -186,8 +186,9 @@ class Design:
     def detection(self, plant: LinearPlant, t_q: float, t_nx: float) -> Detection:
         """The design's detection at the thresholds ``(t_q, t_nx)``.
 
-        Both infinite: no reset ever happens (the reset variances are then those
-        of the design's thresholds, and never used).
+        Both infinite: Table 1 never resets (the reset variances are then those
+        of the design's thresholds, and never used); a design whose resets come
+        from the side monitor still resets.
         """
         if math.isinf(t_q) and math.isinf(t_nx):
             return self.det._replace(t_q=math.inf, t_nx=math.inf)
@@ -234,7 +235,7 @@ def _c(a) -> np.ndarray:
 
 
 def build_design(name: str, dc: DesignConfig, plant: LinearPlant, est: EstimatorConfig,
-                 altitude_m: float) -> Design:
+                 altitude_m: float, monitor_threshold: float = math.inf) -> Design:
     """The kernel settings of the design ``dc``.
 
     Parameters
@@ -249,6 +250,10 @@ def build_design(name: str, dc: DesignConfig, plant: LinearPlant, est: Estimator
         overrides them, ``R``, mode boxes.
     altitude_m : float
         Altitude of the Dryden scale lengths of a gust-aware filter [m].
+    monitor_threshold : float
+        The side monitor's GLR threshold of the run (``monitor.threshold``;
+        6-DOF), which the design's ``monitor_threshold`` overrides on its
+        flights.
 
     Returns
     -------
@@ -290,7 +295,10 @@ def build_design(name: str, dc: DesignConfig, plant: LinearPlant, est: Estimator
     det = _with_test(scaled_reset(detection(plant, s), dc.reset_scale), test, window,
                      min_window)._replace(
         settle=int(round(dc.settle_s / plant.dt)), startup=int(round(dc.startup_s / plant.dt)),
-        clip=math.inf if dc.innovation_clip is None else float(dc.innovation_clip))
+        clip=math.inf if dc.innovation_clip is None else float(dc.innovation_clip),
+        source=RESETS_NAMES.index(dc.resets),
+        side_threshold=float(monitor_threshold if dc.monitor_threshold is None
+                             else dc.monitor_threshold))
     # every field but those Table 1 reads only when it decides (a shared start runs
     # with resets disabled); the excitation policy's are in: it flies before any reset
     key = dc.model_dump_json(exclude={"signature", "t_q", "t_nx"})
@@ -348,8 +356,10 @@ def _with_sensor_biases(fm: FilterModel, P0: np.ndarray, dc: DesignConfig, dt: f
 
 
 def build_designs(names, designs: dict, plant: LinearPlant, est: EstimatorConfig,
-                  altitude_m: float) -> dict:
+                  altitude_m: float, monitor_threshold: float = math.inf) -> dict:
     """``name -> Design`` of the designs ``names`` run (built-in or keys of
-    ``designs``, the config's validated ``designs`` section), in order."""
+    ``designs``, the config's validated ``designs`` section), in order;
+    ``monitor_threshold`` the run's side monitor's (:func:`build_design`)."""
     return {n: build_design(n, builtin_design(n, est) if n in BUILTIN_DESIGNS
-                            else designs[n], plant, est, altitude_m) for n in names}
+                            else designs[n], plant, est, altitude_m, monitor_threshold)
+            for n in names}

@@ -16,7 +16,9 @@ each detection of the group:
 Until its first reset a lane does not depend on the thresholds (the residuals
 are the same, and the initial covariance uses the paper's thresholds whatever
 is run, see ``ftc_mc/sim/setup.py``), so both ways give bit-identical records
-(``tests/test_sweep.py``).
+(``tests/test_sweep.py``).  A design whose resets come from the side monitor
+(``resets: side_monitor``) does not depend on the thresholds at all, and
+runs alone.
 """
 
 from __future__ import annotations
@@ -26,11 +28,12 @@ import math
 import numpy as np
 
 from ..conventions import LONGITUDINAL as LAY
-from ..conventions import N_COST, N_MODES
+from ..conventions import N_COST, N_MODES, RESETS_TABLE1
 from ..core.longitudinal.gustfilter import N_WIND
 from ..core.longitudinal.settings import TrialInputs, TrialRecord
 from ..core.longitudinal.workspace import N_EXC
-from ..core.longitudinal.trial import advance, init_jacobians, init_state, new_state
+from ..core.longitudinal.trial import (N_DIRECTIONS, advance, init_jacobians, init_state,
+                                        new_state)
 from .inputs import design_inputs
 from .paths import path_of
 
@@ -103,6 +106,8 @@ def new_record(setup, L: int, max_resets: int, history: bool = False,
         hist_block=np.zeros((n_hist, L), dtype=np.int64),
         hist_wind=np.zeros((n_hist, N_WIND, L)),
         hist_z=np.zeros((n_hist, LAY.n_z, L)), hist_innov=np.zeros((n_hist, n_res, L)),
+        hist_lat=np.zeros((n_hist, 0 if setup.lat_std is None else len(setup.lat_std), L)),
+        hist_mon=np.zeros((n_hist, N_DIRECTIONS if n_mon else 0, L)),
         xa_end=np.zeros((n_est, L)), sq_lat=np.zeros((N_SQ_LAT, L)),
         cost=np.zeros((N_COST, L)), z_switch_last=np.zeros((2, L)),
         side_k=np.zeros(L, dtype=np.int64), side_block=np.zeros(L, dtype=np.int64),
@@ -164,10 +169,14 @@ def simulate(setup, inp: TrialInputs, runs, max_resets: int, k_share: int | None
                 L * n * len(runs))
     assert 0 < k_share <= n and not history
     groups = {}
-    for i, (name, _) in enumerate(runs):
-        groups.setdefault(setup.designs[name].key, []).append(i)
     recs = [None] * len(runs)
     simulated = 0
+    for i, (name, det) in enumerate(runs):
+        if det.source == RESETS_TABLE1:
+            groups.setdefault(setup.designs[name].key, []).append(i)
+        else:  # the monitor resets whatever the thresholds: nothing to share
+            recs[i] = run_alone(setup, name, det, inp, max_resets)
+            simulated += L * n
     for members in groups.values():
         lead = runs[members[0]][0]
         rec0, st0 = _shared_start(setup, lead, inp, max_resets, k_share)

@@ -68,8 +68,6 @@ class MonitorSpec:
 
     Attributes
     ----------
-    threshold : float
-        GLR threshold.
     window, min_window, startup, snap : int
         GLR window, shortest change tested, start-up, and the time after the
         first decision at which the estimate is recorded [steps].
@@ -130,7 +128,6 @@ class MonitorSpec:
         (``guarded``) and for a table on the linear model; None: no wide box.
     """
 
-    threshold: float
     window: int
     min_window: int
     startup: int
@@ -186,7 +183,7 @@ def monitor_spec(cfg, fm, det, lock_turn: bool = False) -> MonitorSpec | None:
            cfg.validity.alpha_min_deg, cfg.validity.alpha_max_deg, cfg.validity.bank_max_deg)
     linear = mc.turn_model == "linear" or (mc.turn_model == "auto" and cfg.plant.kind == "linear")
     return MonitorSpec(
-        threshold=float(mc.threshold), window=cfg.steps(mc.window_s),
+        window=cfg.steps(mc.window_s),
         min_window=cfg.steps(mc.min_window_s), startup=cfg.steps(mc.startup_s),
         snap=cfg.steps(mc.estimate_after_s),
         q_x=float(fm.q_diag[0]), q_b=float(fm.q_diag[LONGITUDINAL.n_x]),
@@ -403,7 +400,7 @@ def side_monitor(six, u_ff: np.ndarray, u_lower, u_upper, lon_out: np.ndarray,
         z = np.zeros
         return SideMonitor(on=0, A=z((0, 0)), B=z((0, nu)), C=z((0, 0)), u0=z(nu),
                            u_ff=z(nu), lo=z(nu), hi=z(nu), P0=z((0, 0)), Q=z((0, 0)), r=z(0),
-                           reset_var=z(2 * nu), threshold=np.inf, window=1, min_window=1,
+                           reset_var=z(2 * nu), window=1, min_window=1,
                            startup=0, snap=0, turn=lock_turn_table(six, six.u0 - u_ff),
                            nonlinear=0, states=z(0, dtype=np.int64),
                            outs=z(0, dtype=np.int64), n_sub=1, wind=z((len(WIND), 0)))
@@ -452,7 +449,7 @@ def side_monitor(six, u_ff: np.ndarray, u_lower, u_upper, lon_out: np.ndarray,
         on=1, A=c(A), B=c(B), C=c(C), u0=c(u0, dtype=np.float64),
         u_ff=c(u_ff, dtype=np.float64), lo=c(u_lower), hi=c(u_upper), P0=c(P0), Q=c(Q),
         r=c(np.concatenate([spec.r_lon, spec.r_lat])), reset_var=c(spec.reset_var),
-        threshold=float(spec.threshold), window=int(spec.window),
+        window=int(spec.window),
         min_window=int(spec.min_window), startup=int(spec.startup), snap=int(spec.snap),
         turn=lock_turn_table(six, u0, spec.turn_offsets, airframe, spec.turn_measured,
                              spec.turn_probe, rollout, wide, spec.turn_linear),

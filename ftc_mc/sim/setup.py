@@ -269,7 +269,8 @@ def build_setup(cfg: Config | ScenarioConfig) -> SimSetup:
     first = runs[0] if runs[0] in VARIANTS else VARIANTS[0]
     est = EstimatorSettings.from_config(cfg.estimator, first)
     fm = filter_model(plant, est)
-    designs = build_designs(runs, cfg.designs, plant, cfg.estimator, cfg.plant.altitude_m)
+    designs = build_designs(runs, cfg.designs, plant, cfg.estimator, cfg.plant.altitude_m,
+                            float(cfg.monitor.threshold))
     bs = belief_settings(plant, est)
     c = cfg.controller
     laws = {w: control_laws(cfg, plant, fm, w)

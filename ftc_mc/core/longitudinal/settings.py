@@ -68,6 +68,11 @@ _DetectionFields = namedtuple("Detection", [
     "settle",     # steps after a reset during which the other block is not reset (0: none)
     "startup",    # steps from the start before the test is armed: no reset, GLR window
                   # kept empty (0: armed at once; DesignConfig.startup_s)
+    "source",     # conventions.RESETS_TABLE1 (Table 1 decides) or RESETS_SIDE_MONITOR
+                  # (the 6-DOF side monitor's decisions reset its actuator's block:
+                  # core/sixdof/lockturn.py::side_blocks; DesignConfig.resets)
+    "side_threshold",  # the 6-DOF side monitor's GLR threshold on this design's lanes
+                       # (DesignConfig.monitor_threshold, else monitor.threshold)
 ])
 
 
@@ -225,6 +230,11 @@ TrialRecord = namedtuple("TrialRecord", [
     "hist_wind",    # (n_hist, 3, L) gust u_g, w_g [m/s], q_g [rad/s] held over each step
     "hist_z",       # (n_hist, 12, L) measurements z_{k+1} (deviations from the trim outputs)
     "hist_innov",   # (n_hist, 3, L) signed normalised innovations of r_q, r_nx, r_nz's outputs
+    "hist_lat",     # (n_hist, 5, L) the lateral loop's measurements after each step (bank,
+                    #      side velocity, roll and yaw rates, heading; 6-DOF plant, else
+                    #      no columns)
+    "hist_mon",     # (n_hist, 3, L) the side monitor's direction projections (its GLR's
+                    #      input) of each step (6-DOF plant, else no columns)
     "sq_lat",       # (2, L) sums over the valid steps of the squared bank and heading
                     #      deviations [rad^2] (6-DOF plant; zeros otherwise)
     "cost",         # (N_COST, L) over the valid steps (conventions.COST_NAMES): sum of
@@ -333,6 +343,7 @@ LaneState = namedtuple("LaneState", [
                 #        first elevon decision, k + 1, or the selection's step), or -1;
                 #        ``mside`` < 0 once handed back
     "mlast",    # (L,) int64 its latest decision: 0 none, else its block code (1-3)
+    "mnow",     # (L,) int64 its decision at this step: 0 none, else its block code (1-3)
     # the extended filter's Jacobians about the lane's estimate (FilterModel.relin > 0;
     # the trim matrices otherwise, never read)
     "JA",       # (9, 9, L)  d x_{k+1} / d x_k of the one-period airframe map

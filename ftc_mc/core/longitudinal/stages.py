@@ -651,7 +651,8 @@ def record_step(k, st, work, rec):
         ``hist_*`` rows ``k`` written: true state, estimate, fault-parameter
         variances, commands, residuals, excitation, gust, block, measurements
         and normalised innovations (written on every path while a history is
-        kept, :func:`filter_update`).
+        kept, :func:`filter_update`), the lateral loop's measurements (6-DOF;
+        the side monitor writes its own row, ``hist_mon``).
     """
     if k >= rec.hist_x.shape[0]:
         return
@@ -678,6 +679,8 @@ def record_step(k, st, work, rec):
             rec.hist_z[k, i, l] = work.z[i, l]
         for i in range(work.innov.shape[0]):
             rec.hist_innov[k, i, l] = work.innov[i, l]
+        for i in range(rec.hist_lat.shape[1]):  # the 6-DOF plant's lateral sensors
+            rec.hist_lat[k, i, l] = st.lat[i, l]
 
 
 # ------------------------------------------------------------------ 7. reconfigure

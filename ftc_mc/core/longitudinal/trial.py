@@ -214,6 +214,7 @@ def init_state(inp, st, rec):
         st.mpos[l] = 0.0
         st.mturn[l] = -1
         st.mlast[l] = 0
+        st.mnow[l] = 0
         rec.side_k[l] = -1
         rec.side_block[l] = 0
         rec.side_pre[l] = 0
@@ -249,7 +250,7 @@ def new_state(L, n, window, n_x, n_lat, n_glat, n_m, window_m):
                      mcount=np.zeros(L, dtype=np.int64),
                      mside=np.zeros(L, dtype=np.int64), mpos=np.zeros(L),
                      mturn=np.full(L, -1, dtype=np.int64),
-                     mlast=np.zeros(L, dtype=np.int64),
+                     mlast=np.zeros(L, dtype=np.int64), mnow=np.zeros(L, dtype=np.int64),
                      JA=np.zeros((N_X, N_X, L)), JB=np.zeros((N_X, N_U, L)),
                      JW=np.zeros((N_X, N_WIND, L)), JC=np.zeros((N_Z, N_X, L)),
                      JHW=np.zeros((N_Z, N_WIND, L)),

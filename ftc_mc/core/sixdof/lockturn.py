@@ -127,6 +127,13 @@ through pitch only, and once the law banks the wing its model (wings level)
 reads the turn as a thrust change; the monitor reads roll and pitch together
 (the side is decided by the direction's GLR).
 
+**Resets from the monitor** (a design with ``resets: side_monitor``,
+``Detection.source``; any controller).  The monitor then decides *when* as
+well: at each step it names an actuator (``LaneState.mnow``) the
+longitudinal filter resets that actuator's block, and Table 1's decisions
+are dropped (``docs/findings/sixdof-monitor-resets.md``).  The design's
+settle and start-up rules still apply after it.
+
 Plain-NumPy twins: ``tests/naive_sixdof.py::lock_turn_law_ref``,
 ``rocking_law_ref``, ``guarded_law_ref``, ``turn_probe_ref``, ``side_blocks_ref``.
 """
@@ -138,7 +145,7 @@ from collections import namedtuple
 
 import numpy as np
 
-from ...conventions import LONGITUDINAL, NO_RESET
+from ...conventions import LONGITUDINAL, NO_RESET, RESETS_SIDE_MONITOR
 from ..jit import kernel
 from ..shared.excitation import signal_3211, signal_3211_length
 from .kinds import LOCK_TURN, SELECTED_TURN  # noqa: F401 -- the kinds, by their module
@@ -529,22 +536,30 @@ def side_blocks(plant, scheme, st, block):
     """Table 1's decisions of a ``lock_turn`` or ``lock_turn_selected``
     design, each moved to the block of the actuator the design acts on
     (module docstring, "Which block the paper's filter resets"); other
-    designs' are left alone.
+    designs' are left alone.  A design whose resets come from the monitor
+    (``scheme.detection.source``) resets the block of this step's decision
+    instead, whatever its controller ("Resets from the monitor").
 
     Parameters
     ----------
     plant : SixdofPlant or SixdofExtendedPlant
         The path's plant marker (the dispatcher's calling convention).
     scheme : Scheme
-        ``reconfig.kind`` (:data:`LOCK_TURN` or :data:`SELECTED_TURN`: the
-        monitor decides the block).
+        ``detection.source`` (``RESETS_SIDE_MONITOR``: the monitor decides
+        when and which), ``reconfig.kind`` (:data:`LOCK_TURN` or
+        :data:`SELECTED_TURN`: the monitor decides the block).
     st : LaneState
-        ``mside`` (the elevon the lane flies the law about, if > 0) and
-        ``mlast`` (the monitor's latest decision, 0 none).
+        ``mside`` (the elevon the lane flies the law about, if > 0),
+        ``mlast`` (the monitor's latest decision, 0 none) and ``mnow``
+        (its decision at this step, 0 none).
     block : ndarray of int64, shape (L,)
         Table 1's block per lane (``NO_RESET``, ``RESET_THRUST`` or
         ``RESET_ELEVONS``), rewritten in place.
     """
+    if scheme.detection.source == RESETS_SIDE_MONITOR:
+        for l in range(block.shape[0]):
+            block[l] = DECISION_BLOCK[st.mnow[l]]
+        return
     if scheme.reconfig.kind < LOCK_TURN:
         return
     for l in range(block.shape[0]):

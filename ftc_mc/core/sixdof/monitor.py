@@ -74,7 +74,8 @@ throttle moves the airspeed and the load factors.
 **Test.**  The windowed GLR of :mod:`ftc_mc.core.shared.glr` on each ``d_j``
 (Willsky & Jones 1976, with the one-step signature above in place of their
 full signature over the window).  When the largest statistic passes the
-threshold, after the start-up, the monitor decides direction ``j``: it
+threshold (the design's, ``Detection.side_threshold``: a design may set its
+own, ``monitor_threshold``), after the start-up, the monitor decides direction ``j``: it
 resets that actuator's block (``b0_j``, ``b1_j``: no correlation, variance
 ``reset_var``) and restarts every window.  The first decision at or after the
 switch step and its step are recorded, and the decisions before it and in all
@@ -112,7 +113,6 @@ SideMonitor = namedtuple("SideMonitor", [
     "Q",          # (n, n) process noise covariance of X (diagonal but a gust block)
     "r",          # (m,) measurement noise variances (diagonal)
     "reset_var",  # (6,) variance of each fault parameter after its block's reset
-    "threshold",  # GLR threshold on each direction's statistic
     "window",     # GLR window [steps] (LaneState.mbuf's rows)
     "min_window", # shortest change tested [steps]
     "startup",    # steps from the start before a decision may be made
@@ -618,12 +618,14 @@ def monitor_start(mon, k, st):
 
 
 @kernel(inline="always")
-def monitor_decide(mon, flight, k, st, work, rec, num, den, names):
+def monitor_decide(mon, flight, k, st, work, rec, num, den, names, threshold):
     """After the update: the projection of the fault parameters, the windowed
-    GLR of each direction, the decisions with their resets, and the record;
+    GLR of each direction, the decisions with their resets (this step's in
+    ``st.mnow``, the latest in ``st.mlast``), and the record;
     with ``names`` (every design but a ``lock_turn_selected`` one, whose
     selection sets them) the first elevon named is kept in ``st.mside`` and
-    the step in ``st.mturn``."""
+    the step in ``st.mturn``.  ``threshold``: the design's GLR threshold
+    (``Detection.side_threshold``)."""
     x = st.mx
     P = st.mP
     n = x.shape[0]
@@ -642,21 +644,27 @@ def monitor_decide(mon, flight, k, st, work, rec, num, den, names):
     for d in range(nd):
         for l in range(L):
             innov[d, l] = num[d, l] / np.sqrt(den[d, l]) if den[d, l] > 0.0 else 0.0
+    if k < rec.hist_mon.shape[0]:  # a kept history (recorded signals)
+        for d in range(nd):
+            for l in range(L):
+                rec.hist_mon[k, d, l] = innov[d, l]
     stat = np.empty((nd, L))
     kn = k + 1
     if kn <= mon.startup:
         for l in range(L):
             st.mcount[l] = 0
+            st.mnow[l] = 0
         return
     glr_lanes(innov, st.mbuf, st.mcount, k, mon.min_window, np.inf, stat)
     block = np.zeros(L, dtype=np.int64)
     for l in range(L):
-        best = mon.threshold
+        best = threshold
         for d in range(nd):
             if stat[d, l] > best:
                 best = stat[d, l]
                 block[l] = d + 1
         b = block[l]
+        st.mnow[l] = b
         if b == 0:
             continue
         for pidx in (ns + b - 1, ns + nu + b - 1):
@@ -712,7 +720,8 @@ def sixdof_monitor(plant, scheme, flight, k, st, work, rec):
         measurements of ``k + 1``.
     rec : TrialRecord
         ``side_k``, ``side_block``, ``side_pre``, ``side_n`` (on live lanes), ``mon_b``
-        (module docstring).
+        (module docstring); while a history is kept, ``hist_mon`` row ``k``:
+        each direction's projection, the GLR's input.
     """
     mon = flight.plant.monitor
     if mon.on == 0:
@@ -722,7 +731,7 @@ def sixdof_monitor(plant, scheme, flight, k, st, work, rec):
     num, den = monitor_start(mon, k, st)
     trim_filter(mon, flight.plant, st.mx, st.mP, work.u, work.z, st.lat, num, den)
     monitor_decide(mon, flight, k, st, work, rec, num, den,
-                   scheme.reconfig.kind != SELECTED_TURN)
+                   scheme.reconfig.kind != SELECTED_TURN, scheme.detection.side_threshold)
 
 
 @kernel(internal=True)
@@ -736,4 +745,4 @@ def sixdof_monitor_extended(plant, scheme, flight, k, st, work, rec):
     num, den = monitor_start(mon, k, st)
     extended_filter(mon, flight.plant, st.mx, st.mP, work.u, work.z, st.lat, num, den)
     monitor_decide(mon, flight, k, st, work, rec, num, den,
-                   scheme.reconfig.kind != SELECTED_TURN)
+                   scheme.reconfig.kind != SELECTED_TURN, scheme.detection.side_threshold)
