@@ -651,10 +651,15 @@ def side_blocks_ref(kind, mside, mlast, block, source=0, mnow=None):
     (``mlast``: 1 the throttle, 2 and 3 the elevons; 0 none: Table 1's
     stays).  With resets from the monitor (``source`` 1) every lane resets
     the block of the monitor's decision at this step (``mnow``; 0: none),
-    whatever Table 1 and the kind.  Returns the new blocks."""
+    whatever Table 1 and the kind; with ``source`` 2 (either) the lanes
+    where it decided nothing keep the rule above.  Returns the new blocks."""
     out = np.array(block, copy=True)
-    if source == 1:
-        return np.array([0 if m == 0 else 1 if m == 1 else 2 for m in mnow], dtype=np.int64)
+    if source in (1, 2):
+        monitor = np.array([0 if m == 0 else 1 if m == 1 else 2 for m in mnow], dtype=np.int64)
+        if source == 1:
+            return monitor
+        rest = side_blocks_ref(kind, mside, mlast, block)
+        return np.where(monitor != 0, monitor, rest)
     if kind < 2:  # lock_turn (2) and lock_turn_selected (3) only
         return out
     for l in range(len(out)):

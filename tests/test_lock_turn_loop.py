@@ -100,7 +100,7 @@ def test_side_blocks_match_their_twin():
     ``lock_turn`` design's move."""
     from collections import namedtuple
 
-    from ftc_mc.conventions import RESETS_SIDE_MONITOR, RESETS_TABLE1
+    from ftc_mc.conventions import RESETS_EITHER, RESETS_SIDE_MONITOR, RESETS_TABLE1
     from ftc_mc.core.shared.paths import SIXDOF_PLANT
     from ftc_mc.core.sixdof.lockturn import LOCK_TURN, side_blocks
 
@@ -114,7 +114,7 @@ def test_side_blocks_match_their_twin():
     now = np.resize(np.array([0, 1, 2, 3], dtype=np.int64), grid.shape[1])
     st = State(mside=grid[1].copy(), mlast=grid[2].copy(), mnow=now[::-1].copy())
     moved = 0
-    for source in (RESETS_TABLE1, RESETS_SIDE_MONITOR):
+    for source in (RESETS_TABLE1, RESETS_SIDE_MONITOR, RESETS_EITHER):
         for kind in (0, 1, LOCK_TURN):
             block = grid[0].copy()
             side_blocks(SIXDOF_PLANT, Scheme(Det(source), Reconfig(kind)), st, block)
@@ -124,8 +124,10 @@ def test_side_blocks_match_their_twin():
                 moved += int((block != grid[0]).sum())
                 if kind != LOCK_TURN:
                     np.testing.assert_array_equal(block, grid[0])
-            else:  # the monitor's decision alone, whatever Table 1 and the kind
+            elif source == RESETS_SIDE_MONITOR:  # the monitor's alone, whatever Table 1
                 np.testing.assert_array_equal(block != 0, st.mnow != 0)
+            else:  # either: a reset wherever one of them decides
+                np.testing.assert_array_equal(block != 0, (st.mnow != 0) | (grid[0] != 0))
     assert moved > 0
     # the decision codes follow the monitor's directions, named as the
     # longitudinal commands

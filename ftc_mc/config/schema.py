@@ -207,13 +207,13 @@ def _check_lock_turn(cfg, runs) -> None:
     for it."""
     for r in runs:
         dc = cfg.designs.get(r)
-        if dc is not None and dc.resets == "side_monitor":
+        if dc is not None and dc.resets != "table1":
             if cfg.plant.dof != 6:
-                raise ValueError(f"designs.{r}.resets: side_monitor reads the 6-DOF "
+                raise ValueError(f"designs.{r}.resets: {dc.resets} reads the 6-DOF "
                                  f"plant's side monitor (plant.dof: 6), got plant.dof "
                                  f"{cfg.plant.dof}")
             if not cfg.monitor.enabled:
-                raise ValueError(f"designs.{r}.resets: side_monitor reads the side "
+                raise ValueError(f"designs.{r}.resets: {dc.resets} reads the side "
                                  "monitor, but monitor.enabled is false")
     for r in runs:
         kind = cfg.controller_of(r)
@@ -711,7 +711,7 @@ class DesignConfig(_Strict):
     signature: Literal["paper", "swapped"] = "swapped"
     """Table 1 as printed (paper) or with its third clause swapped."""
     resets: Literal[RESETS_NAMES] = "table1"
-    """What resets the blocks: table1 (Table 1) or side_monitor (the 6-DOF side monitor; docs/reference/config.md#detection-designs)."""
+    """What resets the blocks: table1, side_monitor (6-DOF) or either of them (docs/reference/config.md#detection-designs)."""
     monitor_threshold: Pos | None = None
     """The 6-DOF side monitor's GLR threshold on this design's flights; null: monitor.threshold."""
     t_q: Pos = 25.0

@@ -131,8 +131,10 @@ reads the turn as a thrust change; the monitor reads roll and pitch together
 ``Detection.source``; any controller).  The monitor then decides *when* as
 well: at each step it names an actuator (``LaneState.mnow``) the
 longitudinal filter resets that actuator's block, and Table 1's decisions
-are dropped (``docs/findings/sixdof-monitor-resets.md``).  The design's
-settle and start-up rules still apply after it.
+are dropped (``docs/findings/sixdof-monitor-resets.md``).  With ``resets:
+either`` a step the monitor names no actuator keeps Table 1's decision (moved
+as above in a ``lock_turn`` design).  The design's settle and start-up rules
+still apply after it.
 
 Plain-NumPy twins: ``tests/naive_sixdof.py::lock_turn_law_ref``,
 ``rocking_law_ref``, ``guarded_law_ref``, ``turn_probe_ref``, ``side_blocks_ref``.
@@ -145,7 +147,7 @@ from collections import namedtuple
 
 import numpy as np
 
-from ...conventions import LONGITUDINAL, NO_RESET, RESETS_SIDE_MONITOR
+from ...conventions import LONGITUDINAL, NO_RESET, RESETS_SIDE_MONITOR, RESETS_TABLE1
 from ..jit import kernel
 from ..shared.excitation import signal_3211, signal_3211_length
 from .kinds import LOCK_TURN, SELECTED_TURN  # noqa: F401 -- the kinds, by their module
@@ -538,7 +540,8 @@ def side_blocks(plant, scheme, st, block):
     (module docstring, "Which block the paper's filter resets"); other
     designs' are left alone.  A design whose resets come from the monitor
     (``scheme.detection.source``) resets the block of this step's decision
-    instead, whatever its controller ("Resets from the monitor").
+    instead, whatever its controller; with ``either``, Table 1's where the
+    monitor decides nothing ("Resets from the monitor").
 
     Parameters
     ----------
@@ -546,7 +549,7 @@ def side_blocks(plant, scheme, st, block):
         The path's plant marker (the dispatcher's calling convention).
     scheme : Scheme
         ``detection.source`` (``RESETS_SIDE_MONITOR``: the monitor decides
-        when and which), ``reconfig.kind`` (:data:`LOCK_TURN` or
+        when and which; ``RESETS_EITHER``: it does where it decides), ``reconfig.kind`` (:data:`LOCK_TURN` or
         :data:`SELECTED_TURN`: the monitor decides the block).
     st : LaneState
         ``mside`` (the elevon the lane flies the law about, if > 0),
@@ -556,13 +559,17 @@ def side_blocks(plant, scheme, st, block):
         Table 1's block per lane (``NO_RESET``, ``RESET_THRUST`` or
         ``RESET_ELEVONS``), rewritten in place.
     """
-    if scheme.detection.source == RESETS_SIDE_MONITOR:
-        for l in range(block.shape[0]):
-            block[l] = DECISION_BLOCK[st.mnow[l]]
-        return
-    if scheme.reconfig.kind < LOCK_TURN:
+    source = scheme.detection.source
+    turn = scheme.reconfig.kind >= LOCK_TURN
+    if source == RESETS_TABLE1 and not turn:
         return
     for l in range(block.shape[0]):
-        named = st.mside[l] if st.mside[l] > 0 else st.mlast[l]
-        if block[l] != NO_RESET and named != 0:
-            block[l] = DECISION_BLOCK[named]
+        now = st.mnow[l] if source != RESETS_TABLE1 else 0
+        if now != 0:
+            block[l] = DECISION_BLOCK[now]
+        elif source == RESETS_SIDE_MONITOR:
+            block[l] = NO_RESET
+        elif turn and block[l] != NO_RESET:
+            named = st.mside[l] if st.mside[l] > 0 else st.mlast[l]
+            if named != 0:
+                block[l] = DECISION_BLOCK[named]
