@@ -291,9 +291,9 @@ class SideMonitorRef:
     ``y0``, ``dt``).
     """
 
-    def __init__(self, mon, k_fault, plant=None, threshold=30.0):
+    def __init__(self, mon, k_fault, plant=None, thresholds=(30.0, 30.0, 30.0)):
         self.mon, self.kf, self.plant = mon, k_fault, plant
-        self.threshold = threshold  # the design's GLR threshold
+        self.thresholds = np.asarray(thresholds, dtype=float)  # the design's, per direction
         n = mon.P0.shape[0]
         self.X, self.P = np.zeros(n), np.zeros((n, n))
         self.hist = []  # direction projections since the last restart, oldest first
@@ -354,8 +354,9 @@ class SideMonitorRef:
         self.hist = (self.hist + [d])[-mon.window:]
         stat = glr_ref(self.hist[::-1], mon.min_window)  # three directions
         block = 0
-        if stat.max() > self.threshold:
-            block = int(np.argmax(stat)) + 1
+        passing = stat > self.thresholds  # then the largest factor above its threshold
+        if passing.any():
+            block = int(np.argmax(np.where(passing, stat / self.thresholds, 0.0))) + 1
             for i in (ns + block - 1, ns + nu + block - 1):
                 self.P[i, :] = 0.0
                 self.P[:, i] = 0.0

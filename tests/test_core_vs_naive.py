@@ -48,7 +48,7 @@ def table1(r_q, r_nx, r_nz, t_q, t_nx, swapped):
     res = np.array([[r_q], [r_nx], [r_nz]], dtype=float)
     det = Detection(thresholds=thresholds_of(t_q, t_nx), table=decision_table(VARIANTS[swapped]),
                     reset_var=np.ones(5), test=0, window=1, min_window=1, clip=np.inf, settle=0,
-                    startup=0, source=0, side_threshold=np.inf)
+                    startup=0, source=0, side_thresholds=np.full(3, np.inf))
     block = np.zeros(1, dtype=np.int64)
     ks.signature_lanes(res, det, block)
     return block[0]

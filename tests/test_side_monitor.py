@@ -117,7 +117,7 @@ def run_kernel(setup, mon, st, rec, u, z, k, threshold=None):
     scheme = setup.scheme("paper")
     if threshold is not None:
         scheme = scheme._replace(
-            detection=scheme.detection._replace(side_threshold=threshold))
+            detection=scheme.detection._replace(side_thresholds=np.full(3, threshold)))
     flight = setup.flight._replace(plant=setup.truth._replace(monitor=mon))
     work = new_trial_work(L, 14)
     nz = work.z.shape[0]
@@ -162,7 +162,7 @@ def test_monitor_matches_its_twin(setup):
     # fault-free one and the stopped one are compared (the others repeat a fault)
     compared = (0, 1, 2, 5, L - 1) if mon.nonlinear == EXTENDED else tuple(range(L))
     refs = {l: SideMonitorRef(mon, setup.tim.k_fault, setup.truth,
-                              setup.scheme("paper").detection.side_threshold)
+                              setup.scheme("paper").detection.side_thresholds)
             for l in compared}
     # relative errors in the norm: the order of the sums differs; the extended
     # filter's forward differences (step 1e-6) turn the rounding of two

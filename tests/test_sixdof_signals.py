@@ -20,14 +20,15 @@ from ftc_mc.core.sixdof.layout import MONITOR_DIRECTIONS
 from ftc_mc.errors import UserError
 from golden_cases import CAMPAIGNS
 
-THRESHOLD = 12.0
-"""The monitored design's own monitor threshold: below the run's (30), so that
-it decides often, false decisions included."""
+THRESHOLD, THROTTLE = 12.0, 20.0
+"""The monitored design's own monitor thresholds (elevons, throttle): below the
+run's (30), so that it decides often, false decisions included."""
 
 CFG = copy.deepcopy(CAMPAIGNS["sixdof_moderate"])  # the golden case's path, compiled there
 CFG["campaign"].update(signature="paper", designs=["monitored"])
 CFG["designs"] = {"monitored": {"signature": "paper", "resets": "side_monitor",
-                                "monitor_threshold": THRESHOLD}}
+                                "monitor_threshold": THRESHOLD,
+                                "monitor_throttle_threshold": THROTTLE}}
 
 
 @pytest.fixture(scope="module")
@@ -45,7 +46,7 @@ def _offline(recorded):
     steps = lambda s: int(round(s / dt))  # noqa: E731
     out = {}
     for name, design, ids, sig, _ in batches(recorded, columns=MONITOR_COLUMNS):
-        thr = THRESHOLD if design == "monitored" else mc.threshold
+        thr = [THROTTLE, THRESHOLD, THRESHOLD] if design == "monitored" else mc.threshold
         dec = side_monitor_decisions(sig, steps(mc.window_s), steps(mc.min_window_s), thr,
                                      steps(mc.startup_s))
         for i, tid in enumerate(ids):

@@ -795,7 +795,7 @@ def table1_detector(variant: str = "paper", t_q: float | None = None,
     return table1
 
 
-def side_monitor_decisions(d: np.ndarray, window: int, min_window: int, threshold: float,
+def side_monitor_decisions(d: np.ndarray, window: int, min_window: int, thresholds,
                            startup: int) -> np.ndarray:
     """The 6-DOF side monitor's decisions re-run on its recorded projections.
 
@@ -804,9 +804,10 @@ def side_monitor_decisions(d: np.ndarray, window: int, min_window: int, threshol
     order of sums, so that it decides bit for bit as the closed loop did: each
     step appends the projections to a window of the last ``window`` steps; each
     direction's statistic is ``max_m (sum of its newest m) ** 2 / m`` over
-    ``min_window <= m <=`` the window's length; the direction whose statistic
-    is largest, if above ``threshold``, is decided, and the window restarts.
-    Until the step ``startup`` the window stays empty.
+    ``min_window <= m <=`` the window's length; of the directions whose
+    statistic passes its threshold, the one passing it by the largest factor
+    is decided (the first of equal ones), and the window restarts.  Until the
+    step ``startup`` the window stays empty.
 
     Parameters
     ----------
@@ -816,8 +817,8 @@ def side_monitor_decisions(d: np.ndarray, window: int, min_window: int, threshol
     window, min_window, startup : int
         The monitor's GLR window, shortest change and start-up [steps]
         (``monitor`` section).
-    threshold : float
-        The design's monitor threshold.
+    thresholds : float or array_like, shape (3,)
+        The design's monitor threshold of each direction (one: all alike).
 
     Returns
     -------
@@ -827,6 +828,7 @@ def side_monitor_decisions(d: np.ndarray, window: int, min_window: int, threshol
     """
     d = np.asarray(d, dtype=np.float64)
     n, steps, nd = d.shape
+    thr = np.broadcast_to(np.asarray(thresholds, dtype=np.float64), (nd,))
     buf = np.zeros((n, window, nd))  # newest first
     count = np.zeros(n, dtype=np.int64)
     m = np.arange(1, window + 1, dtype=np.float64)
@@ -841,14 +843,17 @@ def side_monitor_decisions(d: np.ndarray, window: int, min_window: int, threshol
         g = acc * acc / m[None, :, None]
         valid = (m[None, :] <= count[:, None]) & (m[None, :] >= min_window)
         stat = np.where(valid[..., None], g, 0.0).max(axis=1)  # (n, nd)
-        best = np.argmax(stat, axis=1)  # the first of equal ones, as the kernel
-        hit = stat[np.arange(n), best] > threshold
+        passing = stat > thr
+        factor = np.where(passing, stat / thr, 0.0)
+        best = np.argmax(factor, axis=1)  # the first of equal ones, as the kernel
+        hit = passing.any(axis=1)
         out[hit, j] = best[hit] + 1
         count[hit] = 0
     return out
 
 
-def side_monitor_detector(threshold: float | None = None):
+def side_monitor_detector(threshold: float | None = None,
+                          throttle_threshold: float | None = None):
     """The 6-DOF side monitor as a detector of recorded signals (open loop): its
     first decision, naming the actuator (``engine``, ``left_elevon``,
     ``right_elevon``), from the projections recorded on the 6-DOF plant
@@ -861,11 +866,15 @@ def side_monitor_detector(threshold: float | None = None):
     ----------
     threshold : float, optional
         The GLR threshold (default: ``monitor.threshold``'s default).
+    throttle_threshold : float, optional
+        The throttle direction's (default: ``threshold``).
     """
     from ..config.schema import MonitorConfig
     from .signals import MONITOR_COLUMNS
     mc = MonitorConfig()
-    thr = mc.threshold if threshold is None else float(threshold)
+    one = mc.threshold if threshold is None else float(threshold)
+    thr = np.array([one if throttle_threshold is None or c != "throttle"
+                    else float(throttle_threshold) for c in LAY.inputs])
 
     def side_monitor(signals, names, dt):
         steps = lambda s: int(round(s / dt))  # noqa: E731

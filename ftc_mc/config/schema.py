@@ -24,8 +24,8 @@ from pydantic import (AfterValidator, BaseModel, BeforeValidator, ConfigDict, Fi
 
 from ..conventions import (ACTUATOR_NAMES, BIASED_OUTPUTS, EXCITATION_POLICIES,
                            KIND_TRANSITIONS, KINDS_BEYOND, MAX_DELAY_STEPS, OUTPUT_NAMES,
-                           PLANT_KINDS, RESETS_NAMES, S3211_UNITS, SENSOR_FAULT_KINDS, SENSOR_PREFIX,
-                           STATE_NAMES, TRANSITIONS, TURBULENCE_LEVELS)
+                           PLANT_KINDS, RESETS_NAMES, S3211_UNITS, SENSOR_FAULT_KINDS,
+                           SENSOR_PREFIX, STATE_NAMES, TRANSITIONS, TURBULENCE_LEVELS)
 from ..errors import UserError
 from ..model.source import (DEFAULT_AIRFRAME, check_airframe, check_condition,
                             is_linear_model)
@@ -714,6 +714,8 @@ class DesignConfig(_Strict):
     """What resets the blocks: table1, side_monitor (6-DOF) or either of them (docs/reference/config.md#detection-designs)."""
     monitor_threshold: Pos | None = None
     """The 6-DOF side monitor's GLR threshold on this design's flights; null: monitor.threshold."""
+    monitor_throttle_threshold: Pos | None = None
+    """Its threshold on the throttle's direction; null: as the elevons' (docs/reference/config.md#the-side-monitor)."""
     t_q: Pos = 25.0
     """Threshold on r_q (Table 1)."""
     t_nx: Pos = 25.0

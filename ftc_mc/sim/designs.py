@@ -74,8 +74,9 @@ import numpy as np
 import scipy.linalg
 
 from ..config.schema import BUILTIN_DESIGNS, DesignConfig, EstimatorConfig
-from ..conventions import (EXCITATION_POLICIES, EXCITE_NONE, OUTPUT_NAMES, RESET_ELEVONS,
-                           RESETS_NAMES, RESET_THRUST, STATE_NAMES, TEST_GLR, TEST_NAMES, TEST_ONE_STEP)
+from ..conventions import (EXCITATION_POLICIES, EXCITE_NONE, LONGITUDINAL, OUTPUT_NAMES,
+                           RESET_ELEVONS, RESETS_NAMES, RESET_THRUST, STATE_NAMES, TEST_GLR,
+                           TEST_NAMES, TEST_ONE_STEP)
 from ..core.longitudinal.settings import Detection, FilterModel
 from ..model.linear import LinearPlant
 from ..model.turbulence import dryden_model
@@ -234,6 +235,17 @@ def _c(a) -> np.ndarray:
     return np.ascontiguousarray(a, dtype=np.float64)
 
 
+def monitor_thresholds(dc: DesignConfig, run_threshold: float) -> np.ndarray:
+    """The side monitor's GLR threshold of each direction (the commands' order:
+    throttle, left, right elevon) on the flights of the design ``dc``: its
+    ``monitor_threshold`` (else the run's ``run_threshold``), the throttle's
+    ``monitor_throttle_threshold`` where it sets one."""
+    thr = float(run_threshold if dc.monitor_threshold is None else dc.monitor_threshold)
+    throttle = (thr if dc.monitor_throttle_threshold is None
+                else float(dc.monitor_throttle_threshold))
+    return np.array([throttle if c == "throttle" else thr for c in LONGITUDINAL.inputs])
+
+
 def build_design(name: str, dc: DesignConfig, plant: LinearPlant, est: EstimatorConfig,
                  altitude_m: float, monitor_threshold: float = math.inf) -> Design:
     """The kernel settings of the design ``dc``.
@@ -297,8 +309,7 @@ def build_design(name: str, dc: DesignConfig, plant: LinearPlant, est: Estimator
         settle=int(round(dc.settle_s / plant.dt)), startup=int(round(dc.startup_s / plant.dt)),
         clip=math.inf if dc.innovation_clip is None else float(dc.innovation_clip),
         source=RESETS_NAMES.index(dc.resets),
-        side_threshold=float(monitor_threshold if dc.monitor_threshold is None
-                             else dc.monitor_threshold))
+        side_thresholds=monitor_thresholds(dc, monitor_threshold))
     # every field but those Table 1 reads only when it decides (a shared start runs
     # with resets disabled); the excitation policy's are in: it flies before any reset
     key = dc.model_dump_json(exclude={"signature", "t_q", "t_nx"})

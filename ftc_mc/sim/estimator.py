@@ -19,7 +19,7 @@ import math
 import numpy as np
 
 from ..config.schema import EstimatorConfig
-from ..conventions import LONGITUDINAL, N_AUG, RESETS_TABLE1, TEST_ONE_STEP, VARIANTS
+from ..conventions import LONGITUDINAL, N_AUG, N_U, RESETS_TABLE1, TEST_ONE_STEP, VARIANTS
 from ..core.longitudinal.settings import (Belief, Detection, FilterModel, decision_table,
                                           thresholds_of)
 from ..model.faults import bias_matrix, fault_bounds
@@ -151,7 +151,7 @@ def detection(plant: LinearPlant, s: EstimatorSettings) -> Detection:
     return Detection(thresholds=thresholds_of(s.t_q, s.t_nx),
                      table=decision_table(s.signature), reset_var=reset_var,
                      test=TEST_ONE_STEP, window=1, min_window=1, clip=math.inf, settle=0,
-                     startup=0, source=RESETS_TABLE1, side_threshold=math.inf)
+                     startup=0, source=RESETS_TABLE1, side_thresholds=np.full(N_U, math.inf))
 
 
 def belief_settings(plant: LinearPlant, s: EstimatorSettings) -> Belief:

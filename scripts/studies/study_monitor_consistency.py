@@ -229,7 +229,8 @@ def kernel_projections(setup, mon, u, z):
     rec = new_record(setup, lanes, 4)
     rec.side_k[:] = -1
     scheme = setup.scheme("paper")  # its monitor with no test
-    scheme = scheme._replace(detection=scheme.detection._replace(side_threshold=np.inf))
+    scheme = scheme._replace(
+        detection=scheme.detection._replace(side_thresholds=np.full(3, np.inf)))
     flight = setup.flight._replace(plant=setup.truth._replace(monitor=mon))
     work = new_trial_work(lanes, 14)
     nz = work.z.shape[0]

@@ -71,8 +71,9 @@ _DetectionFields = namedtuple("Detection", [
     "source",     # conventions.RESETS_TABLE1 (Table 1 decides) or RESETS_SIDE_MONITOR
                   # (the 6-DOF side monitor's decisions reset its actuator's block:
                   # core/sixdof/lockturn.py::side_blocks; DesignConfig.resets)
-    "side_threshold",  # the 6-DOF side monitor's GLR threshold on this design's lanes
-                       # (DesignConfig.monitor_threshold, else monitor.threshold)
+    "side_thresholds",  # (3,) the 6-DOF side monitor's GLR threshold of each direction
+                        # (throttle, left, right elevon) on this design's lanes
+                        # (sim/designs.py::monitor_thresholds)
 ])
 
 

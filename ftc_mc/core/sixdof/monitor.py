@@ -74,8 +74,10 @@ throttle moves the airspeed and the load factors.
 **Test.**  The windowed GLR of :mod:`ftc_mc.core.shared.glr` on each ``d_j``
 (Willsky & Jones 1976, with the one-step signature above in place of their
 full signature over the window).  When the largest statistic passes the
-threshold (the design's, ``Detection.side_threshold``: a design may set its
-own, ``monitor_threshold``), after the start-up, the monitor decides direction ``j``: it
+threshold (the design's, ``Detection.side_thresholds``: a design may set its
+own, ``monitor_threshold``, and the throttle's apart), after the start-up,
+the monitor decides direction ``j`` (of several, the one passing its
+threshold by the largest factor): it
 resets that actuator's block (``b0_j``, ``b1_j``: no correlation, variance
 ``reset_var``) and restarts every window.  The first decision at or after the
 switch step and its step are recorded, and the decisions before it and in all
@@ -618,14 +620,16 @@ def monitor_start(mon, k, st):
 
 
 @kernel(inline="always")
-def monitor_decide(mon, flight, k, st, work, rec, num, den, names, threshold):
+def monitor_decide(mon, flight, k, st, work, rec, num, den, names, thresholds):
     """After the update: the projection of the fault parameters, the windowed
     GLR of each direction, the decisions with their resets (this step's in
     ``st.mnow``, the latest in ``st.mlast``), and the record;
     with ``names`` (every design but a ``lock_turn_selected`` one, whose
     selection sets them) the first elevon named is kept in ``st.mside`` and
-    the step in ``st.mturn``.  ``threshold``: the design's GLR threshold
-    (``Detection.side_threshold``)."""
+    the step in ``st.mturn``.  ``thresholds``: the design's GLR threshold of
+    each direction (``Detection.side_thresholds``); of the directions whose
+    statistic passes its threshold, the one passing it by the largest factor
+    is decided (the first of equal ones)."""
     x = st.mx
     P = st.mP
     n = x.shape[0]
@@ -658,10 +662,11 @@ def monitor_decide(mon, flight, k, st, work, rec, num, den, names, threshold):
     glr_lanes(innov, st.mbuf, st.mcount, k, mon.min_window, np.inf, stat)
     block = np.zeros(L, dtype=np.int64)
     for l in range(L):
-        best = threshold
+        best = 0.0  # the largest factor by which a statistic passes its threshold
         for d in range(nd):
-            if stat[d, l] > best:
-                best = stat[d, l]
+            t = thresholds[d]
+            if stat[d, l] > t and stat[d, l] / t > best:
+                best = stat[d, l] / t
                 block[l] = d + 1
         b = block[l]
         st.mnow[l] = b
@@ -731,7 +736,7 @@ def sixdof_monitor(plant, scheme, flight, k, st, work, rec):
     num, den = monitor_start(mon, k, st)
     trim_filter(mon, flight.plant, st.mx, st.mP, work.u, work.z, st.lat, num, den)
     monitor_decide(mon, flight, k, st, work, rec, num, den,
-                   scheme.reconfig.kind != SELECTED_TURN, scheme.detection.side_threshold)
+                   scheme.reconfig.kind != SELECTED_TURN, scheme.detection.side_thresholds)
 
 
 @kernel(internal=True)
@@ -745,4 +750,4 @@ def sixdof_monitor_extended(plant, scheme, flight, k, st, work, rec):
     num, den = monitor_start(mon, k, st)
     extended_filter(mon, flight.plant, st.mx, st.mP, work.u, work.z, st.lat, num, den)
     monitor_decide(mon, flight, k, st, work, rec, num, den,
-                   scheme.reconfig.kind != SELECTED_TURN, scheme.detection.side_threshold)
+                   scheme.reconfig.kind != SELECTED_TURN, scheme.detection.side_thresholds)
