@@ -64,7 +64,9 @@ def rows(trials: int, seed: int, jobs: int, over: dict):
     cfg = campaign_config(CONFIG, trials=trials, seed=seed, **over)
     res = run_campaign(cfg, jobs=jobs, progress=False)
     s, t = res.summary, res.trials
-    band = survival_table(t, cfg.timing.fault_time_s, cfg.timing.duration_s, edges=(-5.0, 2.0))
+    band = survival_table(t, cfg.timing.fault_time_s, cfg.timing.duration_s,
+                          edges=(-np.inf, -5.0, 2.0, np.inf))
+    band = band[band["offset_lo_deg"] == -5.0]  # the locks from -5 to +2 deg of trim
     out = {}
     for design, g in s.groupby("variant", sort=False):
         unexplained = g["no_reset_rate"] * (1.0 - g["no_reset_explained_share"].fillna(0.0))
