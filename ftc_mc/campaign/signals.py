@@ -22,7 +22,9 @@ Measured signals, commands, innovations, fault values and the belief are
 innovations unit-variance) is far above float32's 6e-8 relative rounding.  The
 decision statistics ``r_q, r_nx, r_nz`` stay ``float64``, so that Table 1
 re-run offline on them compares with the same thresholds bit for bit
-(:func:`ftc_mc.detectors.table1_offline`).
+(:func:`ftc_mc.campaign.detector.table1_detector`); on the 6-DOF plant the
+side monitor's projections are float64 too, for its decisions re-run offline
+(:func:`ftc_mc.campaign.detector.side_monitor_decisions`).
 """
 
 from __future__ import annotations
