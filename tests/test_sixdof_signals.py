@@ -12,7 +12,7 @@ import pytest
 
 import ftc_mc
 from ftc_mc.campaign.detector import batches, side_monitor_decisions, side_monitor_detector
-from ftc_mc.campaign.signals import (KEYS, LATERAL_COLUMNS, MONITOR_COLUMNS, signal_columns,
+from ftc_mc.campaign.signals import (KEYS, lateral_columns, monitor_columns, signal_columns,
                                      signal_files)
 from ftc_mc.config.schema import MonitorConfig
 from ftc_mc.conventions import LONGITUDINAL as LAY
@@ -45,7 +45,7 @@ def _offline(recorded):
     mc = MonitorConfig()
     steps = lambda s: int(round(s / dt))  # noqa: E731
     out = {}
-    for name, design, ids, sig, _ in batches(recorded, columns=MONITOR_COLUMNS):
+    for name, design, ids, sig, _ in batches(recorded, columns=monitor_columns()):
         thr = [THROTTLE, THRESHOLD, THRESHOLD] if design == "monitored" else mc.threshold
         dec = side_monitor_decisions(sig, steps(mc.window_s), steps(mc.min_window_s), thr,
                                      steps(mc.startup_s))
@@ -58,11 +58,11 @@ def test_sixdof_signals_layout(recorded):
     files = signal_files(recorded)
     sig = pd.concat([pd.read_parquet(f) for f in files], ignore_index=True)
     assert tuple(sig.columns) == KEYS + signal_columns(sixdof=True)
-    assert set(LATERAL_COLUMNS) | set(MONITOR_COLUMNS) <= set(sig.columns)
+    assert set(lateral_columns()) | set(monitor_columns()) <= set(sig.columns)
     # the lateral sensors move in moderate gusts; the projections are the GLR's
     # float64 input (their statistics: tests/test_side_monitor.py)
     assert sig["z_phi"].std() > 0 and sig["z_p"].std() > 0
-    for c in MONITOR_COLUMNS:
+    for c in monitor_columns():
         assert sig[c].dtype == np.float64 and np.isfinite(sig[c]).all() and sig[c].std() > 0
 
 

@@ -870,7 +870,7 @@ def side_monitor_detector(threshold: float | None = None,
         The throttle direction's (default: ``threshold``).
     """
     from ..config.schema import MonitorConfig
-    from .signals import MONITOR_COLUMNS
+    from .signals import monitor_columns
     mc = MonitorConfig()
     one = mc.threshold if threshold is None else float(threshold)
     thr = np.array([one if throttle_threshold is None or c != "throttle"
@@ -878,7 +878,7 @@ def side_monitor_detector(threshold: float | None = None,
 
     def side_monitor(signals, names, dt):
         steps = lambda s: int(round(s / dt))  # noqa: E731
-        dec = side_monitor_decisions(signals[..., [names.index(c) for c in MONITOR_COLUMNS]],
+        dec = side_monitor_decisions(signals[..., [names.index(c) for c in columns]],
                                      steps(mc.window_s), steps(mc.min_window_s), thr,
                                      steps(mc.startup_s))
         fired = dec != 0
@@ -889,6 +889,7 @@ def side_monitor_detector(threshold: float | None = None,
         block = np.where(any_, np.array(("",) + LAY.actuators, dtype=object)[named], "")
         return alarm, block
 
-    side_monitor.columns = MONITOR_COLUMNS
+    columns = monitor_columns()
+    side_monitor.columns = columns
     side_monitor.__name__ = "side_monitor"
     return side_monitor

@@ -38,7 +38,6 @@ import pandas as pd
 from ..conventions import LONGITUDINAL as LAY
 from ..conventions import MODE_NAMES
 from ..core.longitudinal.workspace import EXC_3211, EXC_DOUBLET
-from ..core.sixdof.layout import MONITOR_DIRECTIONS, MONITOR_LATERAL
 from ..sim.inputs import Schedule, schedule_kinds
 
 FOLDER = "signals"
@@ -66,28 +65,35 @@ reads them only when it names them (:mod:`ftc_mc.campaign.detector`); every
 other signal column is observable on board."""
 
 
-LATERAL_COLUMNS = tuple(f"z_{o}" for o in MONITOR_LATERAL)
-"""The 6-DOF plant's lateral sensors (bank, side velocity, roll and yaw rates,
-heading; deviations from the 6-DOF trim)."""
+def lateral_columns() -> tuple:
+    """The 6-DOF plant's lateral sensors (bank, side velocity, roll and yaw
+    rates, heading; deviations from the 6-DOF trim).  The 6-DOF layout is
+    imported here, not with the module: a longitudinal run never imports the
+    6-DOF family (``tests/test_sixdof.py``)."""
+    from ..core.sixdof.layout import MONITOR_LATERAL
+    return tuple(f"z_{o}" for o in MONITOR_LATERAL)
 
-MONITOR_COLUMNS = tuple(f"side_d_{d}" for d in MONITOR_DIRECTIONS)
-"""The 6-DOF side monitor's projection of each fault direction (throttle, left,
-right elevon): standard normal under no fault, the input of its GLR
-(``ftc_mc/core/sixdof/monitor.py``)."""
+
+def monitor_columns() -> tuple:
+    """The 6-DOF side monitor's projection of each fault direction (throttle,
+    left, right elevon): standard normal under no fault, the input of its GLR
+    (``ftc_mc/core/sixdof/monitor.py``)."""
+    from ..core.sixdof.layout import MONITOR_DIRECTIONS
+    return tuple(f"side_d_{d}" for d in MONITOR_DIRECTIONS)
 
 
 def signal_columns(n_z: int = LAY.n_z, sixdof: bool = False) -> tuple:
     """Names of the signal columns of a signals row (after :data:`KEYS`), in file
     order (``docs/reference/outputs.md``); :data:`TRUTH_COLUMNS` among them.
     ``sixdof``: a recording on the 6-DOF plant with its side monitor, which
-    adds :data:`LATERAL_COLUMNS` and :data:`MONITOR_COLUMNS`."""
+    adds :func:`lateral_columns` and :func:`monitor_columns`."""
     outs = LAY.outputs if n_z == LAY.n_z else tuple(str(i) for i in range(n_z))
-    return (tuple(f"z_{o}" for o in outs) + (LATERAL_COLUMNS if sixdof else ())
+    return (tuple(f"z_{o}" for o in outs) + (lateral_columns() if sixdof else ())
             + tuple(f"u_{i}" for i in LAY.inputs)
             + TRUTH_COLUMNS + ("exc_doublet", "exc_3211")
             + innovation_names() + tuple(LAY.residuals) + ("reset",)
             + tuple(f"belief_{m}" for m in MODE_NAMES)
-            + (MONITOR_COLUMNS if sixdof else ()))
+            + (monitor_columns() if sixdof else ()))
 
 
 def is_truth(column: str) -> bool:
@@ -183,7 +189,7 @@ def signals_frame(tr_name: str, variant: str, trial_ids, inp, rec, k_fault: int,
         cols[f"belief_{nm}"] = bel[p + 1, m, lane].astype(f4)
     if sixdof:  # float64: the monitor's GLR re-run offline decides as it did
         mon = _rows(rec.hist_mon, keep)
-        for j, nm in enumerate(MONITOR_COLUMNS):
+        for j, nm in enumerate(monitor_columns()):
             cols[nm] = np.ascontiguousarray(mon[:, j], dtype=np.float64)
     return pd.DataFrame(cols)
 
