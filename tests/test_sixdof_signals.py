@@ -126,3 +126,26 @@ def test_monitor_resets_need_the_side_monitor(change, problem):
     cfg = {**copy.deepcopy(CFG), **change}
     with pytest.raises(UserError, match=r"designs\.monitored\.resets: side_monitor.*" + problem):
         campaign_config(cfg)
+
+
+def test_a_sweep_runs_monitor_designs_at_each_point_alone():
+    """At sweep thresholds no residual reaches, every Table 1 lane would share
+    its start; the monitored design's monitor still resets before the switch
+    (false decisions at its low thresholds), with the reset variances of the
+    point's thresholds: each point equals a campaign run at it."""
+    from ftc_mc.api import campaign_config
+    from ftc_mc.campaign.sweep import run_sweep, threshold_points
+
+    cfg = campaign_config(CFG)
+    points = threshold_points("1000000,4000000")
+    res = run_sweep(cfg, points, flights=2, jobs=1, progress=False)
+    for t, _ in points:
+        est = cfg.estimator.model_copy(update={"t_q": t, "t_nx": t})
+        design = cfg.designs["monitored"].model_copy(update={"t_q": t, "t_nx": t})
+        at = cfg.model_copy(update={"estimator": est, "designs": {"monitored": design}})
+        alone = ftc_mc.run_campaign(at, jobs=1, progress=False).trials
+        alone = alone[alone["variant"] == "monitored"].reset_index(drop=True)
+        shared = res.trials[(res.trials["t_q"] == t) & (res.trials["variant"] == "monitored")]
+        assert (alone["side_false"] > 0).any()  # monitor resets before the switch
+        pd.testing.assert_frame_equal(alone, shared.drop(columns=["t_q", "t_nx"])
+                                      .reset_index(drop=True), check_exact=True)

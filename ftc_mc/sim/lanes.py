@@ -17,8 +17,10 @@ Until its first reset a lane does not depend on the thresholds (the residuals
 are the same, and the initial covariance uses the paper's thresholds whatever
 is run, see ``ftc_mc/sim/setup.py``), so both ways give bit-identical records
 (``tests/test_sweep.py``).  A design whose resets come from the side monitor
-(``resets: side_monitor``) does not depend on the thresholds at all, and
-runs alone.
+(``resets: side_monitor`` or ``either``) runs alone at every point: a
+monitor reset in the shared start would open its block with the reset
+variances of the design's own thresholds, not the point's
+(``tests/test_sixdof_signals.py``).
 """
 
 from __future__ import annotations
@@ -174,7 +176,7 @@ def simulate(setup, inp: TrialInputs, runs, max_resets: int, k_share: int | None
     for i, (name, det) in enumerate(runs):
         if det.source == RESETS_TABLE1:
             groups.setdefault(setup.designs[name].key, []).append(i)
-        else:  # the monitor resets whatever the thresholds: nothing to share
+        else:  # the monitor resets before k_share too (lanes.py docstring)
             recs[i] = run_alone(setup, name, det, inp, max_resets)
             simulated += L * n
     for members in groups.values():

@@ -68,9 +68,10 @@ _DetectionFields = namedtuple("Detection", [
     "settle",     # steps after a reset during which the other block is not reset (0: none)
     "startup",    # steps from the start before the test is armed: no reset, GLR window
                   # kept empty (0: armed at once; DesignConfig.startup_s)
-    "source",     # conventions.RESETS_TABLE1 (Table 1 decides) or RESETS_SIDE_MONITOR
+    "source",     # conventions.RESETS_TABLE1 (Table 1 decides), RESETS_SIDE_MONITOR
                   # (the 6-DOF side monitor's decisions reset its actuator's block:
-                  # core/sixdof/lockturn.py::side_blocks; DesignConfig.resets)
+                  # core/sixdof/lockturn.py::side_blocks) or RESETS_EITHER (the
+                  # monitor's where it decides, else Table 1's; DesignConfig.resets)
     "side_thresholds",  # (3,) the 6-DOF side monitor's GLR threshold of each direction
                         # (throttle, left, right elevon) on this design's lanes
                         # (sim/designs.py::monitor_thresholds)

@@ -549,8 +549,9 @@ def side_blocks(plant, scheme, st, block):
         The path's plant marker (the dispatcher's calling convention).
     scheme : Scheme
         ``detection.source`` (``RESETS_SIDE_MONITOR``: the monitor decides
-        when and which; ``RESETS_EITHER``: it does where it decides), ``reconfig.kind`` (:data:`LOCK_TURN` or
-        :data:`SELECTED_TURN`: the monitor decides the block).
+        when and which; ``RESETS_EITHER``: it does where it decides) and
+        ``reconfig.kind`` (:data:`LOCK_TURN` or :data:`SELECTED_TURN`: the
+        monitor decides the block).
     st : LaneState
         ``mside`` (the elevon the lane flies the law about, if > 0),
         ``mlast`` (the monitor's latest decision, 0 none) and ``mnow``
