@@ -9,7 +9,8 @@ vector access over two cache lines.  Measured with ``filter_step_lanes`` at 96
 lanes: 1.68 M steps/s with the work arrays 64-byte aligned, 1.33 M with NumPy's
 default (16-byte) placement.  So every array here is 64-byte aligned, and with
 ``L`` a multiple of 8 every lane row is too; allocate the lane arrays of the
-state (``xa``, ``P``, ``u``, ``z``) with :func:`lane_zeros` for the same reason.
+state (``xa``, ``P``, ``u``, ``z``) with :func:`ftc_mc.sim.lanes.lane_zeros`, which
+the trial loop's lane state uses too, for the same reason.
 """
 
 from __future__ import annotations
@@ -20,32 +21,7 @@ import numpy as np
 
 from ftc_mc.conventions import N_AUG, N_FAULT, N_X, RESIDUAL_NAMES
 from ftc_mc.core.longitudinal.batch import step_rows
-
-ALIGN = 64
-"""Byte alignment of the arrays made here (one cache line, one AVX-512 vector)."""
-
-
-def lane_zeros(shape, dtype=np.float64) -> np.ndarray:
-    """A zeroed C-contiguous array whose data start on a 64-byte boundary.
-
-    Parameters
-    ----------
-    shape : int or tuple of int
-        Array shape, lane axis last.
-    dtype : data-type, optional
-        Element type (default float64).
-
-    Returns
-    -------
-    ndarray
-        A view into a slightly larger buffer, writeable, C-contiguous.
-    """
-    dtype = np.dtype(dtype)
-    n = int(np.prod(shape, dtype=np.int64))
-    buf = np.zeros(n * dtype.itemsize + ALIGN, dtype=np.uint8)
-    start = (-buf.ctypes.data) % ALIGN
-    return buf[start:start + n * dtype.itemsize].view(dtype).reshape(shape)
-
+from ftc_mc.sim.lanes import lane_zeros
 
 LaneWorkspace = namedtuple("LaneWorkspace", [
     "phi",    # (9, 5, L)             Phi(u) of each lane (predict)

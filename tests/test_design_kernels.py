@@ -26,12 +26,12 @@ from test_stages import (L, X_SCALE, _setup, assert_lanes, assert_loop_matches, 
                          random_cov, random_inputs, random_lanes, rel, trim_jacobians)
 from ftc_mc.conventions import N_AUG, N_X, RESET_ELEVONS, RESET_THRUST, TEST_GLR
 from ftc_mc.core.longitudinal import stages
-from ftc_mc.core.longitudinal import trial
 from ftc_mc.core.shared.glr import glr_lanes, glr_restart
 from ftc_mc.core.longitudinal.workspace import new_trial_work
 from ftc_mc.model.turbulence import dryden_model
 from ftc_mc.model.wind import plant_wind_matrices
 from ftc_mc.sim.inputs import flight_inputs
+from ftc_mc.sim import lanes
 from ftc_mc.sim.paths import path_of
 
 NG = 4
@@ -452,7 +452,7 @@ def test_relinearised_jacobians_are_exact(nonlinear_gusts):
 def test_relinearised_whole_loop(nonlinear_gusts):
     """12 steps of ``advance`` on the nonlinear plant in moderate turbulence with
     the extended filter re-linearised every 5 steps (from the trim Jacobians of
-    ``trial.init_jacobians``; steps 0, 5, 10 re-compute) and the one-step test,
+    ``sim.lanes.init_jacobians``; steps 0, 5, 10 re-compute) and the one-step test,
     against ``naive.advance_ref``; tolerances as
     :func:`test_relinearised_filter_update`."""
     fm, P0, d = extended(nonlinear_gusts, 5)
@@ -464,8 +464,8 @@ def test_relinearised_whole_loop(nonlinear_gusts):
     xa0 = np.zeros((N, L))
     xa0[:N_X] = 0.1 * X_SCALE[:, None] * rng.standard_normal((N_X, L))
     inp = inp._replace(xa0=xa0, P0=P0, g0=d.P0_chol @ rng.standard_normal((4, L)))
-    st0 = trial.new_state(L, N, 1, N_X, 0, 0, 0, 1)
-    trial.init_jacobians(fm, st0)
+    st0 = lanes.new_state(L, N, 1, N_X, 0, 0, 0, 1)
+    lanes.init_jacobians(fm, st0)
     for f, M in trim_jacobians(fm).items():
         assert np.array_equal(getattr(st0, f), M), f
     _, st = assert_loop_matches(scheme, flight, inp, n, 1e-7)

@@ -11,7 +11,7 @@ from filterpy.kalman import KalmanFilter
 
 from ftc_mc import api
 from ftc_mc.campaign.side import SIDE_COLUMNS, side_markdown, side_table
-from ftc_mc.core.longitudinal.trial import new_state
+from ftc_mc.sim.lanes import new_state
 from ftc_mc.core.longitudinal.workspace import new_trial_work
 from ftc_mc.core.sixdof.layout import (MONITOR_DIRECTIONS, MONITOR_GUST_STATES, MONITOR_PARAMS,
                                        MONITOR_STATES)

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from ftc_mc import api
-from ftc_mc.core.longitudinal.trial import new_state
+from ftc_mc.sim.lanes import new_state
 from ftc_mc.core.longitudinal.workspace import new_trial_work
 from ftc_mc.core.shared.paths import SELECT_FOUR
 from ftc_mc.core.sixdof.lockturn import SELECTED_TURN

@@ -46,6 +46,7 @@ from ftc_mc.core.longitudinal import trial
 from ftc_mc.core.longitudinal.settings import LaneState, TrialInputs, TrialRecord
 from ftc_mc.core.longitudinal.workspace import new_lane_selection_work, new_trial_work
 from ftc_mc.config import Config
+from ftc_mc.sim import lanes
 from ftc_mc.sim.paths import path_of
 from ftc_mc.sim.inputs import neutral_params
 from ftc_mc.conventions import (FP_DELAY, FP_FLOAT, FP_FLOAT_ANGLE, FP_FLOAT_GAIN, FP_OSC_AMP,
@@ -197,7 +198,7 @@ def random_fault_params(setup, E, L=L, seed=72):
 
 
 def trim_jacobians(fm, L=L):
-    """The per-lane Jacobians of a :class:`LaneState` at trim (``trial.init_jacobians``)."""
+    """The per-lane Jacobians of a :class:`LaneState` at trim (``sim.lanes.init_jacobians``)."""
     def lanes(M):
         return np.ascontiguousarray(np.repeat(np.asarray(M)[:, :, None], L, axis=2))
     return dict(JA=lanes(fm.A), JB=lanes(fm.B), JW=lanes(fm.Bw), JC=lanes(fm.C),
@@ -827,9 +828,9 @@ def test_advance_matches_the_chained_twins(fixture, policy, request):
     if policy != "none":  # the policy started signals the resets alone did not
         plain = scheme._replace(excitation=scheme.excitation._replace(policy=EXCITE_NONE))
         rec0 = new_rec(flight.timing, max_resets=16)
-        st0 = trial.new_state(L, inp.xa0.shape[0], plain.detection.window, N_X, 0, 0, 0, 1)
-        trial.init_state(inp, st0, rec0)
-        trial.init_jacobians(plain.filter, st0)
+        st0 = lanes.new_state(L, inp.xa0.shape[0], plain.detection.window, N_X, 0, 0, 0, 1)
+        lanes.init_state(inp, st0, rec0)
+        lanes.init_jacobians(plain.filter, st0)
         rec0, _ = naive.advance_ref(plain, flight, inp, rec0, st0, 0, 25)
         assert not np.array_equal(rec.hist_exc[:, 2:], rec0.hist_exc[:, 2:])
 
@@ -839,9 +840,9 @@ def assert_loop_matches(scheme, flight, inp, n_steps, tol):
     same initial state: discrete record fields exactly, continuous ones and the
     final lane state to ``tol``.  Returns the kernel's record and state."""
     rec = new_rec(flight.timing, max_resets=16)
-    st = trial.new_state(L, inp.xa0.shape[0], scheme.detection.window, N_X, 0, 0, 0, 1)
-    trial.init_state(inp, st, rec)
-    trial.init_jacobians(scheme.filter, st)
+    st = lanes.new_state(L, inp.xa0.shape[0], scheme.detection.window, N_X, 0, 0, 0, 1)
+    lanes.init_state(inp, st, rec)
+    lanes.init_jacobians(scheme.filter, st)
     rec_n, st_n = naive.advance_ref(scheme, flight, inp, copy_nt(rec), copy_nt(st), 0,
                                     n_steps)
     trial.advance(path_of(scheme, flight), scheme, flight, inp, rec, st, 0, n_steps)

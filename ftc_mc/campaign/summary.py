@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from ..core.longitudinal.trial import STATUS_NAMES
+from ..conventions import STATUS_NAMES
 from ..stats import agrees, median_p95, two_proportion_p, wilson
 from .chunk import COST_COLUMNS
 from .scoring import real_flight_scores

@@ -816,3 +816,4 @@ class PythonTwinCache(ContentFunctionCache):
     (:class:`PythonTwinCacheImpl`)."""
 
     _impl_class = PythonTwinCacheImpl
+

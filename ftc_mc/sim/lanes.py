@@ -30,12 +30,13 @@ import math
 import numpy as np
 
 from ..conventions import LONGITUDINAL as LAY
-from ..conventions import N_COST, N_MODES, RESETS_TABLE1
+from ..conventions import (C_NOMINAL, N_CMD_HIST, N_COST, N_MODES, N_U, N_X, N_Z,
+                           RESETS_TABLE1, RESIDUAL_OUTPUTS, STATUS_OK)
 from ..core.longitudinal.gustfilter import N_WIND
-from ..core.longitudinal.settings import TrialInputs, TrialRecord
+from ..core.longitudinal.settings import LaneState, TrialInputs, TrialRecord
 from ..core.longitudinal.workspace import N_EXC
-from ..core.longitudinal.trial import (N_DIRECTIONS, advance, init_jacobians, init_state,
-                                        new_state)
+from ..core.longitudinal.trial import N_DIRECTIONS, N_RMAX, NO_SIGNAL, advance
+from ..core.shared.dryden import N_GUST_STATE
 from .inputs import design_inputs
 from .paths import path_of
 
@@ -46,10 +47,140 @@ HISTORY_RESETS = 100_000
 """Resets stored per lane when every step is kept (a scenario)."""
 
 
+ALIGN = 64
+"""Byte alignment of the lane state's arrays: one cache line, one AVX-512 vector.
+The kernels load and store 64-byte vectors along the lane axis, and a lane row
+that does not start on a 64-byte boundary splits every vector access over two
+cache lines (``docs/findings/performance.md`` lesson 2)."""
+
+
+def lane_zeros(shape, dtype=np.float64) -> np.ndarray:
+    """A zeroed C-contiguous array whose data start on a 64-byte boundary
+    (:data:`ALIGN`).
+
+    Parameters
+    ----------
+    shape : int or tuple of int
+        Array shape, lane axis last.
+    dtype : data-type, optional
+        Element type (default float64).
+
+    Returns
+    -------
+    ndarray
+        A view into a slightly larger buffer, writeable, C-contiguous.
+    """
+    dtype = np.dtype(dtype)
+    n = int(np.prod(shape, dtype=np.int64))
+    buf = np.zeros(n * dtype.itemsize + ALIGN, dtype=np.uint8)
+    start = (-buf.ctypes.data) % ALIGN
+    return buf[start:start + n * dtype.itemsize].view(dtype).reshape(shape)
+
+
+def new_state(L: int, n: int, window: int, n_x: int, n_lat: int, n_glat: int, n_m: int,
+              window_m: int) -> LaneState:
+    """A :class:`~ftc_mc.core.longitudinal.settings.LaneState` of ``L`` lanes,
+    every array zeroed and 64-byte aligned (:func:`lane_zeros`); contents set by
+    :func:`init_state` (the side monitor's estimate by the monitor at step 0).
+
+    Parameters
+    ----------
+    L : int
+        Lanes (trials).
+    n : int
+        States of the estimate (14: the paper's filter; more with a design's
+        extra states).
+    window : int
+        Steps of the GLR window (1 for the one-step test).
+    n_x : int
+        States of the truth (9 longitudinal, 15 on the 6-DOF plant).
+    n_lat, n_glat : int
+        The 6-DOF lateral loop's states and lateral gust states (0 otherwise).
+    n_m, window_m : int
+        The 6-DOF side monitor's states and window in steps (0 and 1 without it).
+
+    Built in NumPy, not a kernel: a kernel called from Python compiles the
+    unboxing of every field with it, and this runs once per chunk.
+    """
+    z, i8 = lane_zeros, np.int64
+    st = LaneState(x=z((n_x, L)), xa=z((n, L)), P=z((n, n, L)),
+                   d_start=z(L, i8), s_start=z(L, i8), d_amp=z(L), s_amp=z(L),
+                   recheck=z(L, i8), belief=z((N_MODES, L)), alive=z(L, np.bool_),
+                   cur=z(L, i8), rmax=z((N_RMAX, L)), gust=z((N_GUST_STATE, L)),
+                   zhold=z(L), ebuf=z((window, len(RESIDUAL_OUTPUTS), L)),
+                   ecount=z(L, i8), last_k=z(L, i8), last_block=z(L, i8),
+                   lat=z((n_lat, L)), glat=z((n_glat, L)), mx=z((n_m, L)),
+                   mP=z((n_m, n_m, L)), mbuf=z((window_m, N_DIRECTIONS, L)),
+                   mcount=z(L, i8), mside=z(L, i8), mpos=z(L), mturn=z(L, i8),
+                   mlast=z(L, i8), mnow=z(L, i8),
+                   JA=z((N_X, N_X, L)), JB=z((N_X, N_U, L)), JW=z((N_X, N_WIND, L)),
+                   JC=z((N_Z, N_X, L)), JHW=z((N_Z, N_WIND, L)),
+                   uhist=z((N_CMD_HIST, N_U, L)), uprev=z((N_U, L)))
+    st.mturn[:] = -1
+    return st
+
+
+def init_state(inp: TrialInputs, st: LaneState, rec: TrialRecord) -> None:
+    """Initial state of every lane of ``st`` and the per-lane fields of ``rec``:
+    the truth at trim, the initial estimate and covariance of ``inp``, the belief
+    one-hot on the initial mode, no excitation, controller c0, the gust states
+    of ``inp``, no reset, no side decision."""
+    n = st.xa.shape[0]
+    L = st.xa.shape[1]
+    st.x[:] = 0.0
+    st.xa[:] = inp.xa0[:n]
+    st.P[:] = np.asarray(inp.P0)[:n, :n, None]
+    st.d_start[:] = NO_SIGNAL
+    st.s_start[:] = NO_SIGNAL
+    st.d_amp[:] = 0.0
+    st.s_amp[:] = 0.0
+    st.recheck[:] = -1
+    st.belief[:] = 0.0
+    st.belief[np.asarray(inp.mode_pre), np.arange(L)] = 1.0
+    st.alive[:] = True
+    st.cur[:] = C_NOMINAL
+    st.rmax[:] = 0.0
+    st.gust[:] = inp.g0[:st.gust.shape[0]]
+    st.zhold[:] = 0.0
+    st.uprev[:] = 0.0
+    st.uhist[:] = 0.0
+    st.glat[:] = inp.g0_lat[:st.glat.shape[0]]
+    st.lat[:] = 0.0
+    for a in (st.ecount, st.last_block, st.mcount, st.mside, st.mlast, st.mnow):
+        a[:] = 0
+    st.last_k[:] = NO_SIGNAL
+    st.mpos[:] = 0.0
+    st.mturn[:] = -1
+    rec.stop_k[:] = -1
+    rec.n_resets[:] = 0
+    rec.detect_k[:] = -1
+    rec.status[:] = STATUS_OK
+    rec.sq_lat[:] = 0.0
+    rec.cost[:] = 0.0
+    rec.z_switch_last[0] = np.nan
+    rec.z_switch_last[1] = 0.0
+    rec.side_k[:] = -1
+    for a in (rec.side_block, rec.side_pre, rec.side_n):
+        a[:] = 0
+    rec.mon_b[:] = 0.0
+
+
+def init_jacobians(fm, st: LaneState) -> None:
+    """Every lane's Jacobians (``st.JA``, ``JB``, ``JW``, ``JC``, ``JHW``) at
+    trim: ``fm.A``, ``fm.B``, ``fm.Bw``, ``fm.C``, ``fm.Dw``.  The extended
+    filter with ``fm.relin > 0`` replaces them at its first step (``k = 0``);
+    otherwise they are never read."""
+    st.JA[:] = np.asarray(fm.A)[:N_X, :N_X, None]
+    st.JB[:] = np.asarray(fm.B)[:N_X, :N_U, None]
+    st.JW[:] = np.asarray(fm.Bw)[:N_X, :N_WIND, None]
+    st.JC[:] = np.asarray(fm.C)[:N_Z, :N_X, None]
+    st.JHW[:] = np.asarray(fm.Dw)[:N_Z, :N_WIND, None]
+
+
 def start_lanes(scheme, flight, inp: TrialInputs, rec: TrialRecord):
     """The lane state of every trial of ``inp`` at step 0, and ``rec``'s per-lane
-    fields initialised (:func:`ftc_mc.core.longitudinal.trial.init_state`; the extended
-    filter's Jacobians at trim, :func:`~ftc_mc.core.longitudinal.trial.init_jacobians`).
+    fields initialised (:func:`init_state`; the extended filter's Jacobians at
+    trim, :func:`init_jacobians`).
     The truth's sizes are the flight's plant's (the 6-DOF one has 15 states, its
     lateral loop's and its side monitor's)."""
     pl = flight.plant

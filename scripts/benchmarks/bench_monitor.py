@@ -48,7 +48,7 @@ sys.path.insert(0, str(ROOT / "tests"))
 
 import bench_core  # noqa: E402
 from ftc_mc import api  # noqa: E402
-from ftc_mc.core.longitudinal.trial import new_state  # noqa: E402
+from ftc_mc.sim.lanes import new_state  # noqa: E402
 from ftc_mc.core.longitudinal.workspace import new_trial_work  # noqa: E402
 from ftc_mc.core.sixdof.monitor import (EXTENDED, sixdof_monitor,  # noqa: E402
                                         sixdof_monitor_extended)

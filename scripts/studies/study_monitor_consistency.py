@@ -53,7 +53,7 @@ import ftc_mc  # noqa: F401  (BLAS pinning before numpy's first use)
 import numpy as np
 
 from ftc_mc import api
-from ftc_mc.core.longitudinal.trial import new_state
+from ftc_mc.sim.lanes import new_state
 from ftc_mc.core.longitudinal.workspace import new_trial_work
 from ftc_mc.core.sixdof.layout import LAYOUT, MONITOR_STATES
 from ftc_mc.core.sixdof.monitor import sixdof_monitor

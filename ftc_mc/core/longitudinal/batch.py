@@ -138,6 +138,13 @@ def _symmetric_copy(P, Pout, L):
 
 
 # ------------------------------------------------------------------ predict
+ALL_LANES_FROM = np.int64(0)
+"""First lane of a prediction over every lane.  An int64, not the literal ``0``:
+Numba types a literal argument as a signature of its own, and the by-address
+:func:`_predict` was compiled twice, once for the literal and once for the
+re-prediction's run of lanes (1.4 s of the default path's cold compile)."""
+
+
 @kernel(by_address=True)
 def _predict(xa, P, Pn, u, fm, phi, T, l0, l1):
     """Eq. (5) on lanes ``l0:l1``: ``Pn <- A_aug P A_aug^T + Q`` (``Pn`` may be ``P``).
@@ -275,7 +282,7 @@ def predict_lanes(xa, P, u, fm, phi, T):
     T : ndarray, shape (9, n, L)
         Work array.
     """
-    _predict(xa, P, P, u, fm, phi, T, 0, xa.shape[1])
+    _predict(xa, P, P, u, fm, phi, T, ALL_LANES_FROM, xa.shape[1])
 
 
 # ------------------------------------------------------------------ residuals
@@ -579,7 +586,7 @@ def filter_predict_lanes(xa, P, u, z, fm, phi, T, work, res):
     for i in range(N_X):
         for l in range(L):
             x_prev[i, l] = xa[i, l]
-    _predict(xa, P, Pn, u, fm, phi, T, 0, L)
+    _predict(xa, P, Pn, u, fm, phi, T, ALL_LANES_FROM, L)
     residuals_lanes(xa, Pn, z, fm, res)
 
 
@@ -608,7 +615,7 @@ def filter_correct_lanes(xa, P, u, z, fm, det, phi, T, work, block):
                 if block[l] == 0:
                     for i in range(N_X):
                         xa[i, l] = x_prev[i, l]
-            _predict(xa, P, Pn, u, fm, phi, T, 0, L)
+            _predict(xa, P, Pn, u, fm, phi, T, ALL_LANES_FROM, L)
         else:
             l = 0
             while l < L:

@@ -693,16 +693,18 @@ def select_lanes(scheme, st, work):
     xa = st.xa
     P = st.P
     L = xa.shape[1]
-    if xa.shape[0] == N_AUG:
-        select_controllers_lanes(st.cur, xa, P, st.belief, scheme, work.lsel)
-    else:  # the selection predicts with the paper's model: the first 14 states
+    if xa.shape[0] != N_AUG:  # the selection predicts with the paper's model: the first 14 states
         for i in range(N_AUG):
             for l in range(L):
                 work.xsel[i, l] = xa[i, l]
             for j in range(N_AUG):
                 for l in range(L):
                     work.Psel[i, j, l] = P[i, j, l]
-        select_controllers_lanes(st.cur, work.xsel, work.Psel, st.belief, scheme, work.lsel)
+        xa = work.xsel
+        P = work.Psel
+    # one call site: the selection is inlined here once (each call site is a
+    # copy of it, half of this stage's compile)
+    select_controllers_lanes(st.cur, xa, P, st.belief, scheme, work.lsel)
 
 
 @on_path("control", {RECONFIGURING: select_lanes})

@@ -39,17 +39,10 @@ calls it and stage 7 by address (``core/linking.py``):
 
 from __future__ import annotations
 
-import numpy as np
-
-from ...conventions import (N_AUG, N_CMD_HIST, N_MODES, N_U, N_X, N_Z, STATUS_AIRSPEED,  # noqa: F401
-                           STATUS_ALPHA, STATUS_NAMES, STATUS_NONFINITE,
-                           STATUS_NOT_PSD, STATUS_OK, C_NOMINAL, RESIDUAL_OUTPUTS)
-from ..shared.dryden import N_GUST_STATE
-from .gustfilter import N_WIND
+from ...conventions import N_U
 from ..jit import kernel
 from .plant import truth
 from ..shared.paths import SELECT_FOUR, SIXDOF_EXTENDED_PLANT, SIXDOF_PLANT, on_path
-from .settings import LaneState
 from .stages import (check_validity, commands, filter_update, handle_resets,  # noqa: F401
                      is_psd, reconfigure, record_cost, record_end, record_step)
 from .workspace import new_trial_work
@@ -58,7 +51,8 @@ NO_SIGNAL = -(1 << 40)
 """Start step of a signal that is not running (far in the past)."""
 
 N_RMAX = 2
-"""Residuals whose running maximum a lane keeps (``r_q``, ``r_nx``)."""
+"""Residuals whose running maximum a lane keeps (``r_q``, ``r_nx``;
+``LaneState.rmax``)."""
 
 N_DIRECTIONS = N_U
 """Fault directions of the 6-DOF side monitor: one per actuator
@@ -110,7 +104,8 @@ def advance(path, scheme, flight, inp, rec, st, k0, k1):
     inp : TrialInputs
         Per-lane fault schedule, initial estimates and noise.
     rec : TrialRecord
-        Outputs, continued from step ``k0`` (initialised by :func:`init_state`).
+        Outputs, continued from step ``k0`` (initialised by
+        :func:`ftc_mc.sim.lanes.init_state`).
     st : LaneState
         The trials' state at step ``k0``, advanced in place to ``k1``.  It holds
         everything a trial carries from one step to the next, so a state saved
@@ -158,121 +153,3 @@ def trial_steps(path, scheme, flight, inp, k0, k1, st, work, rec):
         check_validity(flight.validity, st, kn, work, rec)
         handle_resets(scheme.excitation, st, kn, work, rec)
         record_step(k, st, work, rec)
-
-
-@kernel
-def init_state(inp, st, rec):
-    """Initial state of every lane (trim, the initial estimate, the belief one-hot
-    on the initial mode, no excitation, controller c0) and the record's
-    per-lane fields."""
-    n = st.xa.shape[0]
-    for l in range(st.xa.shape[1]):
-        for i in range(st.x.shape[0]):
-            st.x[i, l] = 0.0
-        for i in range(n):
-            st.xa[i, l] = inp.xa0[i, l]
-            for j in range(n):
-                st.P[i, j, l] = inp.P0[i, j]
-        st.d_start[l] = NO_SIGNAL
-        st.s_start[l] = NO_SIGNAL
-        st.d_amp[l] = 0.0
-        st.s_amp[l] = 0.0
-        st.recheck[l] = -1
-        for m in range(st.belief.shape[0]):
-            st.belief[m, l] = 0.0
-        st.belief[inp.mode_pre[l], l] = 1.0
-        st.alive[l] = True
-        st.cur[l] = C_NOMINAL
-        for i in range(st.rmax.shape[0]):
-            st.rmax[i, l] = 0.0
-        rec.stop_k[l] = -1
-        rec.n_resets[l] = 0
-        rec.detect_k[l] = -1
-        rec.status[l] = STATUS_OK
-        for i in range(st.gust.shape[0]):
-            st.gust[i, l] = inp.g0[i, l]
-        st.zhold[l] = 0.0
-        for i in range(N_U):
-            st.uprev[i, l] = 0.0
-            for j in range(st.uhist.shape[0]):
-                st.uhist[j, i, l] = 0.0
-        for i in range(st.glat.shape[0]):
-            st.glat[i, l] = inp.g0_lat[i, l]
-        for i in range(st.lat.shape[0]):
-            st.lat[i, l] = 0.0
-        for i in range(rec.sq_lat.shape[0]):
-            rec.sq_lat[i, l] = 0.0
-        for i in range(rec.cost.shape[0]):
-            rec.cost[i, l] = 0.0
-        rec.z_switch_last[0, l] = np.nan
-        rec.z_switch_last[1, l] = 0.0
-        st.ecount[l] = 0
-        st.last_k[l] = NO_SIGNAL
-        st.last_block[l] = 0
-        st.mcount[l] = 0
-        st.mside[l] = 0
-        st.mpos[l] = 0.0
-        st.mturn[l] = -1
-        st.mlast[l] = 0
-        st.mnow[l] = 0
-        rec.side_k[l] = -1
-        rec.side_block[l] = 0
-        rec.side_pre[l] = 0
-        rec.side_n[l] = 0
-        for i in range(rec.mon_b.shape[0]):
-            rec.mon_b[i, l] = 0.0
-
-
-@kernel
-def new_state(L, n, window, n_x, n_lat, n_glat, n_m, window_m):
-    """A :class:`LaneState` of ``L`` lanes, an ``n``-state estimate (14: the
-    paper's filter; 18 with gust states), a GLR window of ``window`` steps
-    (1 for the one-step test) and an ``n_x``-state truth (9 longitudinal, 15
-    on the 6-DOF plant, with its lateral loop's ``n_lat`` and lateral gusts'
-    ``n_glat`` states, and its side monitor's ``n_m`` states and window of
-    ``window_m`` steps; 0 otherwise); contents set by :func:`init_state` (the
-    side monitor's estimate by the monitor at step 0)."""
-    return LaneState(x=np.zeros((n_x, L)), xa=np.zeros((n, L)),
-                     P=np.zeros((n, n, L)),
-                     d_start=np.zeros(L, dtype=np.int64),
-                     s_start=np.zeros(L, dtype=np.int64),
-                     d_amp=np.zeros(L), s_amp=np.zeros(L),
-                     recheck=np.zeros(L, dtype=np.int64), belief=np.zeros((N_MODES, L)),
-                     alive=np.zeros(L, dtype=np.bool_), cur=np.zeros(L, dtype=np.int64),
-                     rmax=np.zeros((N_RMAX, L)), gust=np.zeros((N_GUST_STATE, L)),
-                     zhold=np.zeros(L), ebuf=np.zeros((window, len(RESIDUAL_OUTPUTS), L)),
-                     ecount=np.zeros(L, dtype=np.int64),
-                     last_k=np.zeros(L, dtype=np.int64),
-                     last_block=np.zeros(L, dtype=np.int64),
-                     lat=np.zeros((n_lat, L)), glat=np.zeros((n_glat, L)),
-                     mx=np.zeros((n_m, L)), mP=np.zeros((n_m, n_m, L)),
-                     mbuf=np.zeros((window_m, N_DIRECTIONS, L)),
-                     mcount=np.zeros(L, dtype=np.int64),
-                     mside=np.zeros(L, dtype=np.int64), mpos=np.zeros(L),
-                     mturn=np.full(L, -1, dtype=np.int64),
-                     mlast=np.zeros(L, dtype=np.int64), mnow=np.zeros(L, dtype=np.int64),
-                     JA=np.zeros((N_X, N_X, L)), JB=np.zeros((N_X, N_U, L)),
-                     JW=np.zeros((N_X, N_WIND, L)), JC=np.zeros((N_Z, N_X, L)),
-                     JHW=np.zeros((N_Z, N_WIND, L)),
-                     uhist=np.zeros((N_CMD_HIST, N_U, L)), uprev=np.zeros((N_U, L)))
-
-
-@kernel
-def init_jacobians(fm, st):
-    """Every lane's Jacobians (``st.JA``, ``JB``, ``JW``, ``JC``, ``JHW``) at trim:
-    ``fm.A``, ``fm.B``, ``fm.Bw``, ``fm.C``, ``fm.Dw``.  The extended filter with
-    ``fm.relin > 0`` replaces them at its first step (``k = 0``); otherwise they
-    are never read."""
-    for l in range(st.JA.shape[2]):
-        for i in range(N_X):
-            for j in range(N_X):
-                st.JA[i, j, l] = fm.A[i, j]
-            for j in range(N_U):
-                st.JB[i, j, l] = fm.B[i, j]
-            for j in range(N_WIND):
-                st.JW[i, j, l] = fm.Bw[i, j]
-        for r in range(N_Z):
-            for j in range(N_X):
-                st.JC[r, j, l] = fm.C[r, j]
-            for j in range(N_WIND):
-                st.JHW[r, j, l] = fm.Dw[r, j]
