@@ -145,20 +145,17 @@ Numba types a literal argument as a signature of its own, and the by-address
 re-prediction's run of lanes (1.4 s of the default path's cold compile)."""
 
 
-@kernel(by_address=True)
-def _predict(xa, P, Pn, u, fm, phi, T, l0, l1):
-    """Eq. (5) on lanes ``l0:l1``: ``Pn <- A_aug P A_aug^T + Q`` (``Pn`` may be ``P``).
-
-    Reads the full symmetric ``P`` and writes the full symmetric ``Pn``; ``xa``
-    is advanced in place.  Operation order per lane as in
-    ``tests/single_trajectory.py::predict``.
-    """
-    n = P.shape[0]
+@kernel(inline="always")
+def _predict_state(xa, u, fm, phi, T, l0, l1):
+    """The state half of eq. (5) on lanes ``l0:l1``: ``phi <- Phi(u)`` and
+    ``x <- A x + B u + Phi(u) b`` in place (``b`` unchanged, a random walk,
+    eq. 3), with ``T[:9, 0]`` as scratch.  :func:`_predict` and
+    :func:`predict_state_lanes` both run it, so the two agree to the bit."""
     u00 = fm.u0[0]
     u01 = fm.u0[1]
     u02 = fm.u0[2]
     # Phi(u) = [B_b0, B diag(-u - u0)] (eqs. 4-5), kept for the caller; the
-    # products below recompute it
+    # products of _predict recompute it
     for i in range(N_X):
         bb = _row_b0(fm.Bb0, i)
         nb = _neg_row_b(fm.B, i)
@@ -184,6 +181,18 @@ def _predict(xa, P, Pn, u, fm, phi, T, l0, l1):
     for i in range(N_X):
         for l in range(l0, l1):
             xa[i, l] = T[i, 0, l]
+
+
+@kernel(by_address=True)
+def _predict(xa, P, Pn, u, fm, phi, T, l0, l1):
+    """Eq. (5) on lanes ``l0:l1``: ``Pn <- A_aug P A_aug^T + Q`` (``Pn`` may be ``P``).
+
+    Reads the full symmetric ``P`` and writes the full symmetric ``Pn``; ``xa``
+    is advanced in place.  Operation order per lane as in
+    ``tests/single_trajectory.py::predict``.
+    """
+    n = P.shape[0]
+    _predict_state(xa, u, fm, phi, T, l0, l1)
     # T = [A Phi] P, three rows of A_aug at a time
     for i in range(0, N_X, 3):
         a0 = _row_x(fm.A, i)
@@ -283,6 +292,28 @@ def predict_lanes(xa, P, u, fm, phi, T):
         Work array.
     """
     _predict(xa, P, P, u, fm, phi, T, ALL_LANES_FROM, xa.shape[1])
+
+
+@kernel(inline="always")
+def predict_state_lanes(xa, u, fm, phi, T):
+    """The state half of :func:`predict_lanes` (eq. 5) without the covariance:
+    ``X <- A_aug(u) X + B_aug u``, bit for bit the state :func:`predict_lanes`
+    leaves.  The controller selection predicts its short-horizon costs with it
+    (:func:`ftc_mc.core.longitudinal.control.controller_objectives_lanes`).
+
+    Parameters
+    ----------
+    xa : ndarray, shape (n, L)
+        Augmented estimates, updated in place.
+    u : ndarray, shape (3, L)
+        Command deviations from trim applied during the step.
+    fm : FilterModel
+    phi : ndarray, shape (9, 5, L)
+        Work array; holds ``Phi(u)`` of each lane on return.
+    T : ndarray, shape (9, n, L)
+        Work array.
+    """
+    _predict_state(xa, u, fm, phi, T, ALL_LANES_FROM, xa.shape[1])
 
 
 # ------------------------------------------------------------------ residuals

@@ -49,7 +49,7 @@ from .signature import signature_lanes
 from ..shared.glr import glr_lanes, glr_restart
 from .gustfilter import gust_correct_lanes, gust_predict_lanes
 from ..shared.belief import belief_update_lane
-from .control import (U_LEFT, U_RIGHT, U_THRUST, controller_command, feedback_lanes,
+from .control import (U_LEFT, U_RIGHT, U_THRUST, controller_commands_lanes, feedback_lanes,
                       select_controllers_lanes)
 from ..shared.excitation import (doublet, doublet_length, running, saturate, signal_3211,
                                  signal_3211_length)
@@ -75,18 +75,12 @@ def nominal_output(scheme, st, work):
 @kernel(internal=True)
 def reconfiguring_output(scheme, st, work):
     """The output of each lane's controller in use into ``work.u``
-    (:func:`ftc_mc.core.longitudinal.control.controller_command`: c0, c1 of eq. 44 or c2 of
-    eqs. 20-25); one-lane buffers ``xl``, ``Ul``."""
-    xa = st.xa
-    xl = work.xl
-    Ul = work.Ul
-    for l in range(xa.shape[1]):
-        for i in range(xa.shape[0]):
-            xl[i] = xa[i, l]
-        controller_command(st.cur[l], xl, scheme.controller.K, scheme.engine,
-                           scheme.filter.u0, Ul)
-        for i in range(N_U):
-            work.u[i, l] = Ul[i]
+    (:func:`ftc_mc.core.longitudinal.control.controller_commands_lanes`: c0,
+    c1 of eq. 44 or c2 of eqs. 20-25, each lane bit for bit
+    :func:`~ftc_mc.core.longitudinal.control.controller_command`, the nominal
+    feedback across lanes); one-lane buffers ``xl``, ``Ul``."""
+    controller_commands_lanes(st.cur, st.xa, scheme.controller.K, scheme.engine,
+                              scheme.filter.u0, work.u, work.xl, work.Ul)
 
 
 @on_path("control", {NOMINAL_CONTROL: nominal_output, RECONFIGURING: reconfiguring_output,
@@ -726,8 +720,9 @@ def reconfigure(path, scheme, timing, inp, st, kn, period, work, rec):
     estimate's first 14 states (a design's gust states are left out), for every
     lane at once (:func:`ftc_mc.core.longitudinal.control.select_controllers_lanes`, per
     lane bit-identical to ``tests/single_trajectory.py::select_controller``; the
-    horizon predictions run lane-interleaved, about 4x faster than one lane at
-    a time); and the detection time: the
+    horizon predictions run lane-interleaved, and the covariance's only for
+    the controllers whose objective can be the smallest,
+    ``docs/findings/performance.md`` lesson 19); and the detection time: the
     first period end after the switch ``k_fault`` where the final mode is the
     most probable with at least ``detect_prob`` (live lanes only).
 

@@ -37,15 +37,18 @@ N_EXC = 4
 
 LaneSelectionWork = namedtuple("LaneSelectionWork", [
     # lane arrays (lane index last)
-    "xs",      # (n, L) estimates predicted over the horizon
-    "Ps",      # (n, n, L) their covariances
+    "xs",      # (n L,) estimates predicted over the horizon, viewed as (n, L') (L' <= L)
+    "Ps",      # (n n L,) their covariances, viewed as (n, n, L')
     "U",       # (N_U, L) commands of the controller under test
     "z",       # (N_Z, L) predicted measurements (zero innovation)
     "phi",     # (N_X, N_FAULT, L) Phi(u) (batch.predict_lanes)
     "T",       # (N_X, n, L) [A Phi] P (batch.predict_lanes)
     "h",       # (UPDATE_ROWS, n, L) gains of the update (batch.update_lanes)
     "cost",    # (L,) discounted short-horizon cost (eq. 45)
-    "obj",     # (N_CONTROLLERS, L) objective of each controller (eq. 47)
+    "obj",     # (N_CONTROLLERS, L) objective of each controller (eq. 47), +inf if not computed
+    "floor",   # (N_CONTROLLERS, L) lower bound of each objective from its cost alone
+    "cand",    # (L,) int64 controller of each predicted entry
+    "lane",    # (L,) int64 lane of each predicted entry
     # one lane at a time
     "xl",      # (n,) a lane's predicted estimate (engine controller c1)
     "Ul",      # (N_U,) its command
@@ -111,9 +114,11 @@ TrialWork = namedtuple("TrialWork", [
 def new_lane_selection_work(L, n):
     """Zeroed :class:`LaneSelectionWork` for ``L`` lanes and augmented dimension ``n``."""
     return LaneSelectionWork(
-        xs=np.zeros((n, L)), Ps=np.zeros((n, n, L)), U=np.zeros((N_U, L)),
+        xs=np.zeros(n * L), Ps=np.zeros(n * n * L), U=np.zeros((N_U, L)),
         z=np.zeros((N_Z, L)), phi=np.zeros((N_X, N_FAULT, L)), T=np.zeros((N_X, n, L)),
         h=np.zeros((UPDATE_ROWS, n, L)), cost=np.zeros(L), obj=np.zeros((N_CONTROLLERS, L)),
+        floor=np.zeros((N_CONTROLLERS, L)),
+        cand=np.zeros(L, dtype=np.int64), lane=np.zeros(L, dtype=np.int64),
         xl=np.zeros(n), Ul=np.zeros(N_U), bl=np.zeros(N_MODES), bhat=np.zeros(N_FAULT),
         bvar=np.zeros(N_FAULT), bwork=np.zeros(2 * N_MODES))
 
