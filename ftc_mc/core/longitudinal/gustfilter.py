@@ -404,6 +404,13 @@ def _nl_outputs(xa, fm, hpred, xp, tw):
 
 
 # ------------------------------------------------------------------ path dispatch
+NOT_FRESH = np.bool_(False)
+"""``_gpredict``'s ``fresh`` on a re-prediction after a reset.  A NumPy bool,
+not the literal ``False``: Numba types a literal as a signature of its own, and
+the prediction was compiled twice (4 s of the 6-DOF extended
+monitor's path)."""
+
+
 # The airframe's equations run only on the extended filter's path
 # (core/shared/paths.py): the general filter's kernels take the filter's marker
 # (``fkind``), and on the dense filter's these calls compile to nothing.
@@ -842,7 +849,7 @@ def gust_correct_lanes(fkind, xa, P, fm, det, tw, st):
         for i in range(n):
             for l in range(L):
                 xa[i, l] = x_prev[i, l]
-        _gpredict(fkind, xa, P, Pn, tw.u, fm, tw.phi, tw.T, work[n + 3], tw, st, False)
+        _gpredict(fkind, xa, P, Pn, tw.u, fm, tw.phi, tw.T, work[n + 3], tw, st, NOT_FRESH)
         if fm.nl != 0:
             nl_outputs(fkind, xa, fm, work[n + 4], work[n + 5], tw)
     _gupdate(xa, Pn, tw.z, fm, tw.crow, work[n], work[n + 1], work[n + 2], work[n + 4],
