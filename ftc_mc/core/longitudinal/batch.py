@@ -142,7 +142,9 @@ ALL_LANES_FROM = np.int64(0)
 """First lane of a prediction over every lane.  An int64, not the literal ``0``:
 Numba types a literal argument as a signature of its own, and the by-address
 :func:`_predict` was compiled twice, once for the literal and once for the
-re-prediction's run of lanes (1.4 s of the default path's cold compile)."""
+re-prediction's run of lanes (1.4-2.0 s of the default path's cold compile);
+the run's first lane, a loop variable that starts at ``0``, is an int64 for the
+same reason."""
 
 
 @kernel(inline="always")
@@ -648,7 +650,7 @@ def filter_correct_lanes(xa, P, u, z, fm, det, phi, T, work, block):
                         xa[i, l] = x_prev[i, l]
             _predict(xa, P, Pn, u, fm, phi, T, ALL_LANES_FROM, L)
         else:
-            l = 0
+            l = np.int64(0)  # not the literal 0: a literal first lane is a signature of its own
             while l < L:
                 if block[l] != 0:
                     l1 = l + 1
