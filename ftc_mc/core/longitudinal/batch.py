@@ -138,13 +138,17 @@ def _symmetric_copy(P, Pout, L):
 
 
 # ------------------------------------------------------------------ predict
-ALL_LANES_FROM = np.int64(0)
-"""First lane of a prediction over every lane.  An int64, not the literal ``0``:
-Numba types a literal argument as a signature of its own, and the by-address
-:func:`_predict` was compiled twice, once for the literal and once for the
-re-prediction's run of lanes (1.4-2.0 s of the default path's cold compile);
-the run's first lane, a loop variable that starts at ``0``, is an int64 for the
-same reason."""
+ALL_LANES_FROM = 0
+"""First lane of a prediction over every lane: the literal ``0``, on purpose.
+Numba types a literal argument as a signature of its own, so the by-address
+:func:`_predict` is compiled twice, specialised on the first lane ``0`` for
+every step's prediction and the selection's, and for any first lane for the
+serial re-prediction of a run of lanes that reset (1.6-1.8 s of the default
+path's cold compile).  The specialised copy is the fast one: with an int64
+first lane everywhere ``configs/paper_tables.yaml`` (1000 trials a row, ``--jobs
+2``) ran at 0.76-0.78 M trial steps/s nominal against 1.05-1.12 M with it, and
+0.41 M reconfiguring against 0.61 M (``docs/findings/performance.md``,
+lesson 20)."""
 
 
 @kernel(inline="always")
@@ -650,7 +654,7 @@ def filter_correct_lanes(xa, P, u, z, fm, det, phi, T, work, block):
                         xa[i, l] = x_prev[i, l]
             _predict(xa, P, Pn, u, fm, phi, T, ALL_LANES_FROM, L)
         else:
-            l = np.int64(0)  # not the literal 0: a literal first lane is a signature of its own
+            l = 0
             while l < L:
                 if block[l] != 0:
                     l1 = l + 1
