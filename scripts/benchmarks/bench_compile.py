@@ -68,6 +68,8 @@ from ftc_mc.campaign.chunk import chunk_spec, warm_up
 import dataclasses
 cfg_name, design, overrides = sys.argv[1], sys.argv[2], json.loads(sys.argv[3])
 cfg = load_config("configs/" + cfg_name)
+if design in cfg.designs:  # a design of the config's section: run it (built-ins always run)
+    overrides = dict(overrides, campaign={"designs": [design]})
 if overrides:
     cfg = with_overrides(cfg, **overrides)
 spec = chunk_spec(cfg)
