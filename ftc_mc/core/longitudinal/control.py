@@ -397,21 +397,10 @@ def _pad_entries(m, L, sw):
     return Lp
 
 
-GATHERED = np.bool_(True)
-"""``_entry_objectives``'s ``gather`` for entries gathered from the lanes.  A
-NumPy bool, not the literal ``True``: Numba types each literal as a signature
-of its own, and :func:`_entry_objectives` was compiled once per literal."""
-
-IN_ORDER = np.bool_(False)
-"""``_entry_objectives``'s ``gather`` for the lanes in order (:data:`GATHERED`)."""
-
-
 @kernel(internal=True)
-def _entry_objectives(m, gather, cur, xa, P, belief, scheme, sw):
+def _entry_objectives(m, cur, xa, P, belief, scheme, sw):
     """The objective (eq. 47) of the first ``m`` entries of ``sw.cand``,
-    ``sw.lane`` (controller ``a`` on lane ``l``) into ``sw.obj[a, l]``;
-    ``gather`` False when the entries are the lanes in order (``m = L``,
-    ``sw.lane[p] = p``).
+    ``sw.lane`` (controller ``a`` on lane ``l``) into ``sw.obj[a, l]``.
 
     Each entry is one lane of a horizon prediction
     (:func:`_predicted_cost_lanes`, lanes gathered from ``xa``, ``P``, padded
@@ -430,22 +419,13 @@ def _entry_objectives(m, gather, cur, xa, P, belief, scheme, sw):
     Lp = _pad_entries(m, L, sw)
     xs = sw.xs[:n * Lp].reshape((n, Lp))
     Ps = sw.Ps[:n * n * Lp].reshape((n, n, Lp))
-    if gather:
-        for i in range(n):
+    for i in range(n):
+        for p in range(Lp):
+            xs[i, p] = xa[i, lane[p]]
+    for i in range(n):
+        for j in range(n):
             for p in range(Lp):
-                xs[i, p] = xa[i, lane[p]]
-        for i in range(n):
-            for j in range(n):
-                for p in range(Lp):
-                    Ps[i, j, p] = P[i, j, lane[p]]
-    else:  # every lane in order (a plain copy, which vectorises)
-        for i in range(n):
-            for p in range(Lp):
-                xs[i, p] = xa[i, p]
-        for i in range(n):
-            for j in range(n):
-                for p in range(Lp):
-                    Ps[i, j, p] = P[i, j, p]
+                Ps[i, j, p] = P[i, j, lane[p]]
     _predicted_cost_lanes(cand, xs, Ps, scheme.filter, rc, scheme.engine, ctl.K,
                           ctl.lo_dev, ctl.hi_dev, sw)
     for p in range(m):
@@ -533,7 +513,7 @@ def controller_objectives_lanes(cur, xa, P, belief, scheme, sw):
     for l in range(L):
         sw.cand[l] = cur[l]
         lane[l] = l
-    _entry_objectives(L, IN_ORDER, cur, xa, P, belief, scheme, sw)
+    _entry_objectives(L, cur, xa, P, belief, scheme, sw)
     m = np.int64(0)  # not the literal 0: a literal count would be a signature of its own
     for l in range(L):
         c = cur[l]
@@ -543,10 +523,10 @@ def controller_objectives_lanes(cur, xa, P, belief, scheme, sw):
                 lane[m] = l
                 m += 1
                 if m == L:
-                    _entry_objectives(m, GATHERED, cur, xa, P, belief, scheme, sw)
+                    _entry_objectives(m, cur, xa, P, belief, scheme, sw)
                     m = np.int64(0)
     if m > 0:
-        _entry_objectives(m, GATHERED, cur, xa, P, belief, scheme, sw)
+        _entry_objectives(m, cur, xa, P, belief, scheme, sw)
 
 
 @kernel(inline="always")
